@@ -1,0 +1,74 @@
+# bayesgrasp: `make demo` and `make test` do all the set-up on a fresh Debian machine.
+SHELL := /bin/bash
+PYTHON ?= python3
+VENV := .venv
+BENCH_VENV := .venv-bench
+PY := $(VENV)/bin/python
+JOBS ?= $(shell nproc 2>/dev/null || echo 2)
+export CMAKE_BUILD_PARALLEL_LEVEL ?= $(JOBS)
+
+# Debian packages the build needs (checked one by one; only missing ones are installed).
+DEB_PACKAGES := build-essential cmake pkg-config python3-dev python3-venv \
+  libeigen3-dev libfcl-dev libbullet-dev libqhull-dev nlohmann-json3-dev liblbfgspp-dev \
+  libgtest-dev libbenchmark-dev
+
+SOURCES := $(shell find cpp python tests/cpp bench -type f \( -name '*.cpp' -o -name '*.hpp' -o -name '*.h' -o -name '*.py' -o -name '*.json' \) 2>/dev/null) \
+           CMakeLists.txt pyproject.toml
+
+.PHONY: all demo test bench deps clean distclean ctest pytest
+all: $(VENV)/.installed
+
+# ---- system packages -------------------------------------------------------------------
+build/.deps-ok: Makefile
+	@mkdir -p build
+	@missing=""; for p in $(DEB_PACKAGES); do \
+	  dpkg-query -W -f='$${Status}' $$p 2>/dev/null | grep -q "install ok installed" || missing="$$missing $$p"; \
+	done; \
+	if [ -n "$$missing" ]; then \
+	  echo ">> installing Debian packages:$$missing"; \
+	  SUDO=""; [ "$$(id -u)" -ne 0 ] && SUDO=sudo; \
+	  $$SUDO apt-get update -qq && DEBIAN_FRONTEND=noninteractive $$SUDO apt-get install -y -qq --no-install-recommends $$missing; \
+	else echo ">> Debian packages present"; fi
+	@touch $@
+deps: build/.deps-ok
+
+# ---- Python virtual environment ----------------------------------------------------------
+$(VENV)/.base: build/.deps-ok
+	$(PYTHON) -m venv $(VENV)
+	$(PY) -m pip install -q --upgrade pip
+	$(PY) -m pip install -q "scikit-build-core>=0.10" "pybind11>=2.12" ninja numpy scipy matplotlib trimesh tqdm pytest scikit-learn
+	@touch $@
+
+# The package is built by scikit-build-core in build/py (kept between builds, so a second
+# build recompiles only what changed); the same tree holds the C++ tests and benchmarks.
+$(VENV)/.installed: $(VENV)/.base $(SOURCES)
+	$(PY) -m pip install -q --no-build-isolation --no-deps .
+	@touch $@
+
+# ---- the two commands --------------------------------------------------------------------
+demo: $(VENV)/.installed
+	$(VENV)/bin/bayesgrasp demo --out out/demo
+
+ctest: $(VENV)/.installed
+	ctest --test-dir build/py --output-on-failure -j $(JOBS)
+
+pytest: $(VENV)/.installed
+	$(VENV)/bin/python -m pytest -q tests/python
+
+test: ctest pytest
+
+# ---- benchmarks ----------------------------------------------------------------------------
+# Peers (GPy, pyswarms, pybullet, scikit-learn) live in their own virtual environment.
+$(BENCH_VENV)/.base: build/.deps-ok
+	$(PYTHON) -m venv $(BENCH_VENV)
+	$(BENCH_VENV)/bin/pip install -q --upgrade pip
+	$(BENCH_VENV)/bin/pip install -q -r bench/requirements.txt
+	@touch $@
+
+bench: $(VENV)/.installed $(BENCH_VENV)/.base
+	BENCH_PY=$(BENCH_VENV)/bin/python BAYESGRASP_PY=$(PY) BUILD_DIR=build/py bash bench/run_all.sh
+
+clean:
+	rm -rf build/py out
+distclean:
+	rm -rf build $(VENV) $(BENCH_VENV)

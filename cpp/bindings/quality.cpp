@@ -1,0 +1,6 @@
+// Bindings for the quality concept (to be written).
+#include <pybind11/pybind11.h>
+
+namespace bayesgrasp::bind {
+void bind_quality(pybind11::module_& m) {}
+}  // namespace bayesgrasp::bind

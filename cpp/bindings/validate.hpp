@@ -1,0 +1,95 @@
+// Input checks shared by the bindings: every array a user passes is checked for shape,
+// dtype (converted to float64/int32 by pybind11) and finiteness, and a ValueError names
+// the offending argument. Nothing a user passes may crash the interpreter.
+#pragma once
+
+#include <pybind11/eigen.h>
+#include <pybind11/numpy.h>
+#include <pybind11/pybind11.h>
+
+#include <cmath>
+#include <string>
+
+#include "bayesgrasp/geometry/mesh.hpp"
+
+namespace bayesgrasp::bind {
+
+namespace py = pybind11;
+using RowMatrixXd = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
+using DArray = py::array_t<double, py::array::c_style | py::array::forcecast>;
+using IArray = py::array_t<int, py::array::c_style | py::array::forcecast>;
+
+inline std::string shape_str(const py::array& a) {
+  std::string s = "(";
+  for (py::ssize_t i = 0; i < a.ndim(); ++i) s += (i ? ", " : "") + std::to_string(a.shape(i));
+  return s + (a.ndim() == 1 ? ",)" : ")");
+}
+
+/// Checks a float array is 2-D with `cols` columns (any if cols < 0) and all finite;
+/// returns it as a row-major Eigen matrix (copy).
+inline RowMatrixXd matrix(const DArray& a, const char* name, py::ssize_t cols = -1,
+                          bool allow_empty = false) {
+  if (a.ndim() != 2 || (cols >= 0 && a.shape(1) != cols))
+    throw py::value_error(std::string(name) + ": expected shape (N, " +
+                          (cols >= 0 ? std::to_string(cols) : std::string("D")) + "), got " + shape_str(a));
+  if (!allow_empty && a.shape(0) == 0) throw py::value_error(std::string(name) + ": is empty");
+  Eigen::Map<const RowMatrixXd> m(a.data(), a.shape(0), a.shape(1));
+  if (!m.allFinite()) throw py::value_error(std::string(name) + ": contains NaN or infinity");
+  return m;
+}
+
+/// Checks a float array is 1-D with `n` entries (any if n < 0) and all finite.
+inline Eigen::VectorXd vector(const DArray& a, const char* name, py::ssize_t n = -1) {
+  if (a.ndim() != 1 || (n >= 0 && a.shape(0) != n))
+    throw py::value_error(std::string(name) + ": expected shape (" +
+                          (n >= 0 ? std::to_string(n) : std::string("N")) + ",), got " + shape_str(a));
+  Eigen::Map<const Eigen::VectorXd> v(a.data(), a.shape(0));
+  if (!v.allFinite()) throw py::value_error(std::string(name) + ": contains NaN or infinity");
+  return v;
+}
+
+inline double finite(double x, const char* name) {
+  if (!std::isfinite(x)) throw py::value_error(std::string(name) + ": must be finite, got " + std::to_string(x));
+  return x;
+}
+
+inline double positive(double x, const char* name) {
+  if (!(x > 0.0) || !std::isfinite(x))
+    throw py::value_error(std::string(name) + ": must be positive and finite, got " + std::to_string(x));
+  return x;
+}
+
+/// A 4x4 homogeneous pose.
+inline Iso3 pose(const DArray& a, const char* name) {
+  if (a.ndim() != 2 || a.shape(0) != 4 || a.shape(1) != 4)
+    throw py::value_error(std::string(name) + ": expected shape (4, 4), got " + shape_str(a));
+  Eigen::Map<const Eigen::Matrix<double, 4, 4, Eigen::RowMajor>> m(a.data());
+  try {
+    return pose_from_matrix(m);
+  } catch (const std::invalid_argument& e) {
+    throw py::value_error(std::string(name) + ": " + e.what());
+  }
+}
+
+/// A triangle mesh from (V: (N, 3) float, F: (M, 3) int).
+inline TriMesh mesh(const DArray& V, const IArray& F, const char* name = "mesh") {
+  TriMesh m;
+  m.V = matrix(V, (std::string(name) + " vertices").c_str(), 3);
+  if (F.ndim() != 2 || F.shape(1) != 3)
+    throw py::value_error(std::string(name) + " faces: expected shape (M, 3), got " + shape_str(F));
+  m.F = Eigen::Map<const Faces>(F.data(), F.shape(0), 3);
+  try {
+    validate_mesh(m);
+  } catch (const std::invalid_argument& e) {
+    throw py::value_error(std::string(name) + ": " + e.what());
+  }
+  return m;
+}
+
+inline py::array_t<double> to_numpy(const RowMatrixXd& m) {
+  py::array_t<double> out({m.rows(), m.cols()});
+  std::copy(m.data(), m.data() + m.size(), out.mutable_data());
+  return out;
+}
+
+}  // namespace bayesgrasp::bind
