@@ -1,6 +1,336 @@
-// Bindings for the belief concept (to be written).
+// Bindings for the belief concept: particle beliefs (reweighting, resampling, Metropolis moves,
+// roughening), entropy estimates, the expected posterior entropy of actions (Eq. 3.2), the planar
+// relative pose and the GP measurement model. Thin: validate, convert, release the GIL and
+// re-acquire it only around calls of a Python likelihood. Warnings (all-zero likelihood recovery)
+// are raised by python/bayesgrasp/belief.py from the returned flag.
+#include <pybind11/eigen.h>
 #include <pybind11/pybind11.h>
+#include <pybind11/stl.h>
+
+#include "bayesgrasp/belief/entropy.hpp"
+#include "bayesgrasp/belief/measurement_model.hpp"
+#include "bayesgrasp/belief/particles.hpp"
+#include "bayesgrasp/belief/relative_pose.hpp"
+#include "validate.hpp"
 
 namespace bayesgrasp::bind {
-void bind_belief(pybind11::module_& m) {}
+
+namespace py = pybind11;
+using namespace py::literals;
+namespace bl = bayesgrasp::belief;
+
+namespace {
+
+/// A belief with its own seeded generator (Python-side object).
+struct PyBelief {
+  bl::ParticleBelief belief;
+  bl::Rng rng;
+};
+
+template <class F>
+auto guarded(F&& f) -> decltype(f()) {
+  try {
+    return f();
+  } catch (const std::invalid_argument& e) {
+    throw py::value_error(e.what());
+  }
+}
+
+template <class F>
+auto released(F&& f) -> decltype(f()) {
+  try {
+    py::gil_scoped_release release;
+    return f();
+  } catch (const std::invalid_argument& e) {
+    throw py::value_error(e.what());
+  }
+}
+
+bl::StateSpace space_from(const DArray& low, const DArray& high, const py::object& wraps) {
+  const Eigen::VectorXd lo = vector(low, "low"), hi = vector(high, "high");
+  if (lo.size() == 0) throw py::value_error("low: must have at least one entry");
+  if (hi.size() != lo.size()) throw py::value_error("high: expected the same length as low");
+  for (Eigen::Index i = 0; i < lo.size(); ++i)
+    if (lo[i] > hi[i])
+      throw py::value_error("bounds: low > high in dimension " + std::to_string(i) + " (" + std::to_string(lo[i]) +
+                            " > " + std::to_string(hi[i]) + ")");
+  std::vector<bool> w;
+  if (!wraps.is_none()) {
+    w = py::cast<std::vector<bool>>(wraps);
+    if (static_cast<Eigen::Index>(w.size()) != lo.size())
+      throw py::value_error("wraps: expected one flag per dimension (" + std::to_string(lo.size()) + "), got " +
+                            std::to_string(w.size()));
+  }
+  return guarded([&] { return bl::StateSpace(lo, hi, w); });
+}
+
+/// Log-weights may contain -inf (zero weight) but not NaN or +inf.
+Eigen::VectorXd log_weights_from(const DArray& a, const char* name) {
+  if (a.ndim() != 1) throw py::value_error(std::string(name) + ": expected a 1-D array, got " + shape_str(a));
+  Eigen::Map<const Eigen::VectorXd> v(a.data(), a.shape(0));
+  for (Eigen::Index i = 0; i < v.size(); ++i)
+    if (std::isnan(v[i]) || v[i] == std::numeric_limits<double>::infinity())
+      throw py::value_error(std::string(name) + ": contains NaN or +infinity");
+  return v;
+}
+
+/// A vectorised Python callable (N, D) -> (N,) as a batch log-likelihood (GIL taken per call).
+bl::BatchLogLikelihood likelihood_from(const py::object& obj, const char* name) {
+  if (!PyCallable_Check(obj.ptr()))
+    throw py::value_error(std::string(name) + ": expected a callable (N, D) -> (N,) of log-likelihoods");
+  py::function fn = py::reinterpret_borrow<py::function>(obj);
+  std::string nm(name);
+  return [fn, nm](const bl::RowMatrixXd& X, Eigen::VectorXd& ll) {
+    py::gil_scoped_acquire gil;
+    py::array_t<double> arr({X.rows(), X.cols()});
+    std::copy(X.data(), X.data() + X.size(), arr.mutable_data());
+    DArray a = py::cast<DArray>(fn(arr));
+    if (!(a.ndim() == 1 || (a.ndim() == 2 && a.shape(1) == 1)) || a.shape(0) != X.rows())
+      throw py::value_error(nm + ": must return an array of shape (" + std::to_string(X.rows()) + ",), got " +
+                            shape_str(a));
+    ll = Eigen::Map<const Eigen::VectorXd>(a.data(), X.rows());
+  };
+}
+
+/// mean/var as (A, N, K) or (N, K) (A = 1) arrays -> (A*N, K) matrices.
+bl::RowMatrixXd stacked(const DArray& a, const char* name, py::ssize_t& n_actions, py::ssize_t n) {
+  if (a.ndim() == 2) {
+    n_actions = 1;
+    return matrix(a, name);
+  }
+  if (a.ndim() != 3) throw py::value_error(std::string(name) + ": expected shape (A, N, K) or (N, K), got " + shape_str(a));
+  if (a.shape(1) != n)
+    throw py::value_error(std::string(name) + ": expected " + std::to_string(n) + " particles on axis 1, got " +
+                          shape_str(a));
+  n_actions = a.shape(0);
+  Eigen::Map<const bl::RowMatrixXd> m(a.data(), a.shape(0) * a.shape(1), a.shape(2));
+  if (!m.allFinite()) throw py::value_error(std::string(name) + ": contains NaN or infinity");
+  return m;
+}
+
+py::array_t<double> to_np(const bl::RowMatrixXd& m) { return to_numpy(m); }
+
+}  // namespace
+
+void bind_belief(py::module_& m) {
+  py::class_<PyBelief>(m, "ParticleBelief",
+                       "Weighted particles over a box-bounded state (wrapping dims for angles) with its own\n"
+                       "seeded generator. Use bayesgrasp.belief.ParticleBelief (adds warnings).")
+      .def(py::init([](const DArray& particles, const DArray& low, const DArray& high, const py::object& wraps,
+                       const py::object& log_weights, std::uint64_t seed) {
+             bl::StateSpace s = space_from(low, high, wraps);
+             bl::RowMatrixXd X = matrix(particles, "particles", s.dim(), /*allow_empty=*/true);
+             if (X.rows() == 0) throw py::value_error("particles: zero particles");
+             Eigen::VectorXd lw;
+             if (!log_weights.is_none()) lw = log_weights_from(py::cast<DArray>(log_weights), "log_weights");
+             return guarded([&] { return new PyBelief{bl::ParticleBelief(s, X, lw), bl::Rng(seed)}; });
+           }),
+           "particles"_a, "low"_a, "high"_a, "wraps"_a = py::none(), "log_weights"_a = py::none(), "seed"_a = 0,
+           "particles (N, D) inside [low, high] (wrapping dims are wrapped into [low, high)); log_weights\n"
+           "(N,) or None for uniform; seed for this belief's generator.")
+      .def_static(
+          "uniform",
+          [](const DArray& low, const DArray& high, int n, const py::object& wraps, std::uint64_t seed) {
+            bl::StateSpace s = space_from(low, high, wraps);
+            bl::Rng rng(seed);
+            return guarded([&] { return new PyBelief{bl::ParticleBelief::uniform(s, n, rng), rng}; });
+          },
+          "low"_a, "high"_a, "n"_a, "wraps"_a = py::none(), "seed"_a = 0, "n particles uniform in the box.")
+      .def_static(
+          "gaussian",
+          [](const DArray& low, const DArray& high, const DArray& mean, const DArray& std, int n,
+             const py::object& wraps, std::uint64_t seed) {
+            bl::StateSpace s = space_from(low, high, wraps);
+            const Eigen::VectorXd mu = vector(mean, "mean", s.dim()), sd = vector(std, "std", s.dim());
+            bl::Rng rng(seed);
+            return guarded([&] { return new PyBelief{bl::ParticleBelief::gaussian(s, mu, sd, n, rng), rng}; });
+          },
+          "low"_a, "high"_a, "mean"_a, "std"_a, "n"_a, "wraps"_a = py::none(), "seed"_a = 0,
+          "n particles from N(mean, diag(std^2)), truncated to the box (wrapping dims wrapped).")
+      .def_property_readonly("particles", [](const PyBelief& b) { return to_np(b.belief.particles()); },
+                             "(N, D) particle states (a copy).")
+      .def_property_readonly("log_weights", [](const PyBelief& b) { return Eigen::VectorXd(b.belief.log_weights()); },
+                             "(N,) normalised log-weights.")
+      .def_property_readonly("weights", [](const PyBelief& b) { return b.belief.weights(); }, "(N,) weights, sum 1.")
+      .def_property_readonly("size", [](const PyBelief& b) { return b.belief.size(); })
+      .def_property_readonly("dim", [](const PyBelief& b) { return b.belief.dim(); })
+      .def_property_readonly("low", [](const PyBelief& b) { return b.belief.space().low; })
+      .def_property_readonly("high", [](const PyBelief& b) { return b.belief.space().high; })
+      .def_property_readonly("wraps",
+                             [](const PyBelief& b) {
+                               std::vector<bool> w(b.belief.dim(), false);
+                               for (int k = 0; k < b.belief.dim(); ++k) w[k] = b.belief.space().wrap(k);
+                               return w;
+                             })
+      .def("ess", [](const PyBelief& b) { return b.belief.ess(); }, "Effective sample size 1 / sum w^2.")
+      .def("mean", [](const PyBelief& b) { return b.belief.mean(); },
+           "Weighted mean (circular mean for wrapping dims).")
+      .def(
+          "reweight",
+          [](PyBelief& b, const DArray& ll) {
+            const Eigen::VectorXd v = log_weights_from(ll, "log_likelihood");
+            return guarded([&] { return b.belief.reweight(v); });
+          },
+          "log_likelihood"_a,
+          "Adds log-likelihoods (N,) to the log-weights and normalises. Returns True if every likelihood\n"
+          "was zero and the weights were reset to uniform (the recovery).")
+      .def(
+          "update",
+          [](PyBelief& b, const py::object& fn) {
+            const bl::BatchLogLikelihood f = likelihood_from(fn, "log_likelihood");
+            return released([&] { return b.belief.update(f); });
+          },
+          "log_likelihood"_a,
+          "Evaluates log_likelihood (vectorised callable (N, D) -> (N,)) once at all particles, then\n"
+          "reweight(). Returns the recovery flag.")
+      .def(
+          "update_gp",
+          [](PyBelief& b, const gp::GaussianProcess& model, const DArray& action, const DArray& measurement) {
+            if (b.belief.dim() != 3) throw py::value_error("belief: update_gp needs a planar pose state (x, y, yaw)");
+            const Eigen::RowVectorXd a = vector(action, "action").transpose();
+            const Eigen::RowVectorXd meas = vector(measurement, "measurement").transpose();
+            if (a.size() < 3) throw py::value_error("action: expected at least (x, y, yaw)");
+            if (a.size() != model.input_dim())
+              throw py::value_error("action: length must equal the GP's input dimension (" +
+                                    std::to_string(model.input_dim()) + ")");
+            return released([&] { return b.belief.update(bl::gp_measurement_likelihood(model, a, meas)); });
+          },
+          "gp"_a, "action"_a, "measurement"_a,
+          "Bayes update with the GP measurement model in one C++ call: log-likelihood of measurement (P,)\n"
+          "at every particle = the GP's log predictive density at relative_planar_pose(action, particle).\n"
+          "Returns the recovery flag.")
+      .def(
+          "resample",
+          [](PyBelief& b, const std::string& scheme, int n) {
+            return guarded([&] {
+              b.belief.resample(b.rng, bl::resampling_from_string(scheme), n);
+              return py::none();
+            });
+          },
+          "scheme"_a = "systematic", "n"_a = 0,
+          "Resamples N (or n > 0) particles: 'systematic', 'stratified' or 'multinomial'; weights become uniform.")
+      .def(
+          "resample_if_needed",
+          [](PyBelief& b, double threshold, const std::string& scheme) {
+            return guarded([&] { return b.belief.resample_if_needed(b.rng, threshold, bl::resampling_from_string(scheme)); });
+          },
+          "threshold"_a = 0.5, "scheme"_a = "systematic", "Resamples if ess < threshold * N; returns whether it did.")
+      .def(
+          "metropolis",
+          [](PyBelief& b, const py::object& fn, const DArray& step, int n_steps) {
+            const bl::BatchLogLikelihood f = likelihood_from(fn, "log_target");
+            const Eigen::VectorXd st = vector(step, "step", b.belief.dim());
+            const bl::MetropolisStats s = released([&] { return b.belief.metropolis(f, st, n_steps, b.rng); });
+            return py::dict("acceptance_rate"_a = s.acceptance_rate, "evaluations"_a = s.evaluations);
+          },
+          "log_target"_a, "step"_a, "n_steps"_a = 1,
+          "n_steps Metropolis random-walk sweeps (proposal std `step` per dim) under log_target, a\n"
+          "vectorised callable (N, D) -> (N,) called once per sweep (plus once at the start). Proposals\n"
+          "outside the box are rejected; wrapping dims wrap. Returns acceptance_rate and evaluations.")
+      .def(
+          "roughen",
+          [](PyBelief& b, double k) { return guarded([&] { b.belief.roughen(b.rng, k); return py::none(); }); },
+          "k"_a = 0.2, "Gordon et al. roughening: jitter std k * spread * N^(-1/D) per dimension.")
+      .def("weight_entropy", [](const PyBelief& b) { return guarded([&] { return bl::weight_entropy(b.belief.log_weights()); }); },
+           "-sum w log w of the weights (the thesis's weight-based estimate).")
+      .def(
+          "kde_entropy",
+          [](const PyBelief& b, const std::string& bandwidth) {
+            return released([&] {
+              return bl::kde_entropy(b.belief.particles(), b.belief.log_weights(), b.belief.space(),
+                                     bl::bandwidth_from_string(bandwidth));
+            });
+          },
+          "bandwidth"_a = "scott", "Weighted Gaussian-KDE entropy by resubstitution (see kde_entropy).");
+
+  m.def(
+      "resample_indices",
+      [](const DArray& weights, int n, const std::string& scheme, std::uint64_t seed) {
+        const Eigen::VectorXd w = vector(weights, "weights");
+        bl::Rng rng(seed);
+        return guarded([&] { return bl::resample_indices(w, n, bl::resampling_from_string(scheme), rng); });
+      },
+      "weights"_a, "n"_a, "scheme"_a = "systematic", "seed"_a = 0,
+      "Indices of n particles drawn with probabilities proportional to weights (>= 0).");
+
+  m.def(
+      "weight_entropy", [](const DArray& lw) { return guarded([&] { return bl::weight_entropy(log_weights_from(lw, "log_weights")); }); },
+      "log_weights"_a, "-sum w log w of the normalised weights exp(log_weights).");
+
+  m.def(
+      "kde_entropy",
+      [](const DArray& particles, const DArray& log_weights, const DArray& low, const DArray& high,
+         const py::object& wraps, const std::string& bandwidth) {
+        const bl::StateSpace s = space_from(low, high, wraps);
+        const bl::RowMatrixXd X = matrix(particles, "particles", s.dim());
+        const Eigen::VectorXd lw = log_weights_from(log_weights, "log_weights");
+        return released([&] { return bl::kde_entropy(X, lw, s, bl::bandwidth_from_string(bandwidth)); });
+      },
+      "particles"_a, "log_weights"_a, "low"_a, "high"_a, "wraps"_a = py::none(), "bandwidth"_a = "scott",
+      "Weighted Gaussian-KDE entropy -sum_i w_i log p(x_i); kernel covariance f^2 C (C the weighted\n"
+      "covariance, f by Scott's or Silverman's rule with n_eff = 1/sum w^2), as scipy's gaussian_kde.");
+
+  m.def(
+      "expected_posterior_entropy",
+      [](const DArray& log_weights, const DArray& mean, const DArray& var, int n_samples, std::uint64_t seed,
+         int n_threads) {
+        const Eigen::VectorXd lw = log_weights_from(log_weights, "log_weights");
+        if (lw.size() == 0) throw py::value_error("log_weights: zero particles");
+        py::ssize_t a_m = 0, a_v = 0;
+        const bl::RowMatrixXd M = stacked(mean, "mean", a_m, lw.size());
+        const bl::RowMatrixXd V = stacked(var, "var", a_v, lw.size());
+        if (a_m != a_v || M.rows() != V.rows() || M.cols() != V.cols())
+          throw py::value_error("var: expected the same shape as mean");
+        const auto est = released([&] {
+          return bl::expected_posterior_entropy_batch(lw, M, V, static_cast<int>(a_m), n_samples, seed, n_threads);
+        });
+        Eigen::VectorXd h(est.size()), se(est.size());
+        for (size_t i = 0; i < est.size(); ++i) { h[i] = est[i].mean; se[i] = est[i].std_error; }
+        return py::make_tuple(h, se);
+      },
+      "log_weights"_a, "mean"_a, "var"_a, "n_samples"_a = 100, "seed"_a = 0, "n_threads"_a = 1,
+      "Expected posterior weight entropy of actions (Eq. 3.2). mean, var: the predictive mean and\n"
+      "variance (with noise) of the measurement at every particle, (N, K) for one action or (A, N, K)\n"
+      "for A actions. Per sample: particle j ~ w, m ~ N(mean_j, var_j), reweight all particles by\n"
+      "N(m; mean_i, var_i), weight entropy; averaged. The same seed gives the same draws for every\n"
+      "action. Returns (entropy (A,), standard error (A,)).");
+
+  m.def(
+      "expected_posterior_entropy_gp",
+      [](const gp::GaussianProcess& model, const DArray& particles, const DArray& log_weights, const DArray& actions,
+         int n_samples, std::uint64_t seed, int n_threads) {
+        const bl::RowMatrixXd P = matrix(particles, "particles", 3);
+        const Eigen::VectorXd lw = log_weights_from(log_weights, "log_weights");
+        if (lw.size() != P.rows()) throw py::value_error("log_weights: expected one per particle");
+        const bl::RowMatrixXd A = matrix(actions, "actions");
+        if (A.cols() != model.input_dim())
+          throw py::value_error("actions: columns must equal the GP's input dimension (" +
+                                std::to_string(model.input_dim()) + ")");
+        const auto est = released([&] {
+          bl::RowMatrixXd M, V;
+          bl::gp_predict_measurements(model, A, P, M, V);
+          return bl::expected_posterior_entropy_batch(lw, M, V, static_cast<int>(A.rows()), n_samples, seed, n_threads);
+        });
+        Eigen::VectorXd h(est.size()), se(est.size());
+        for (size_t i = 0; i < est.size(); ++i) { h[i] = est[i].mean; se[i] = est[i].std_error; }
+        return py::make_tuple(h, se);
+      },
+      "gp"_a, "particles"_a, "log_weights"_a, "actions"_a, "n_samples"_a = 100, "seed"_a = 0, "n_threads"_a = 1,
+      "Expected posterior entropy of A actions under a GP measurement model, in one C++ call: one GP\n"
+      "prediction (mean, variance with noise) at the relative poses of all (action, particle) pairs,\n"
+      "then expected_posterior_entropy. particles (N, 3) planar poses; actions (A, input_dim).");
+
+  m.def(
+      "relative_planar_pose",
+      [](const DArray& actions, const DArray& poses) {
+        const bl::RowMatrixXd A = matrix(actions, "actions");
+        const bl::RowMatrixXd P = matrix(poses, "poses", 3);
+        if (A.cols() < 3) throw py::value_error("actions: expected at least 3 columns (x, y, yaw)");
+        return to_np(guarded([&] { return bl::relative_planar_pose(A, P); }));
+      },
+      "actions"_a, "poses"_a,
+      "Grasp poses relative to object poses, for all pairs: actions (A, 3 + extra), poses (N, 3) ->\n"
+      "(A*N, 3 + extra), row a*N + j = (R(-yaw_j)(a_xy - o_xy), wrap(a_yaw - yaw_j), extra_a).");
+}
+
 }  // namespace bayesgrasp::bind

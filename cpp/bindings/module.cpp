@@ -12,6 +12,7 @@ void bind_physics(py::module_& m);
 void bind_gp(py::module_& m);
 void bind_belief(py::module_& m);
 void bind_optim(py::module_& m);
+void bind_vision(py::module_& m);
 }  // namespace bayesgrasp::bind
 
 PYBIND11_MODULE(_core, m) {
@@ -33,4 +34,6 @@ PYBIND11_MODULE(_core, m) {
   bind_belief(belief);
   auto optim = m.def_submodule("optim", "PSO, steepest descent, simulated annealing, firefly, trust region.");
   bind_optim(optim);
+  auto vision = m.def_submodule("vision", "Simulated depth camera, table segmentation, FPFH + RANSAC + ICP registration.");
+  bind_vision(vision);
 }

@@ -1,0 +1,22 @@
+#!/usr/bin/env bash
+# Contact-simulation benchmarks (issue 2 section 10): auto-grasp on a ~2k-triangle mug, one core.
+#   1. bench_sim (C++, Google Benchmark): our conservative-advancement auto-grasp (top grasps and
+#      closing alone, FCL representation variants), the GraspIt!-style fixed 0.01-rad stepping on
+#      the same FCL backend and grasps, and the 2-thread batch. It also exports the mug and the
+#      grasp set (bench/results/mug.obj, sim_grasps.csv) and the joint-angle agreement.
+#   2. sim_pybullet.py (BENCH_PY): the same hand (URDF written to bench/results/) closed on the
+#      same mug by pybullet POSITION_CONTROL, same grasps.
+#   3. sim_report.py: medians, ratios -> bench/results/sim.json.
+# Env: BUILD_DIR (holds bench_sim), BENCH_PY (pybullet), BAYESGRASP_PY (unused here).
+set -euo pipefail
+cd "$(dirname "$0")/.."
+BUILD_DIR=${BUILD_DIR:-build/py}
+BENCH_PY=${BENCH_PY:-.venv-bench/bin/python}
+OUT=bench/results
+mkdir -p "$OUT"
+export OMP_NUM_THREADS=${OMP_NUM_THREADS:-1}
+"$BUILD_DIR/bench_sim" --export="$OUT" --grasps=256 \
+  --benchmark_repetitions=5 --benchmark_report_aggregates_only=true \
+  --benchmark_out="$OUT/bench_sim.json" --benchmark_out_format=json
+"$BENCH_PY" bench/sim_pybullet.py --results "$OUT" --grasps "${SIM_PYBULLET_GRASPS:-64}"
+"$BENCH_PY" bench/sim_report.py --results "$OUT"

@@ -1,0 +1,206 @@
+// Gaussian-process regression: the common interface of ExactGP and SparseGP (FITC).
+//
+// API in brief (rows of X are inputs, rows of Y the output vectors; P outputs share one set of
+// hyper-parameters and one factorisation; IndependentOutputsGP gives each output its own):
+//
+//   GPOptions o;  o.kernel = KernelType::SquaredExponential;  o.n_inducing = 200;
+//   SparseGP gp(o);                      // or ExactGP gp(o);
+//   gp.fit(X, Y);                        // X (N, D), Y (N, P); optimises hyper-parameters if o.optimize
+//   Eigen::MatrixXd m = gp.predict_mean(Xs);          // (Ns, P) fast path (fused kernel + dot)
+//   gp.predict(Xs, mean, var);                        // (Ns, P) each; var of the latent f (add noise
+//                                                     //  with include_noise = true)
+//   Eigen::VectorXd lp = gp.log_predictive_density(Xs, Ys);  // (Ns,): sum over outputs of
+//                                                     //  log N(Ys(i,p) | mean, var_f + noise)
+//   std::mt19937_64 rng(seed);  auto S = gp.sample(Xs, n, rng);  // n matrices (Ns, P), marginal
+//   const GaussianProcess& base = gp;                 // all of the above through the base class
+//
+// Normalisation (o.normalize_x / o.normalize_y): inputs and outputs are standardised before the
+// fit; the hyper-parameters (lengthscales, variance, noise, mean constant) live in that
+// standardised space; every prediction is returned in the original units. All predictions are
+// const and thread-safe; batches of >= 2048 inputs use o.threads OpenMP threads.
+// Errors: std::invalid_argument for bad arguments, std::runtime_error for numerical failure
+// (never silent NaN).
+#pragma once
+
+#include <Eigen/Core>
+
+#include <cstdint>
+#include <functional>
+#include <memory>
+#include <random>
+#include <string>
+#include <vector>
+
+#include "bayesgrasp/gp/kernel.hpp"
+
+namespace bayesgrasp::gp {
+
+enum class MeanType { Zero, Constant };
+MeanType mean_type_from_string(const std::string& name);  ///< "zero" or "constant"
+std::string mean_type_name(MeanType type);
+
+struct GPOptions {
+  KernelType kernel = KernelType::SquaredExponential;
+  Eigen::VectorXd lengthscale;   ///< initial lengthscales (D,) or (1,) = isotropic start; empty = 1
+  double variance = 1.0;         ///< initial signal variance
+  double noise = 1e-2;           ///< initial noise variance (>= 0; 0 = noise-free, with jitter)
+  MeanType mean = MeanType::Zero;
+  Eigen::VectorXd mean_constant; ///< initial mean constants (P,) for MeanType::Constant; empty = auto
+  bool optimize = true;          ///< maximise the log marginal likelihood in fit()
+  int max_iter = 200;            ///< L-BFGS iterations
+  bool normalize_x = true;
+  bool normalize_y = true;
+  double jitter = 1e-8;          ///< initial diagonal jitter relative to the signal variance
+  int threads = 1;               ///< OpenMP threads for large prediction batches
+  // SparseGP only
+  int n_inducing = 200;          ///< M (capped at the number of distinct training inputs)
+  bool optimize_inducing = false;
+  std::uint64_t seed = 0;        ///< k-means++ seed for the inducing inputs
+  Eigen::MatrixXd inducing;      ///< (M, D) initial inducing inputs in input units; empty = k-means++
+  int kmeans_iter = 10;          ///< Lloyd iterations after k-means++ seeding
+};
+
+/// Result of fit(): how the optimisation went.
+struct FitInfo {
+  int iterations = 0;
+  int evaluations = 0;          ///< objective + gradient evaluations
+  double log_marginal_likelihood = 0.0;
+  double jitter_used = 0.0;     ///< final jitter (relative) that made the Cholesky succeed
+  std::string message;
+};
+
+class GaussianProcess {
+ public:
+  explicit GaussianProcess(GPOptions options);
+  virtual ~GaussianProcess() = default;
+
+  /// Fits to X (N, D) and Y (N, P). Throws std::invalid_argument on bad shapes or non-finite data.
+  virtual void fit(const Eigen::MatrixXd& X, const Eigen::MatrixXd& Y) = 0;
+
+  bool fitted() const { return fitted_; }
+  int input_dim() const { return dim_; }
+  int output_dim() const { return outputs_; }
+
+  // ---- prediction (original units) ----
+  /// Predictive mean at the rows of X: (N, P).
+  virtual Eigen::MatrixXd predict_mean(const Eigen::MatrixXd& X) const;
+  /// Predictive mean and variance, each (N, P). Variance of f, plus the noise if include_noise.
+  virtual void predict(const Eigen::MatrixXd& X, Eigen::MatrixXd& mean, Eigen::MatrixXd& var,
+                       bool include_noise = false) const;
+  /// Log density of the observed rows of Y at the rows of X under the predictive distribution
+  /// with noise: sum over outputs of log N(Y(i,p) | mean(i,p), var(i,p) + noise_p). (N,)
+  virtual Eigen::VectorXd log_predictive_density(const Eigen::MatrixXd& X, const Eigen::MatrixXd& Y) const;
+  /// n_samples independent draws per input from the marginal predictive distribution (with the
+  /// noise if include_noise): n_samples matrices (N, P).
+  virtual std::vector<Eigen::MatrixXd> sample(const Eigen::MatrixXd& X, int n_samples,
+                                              std::mt19937_64& rng, bool include_noise = true) const;
+  /// Joint draws over the rows of X (outputs independent): n_samples matrices (N, P).
+  virtual std::vector<Eigen::MatrixXd> sample_joint(const Eigen::MatrixXd& X, int n_samples,
+                                                    std::mt19937_64& rng, bool include_noise = true) const;
+  /// Predictive covariance (N, N) of output p (of f, plus noise on the diagonal if include_noise).
+  virtual Eigen::MatrixXd predict_cov(const Eigen::MatrixXd& X, int output = 0,
+                                      bool include_noise = false) const;
+
+  // ---- hyper-parameters and objective (standardised space) ----
+  virtual double log_marginal_likelihood() const { return lml_; }
+  const Kernel& kernel() const { return kernel_; }
+  double noise() const { return noise_; }
+  const Eigen::VectorXd& mean_constant() const { return mean_c_; }  ///< (P,), zeros for MeanType::Zero
+  const GPOptions& options() const { return opt_; }
+  const FitInfo& fit_info() const { return info_; }
+  void set_threads(int threads) { opt_.threads = threads < 1 ? 1 : threads; }
+
+  /// Normalisation used in the fit: x_std = (x - x_mean) / x_scale, y likewise.
+  const Eigen::VectorXd& x_mean() const { return x_mean_; }
+  const Eigen::VectorXd& x_scale() const { return x_scale_; }
+  const Eigen::VectorXd& y_mean() const { return y_mean_; }
+  const Eigen::VectorXd& y_scale() const { return y_scale_; }
+  const Eigen::MatrixXd& X_train() const { return X_; }  ///< raw training inputs
+  const Eigen::MatrixXd& Y_train() const { return Y_; }  ///< raw training outputs
+
+  /// Packed parameter vector theta = [log lengthscales (D), log variance, log noise,
+  /// mean constants (P, Constant mean only), inducing inputs (M*D column-major, standardised
+  /// units; SparseGP with optimize_inducing only)].
+  virtual Eigen::VectorXd parameters() const;
+  /// Negative log marginal likelihood at theta and its analytic gradient (for the current
+  /// training data), without changing the model.
+  virtual double objective(const Eigen::VectorXd& theta, Eigen::VectorXd& grad) const = 0;
+
+ protected:
+  // Scaled basis for the fused prediction kernels, in raw input coordinates:
+  //   mean = offset + f(r2(x, basis)) * alpha,  var_f = variance_p * (1 - |G f|^2)
+  struct Cache {
+    KernelType type = KernelType::SquaredExponential;
+    Eigen::VectorXd inv_ls;      // (D,)  1 / lengthscale in raw units
+    Eigen::MatrixXd basis;       // (M, D) basis inputs times inv_ls
+    Eigen::MatrixXd alpha;       // (M, P) weights in raw output units (include the variance)
+    Eigen::RowVectorXd offset;   // (P,)
+    Eigen::MatrixXd G;           // (M, M) variance factor; var_f = var_p * (1 - |G f|^2)
+    int G_shape = 0;             // 0 general, 1 lower triangular, 2 upper triangular,
+                                 // 3: G is lower triangular and the factor is G^-1 (solve)
+    Eigen::RowVectorXd var_f0;   // (P,) prior variance per output in raw units
+    Eigen::RowVectorXd noise;    // (P,) noise variance per output in raw units
+  };
+
+  void check_fitted(const char* what) const;
+  void check_inputs(const Eigen::MatrixXd& X, const char* name) const;
+  /// Standardises X, Y into Xn_, Yn_ and sets the normalisation; validates.
+  void set_training_data(const Eigen::MatrixXd& X, const Eigen::MatrixXd& Y);
+  /// Runs L-BFGS-B on objective() from parameters(); returns the best theta found and sets
+  /// kernel_, noise_, mean_c_ from it.
+  Eigen::VectorXd optimise(int n_inducing_params);
+  /// Splits theta into the hyper-parameters (and the inducing inputs if Z is non-null).
+  void unpack(const Eigen::VectorXd& theta, Kernel& k, double& noise, Eigen::VectorXd& c,
+              Eigen::MatrixXd* Z) const;
+
+  GPOptions opt_;
+  Kernel kernel_;
+  double noise_ = 1e-2;
+  Eigen::VectorXd mean_c_;
+  int dim_ = 0, outputs_ = 0;
+  bool fitted_ = false;
+  double lml_ = 0.0;
+  FitInfo info_;
+  Eigen::MatrixXd X_, Y_;    // raw
+  Eigen::MatrixXd Xn_, Yn_;  // standardised
+  Eigen::VectorXd x_mean_, x_scale_, y_mean_, y_scale_;
+  Cache cache_;
+
+  friend class IndependentOutputsGP;
+};
+
+/// One model per output column, each with its own hyper-parameters (and inducing inputs).
+class IndependentOutputsGP : public GaussianProcess {
+ public:
+  using Factory = std::function<std::unique_ptr<GaussianProcess>()>;
+  IndependentOutputsGP(GPOptions options, Factory factory);
+  void fit(const Eigen::MatrixXd& X, const Eigen::MatrixXd& Y) override;
+  Eigen::MatrixXd predict_mean(const Eigen::MatrixXd& X) const override;
+  void predict(const Eigen::MatrixXd& X, Eigen::MatrixXd& mean, Eigen::MatrixXd& var,
+               bool include_noise = false) const override;
+  Eigen::MatrixXd predict_cov(const Eigen::MatrixXd& X, int output = 0,
+                              bool include_noise = false) const override;
+  std::vector<Eigen::MatrixXd> sample_joint(const Eigen::MatrixXd& X, int n_samples,
+                                            std::mt19937_64& rng, bool include_noise = true) const override;
+  double log_marginal_likelihood() const override;
+  Eigen::VectorXd parameters() const override;
+  double objective(const Eigen::VectorXd& theta, Eigen::VectorXd& grad) const override;
+  int n_models() const { return static_cast<int>(models_.size()); }
+  const GaussianProcess& model(int p) const { return *models_.at(p); }
+
+ private:
+  Factory factory_;
+  std::vector<std::unique_ptr<GaussianProcess>> models_;
+};
+
+/// Cholesky with adaptive jitter: tries A + jitter*scale*I for jitter = jitter0, x10, ... up to
+/// max_jitter; returns the lower factor and sets *used. Throws std::runtime_error (naming `what`)
+/// if it never succeeds or A is not finite.
+Eigen::MatrixXd robust_cholesky(const Eigen::MatrixXd& A, double jitter0, double scale, const char* what,
+                                double* used = nullptr, double max_jitter = 1e-2);
+
+/// k-means++ seeding (seeded) followed by `iters` Lloyd iterations; returns up to k centres (k, D)
+/// (fewer if X has fewer distinct rows).
+Eigen::MatrixXd kmeans_pp(const Eigen::MatrixXd& X, int k, std::uint64_t seed, int iters = 10);
+
+}  // namespace bayesgrasp::gp

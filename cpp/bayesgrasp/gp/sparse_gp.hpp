@@ -1,0 +1,28 @@
+// Sparse GP regression with the FITC approximation (Snelson & Ghahramani 2006):
+//   p(y) = N(0, Q_nn + diag(K_nn - Q_nn) + noise I),  Q_nn = K_nm K_mm^-1 K_mn,
+// with M inducing inputs Z (k-means++ initialised, optionally optimised). One objective and
+// gradient evaluation costs O(N M^2) through Cholesky factors of M x M matrices only.
+// See gaussian_process.hpp for the common interface.
+#pragma once
+
+#include "bayesgrasp/gp/gaussian_process.hpp"
+
+namespace bayesgrasp::gp {
+
+class SparseGP : public GaussianProcess {
+ public:
+  explicit SparseGP(GPOptions options = {});
+  void fit(const Eigen::MatrixXd& X, const Eigen::MatrixXd& Y) override;
+  double objective(const Eigen::VectorXd& theta, Eigen::VectorXd& grad) const override;
+  Eigen::VectorXd parameters() const override;
+
+  /// Inducing inputs (M, D) in input units.
+  Eigen::MatrixXd inducing_inputs() const;
+  int n_inducing() const { return static_cast<int>(Zn_.rows()); }
+
+ private:
+  void build_cache();
+  Eigen::MatrixXd Zn_;  // (M, D) standardised
+};
+
+}  // namespace bayesgrasp::gp

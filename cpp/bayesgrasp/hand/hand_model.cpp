@@ -1,0 +1,286 @@
+#include "bayesgrasp/hand/hand_model.hpp"
+
+#include <cmath>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <sstream>
+#include <stdexcept>
+
+namespace bayesgrasp {
+
+namespace {
+
+using nlohmann::json;
+constexpr double kDeg = M_PI / 180.0;
+
+[[noreturn]] void fail(const std::string& where, const std::string& what) {
+  throw std::invalid_argument("hand file: " + where + ": " + what);
+}
+
+const json& need(const json& j, const char* key, const std::string& where) {
+  if (!j.is_object() || !j.contains(key)) fail(where, std::string("missing key '") + key + "'");
+  return j.at(key);
+}
+
+double number(const json& j, const char* key, const std::string& where) {
+  const json& v = need(j, key, where);
+  if (!v.is_number()) fail(where, std::string("'") + key + "' must be a number");
+  const double x = v.get<double>();
+  if (!std::isfinite(x)) fail(where, std::string("'") + key + "' must be finite");
+  return x;
+}
+
+double number_or(const json& j, const char* key, double fallback, const std::string& where) {
+  return j.contains(key) ? number(j, key, where) : fallback;
+}
+
+Vec3 vec3(const json& j, const char* key, const std::string& where) {
+  const json& v = need(j, key, where);
+  if (!v.is_array() || v.size() != 3) fail(where, std::string("'") + key + "' must be a list of 3 numbers");
+  Vec3 out;
+  for (int i = 0; i < 3; ++i) {
+    if (!v[i].is_number()) fail(where, std::string("'") + key + "' must be a list of 3 numbers");
+    out[i] = v[i].get<double>();
+  }
+  if (!out.allFinite()) fail(where, std::string("'") + key + "' must be finite");
+  return out;
+}
+
+std::vector<Shape> shapes(const json& j, const std::string& where) {
+  std::vector<Shape> out;
+  if (!j.contains("shapes")) return out;
+  const json& arr = j.at("shapes");
+  if (!arr.is_array()) fail(where, "'shapes' must be a list");
+  for (size_t i = 0; i < arr.size(); ++i) {
+    const std::string w = where + ".shapes[" + std::to_string(i) + "]";
+    const json& s = arr[i];
+    const json& type = need(s, "type", w);
+    Shape shape;
+    if (type == "box") {
+      shape.type = Shape::Type::Box;
+      shape.center = vec3(s, "center", w);
+      shape.half_extents = vec3(s, "half_extents", w);
+      if ((shape.half_extents.array() <= 0).any()) fail(w, "half_extents must be positive");
+    } else if (type == "capsule") {
+      shape.type = Shape::Type::Capsule;
+      shape.p0 = vec3(s, "p0", w);
+      shape.p1 = vec3(s, "p1", w);
+      shape.radius = number(s, "radius", w);
+      if (!(shape.radius > 0)) fail(w, "radius must be positive");
+    } else {
+      fail(w, "unknown shape type (expected 'box' or 'capsule')");
+    }
+    out.push_back(shape);
+  }
+  return out;
+}
+
+Eigen::Matrix3d link_rotation(const Vec3& d, double theta) {
+  const Vec3 z = Vec3::UnitZ();
+  const Vec3 a = d.cross(z);
+  const Vec3 x = std::cos(theta) * d + std::sin(theta) * z;
+  Eigen::Matrix3d R;
+  R.col(0) = x;
+  R.col(1) = a;
+  R.col(2) = x.cross(a);
+  return R;
+}
+
+}  // namespace
+
+double Finger::t_max() const {
+  double t = 0.0;
+  for (const Phalanx& p : phalanges)
+    if (p.ratio > 0) t = std::max(t, (p.upper - p.offset) / p.ratio);
+  return t;
+}
+
+HandModel HandModel::from_json(const std::string& json_text) {
+  json root;
+  try {
+    root = json::parse(json_text);
+  } catch (const json::parse_error& e) {
+    throw std::invalid_argument(std::string("hand file: not valid JSON: ") + e.what());
+  }
+  HandModel h;
+  if (!root.is_object()) fail("top level", "must be an object");
+  const json& name = need(root, "name", "top level");
+  if (!name.is_string()) fail("top level", "'name' must be a string");
+  h.name_ = name.get<std::string>();
+
+  Link palm;
+  palm.name = "palm";
+  palm.shapes = shapes(need(root, "palm", "top level"), "palm");
+  h.links_.push_back(palm);
+
+  const json& spread = need(root, "spread", "top level");
+  h.spread_lower_ = number(spread, "lower_deg", "spread") * kDeg;
+  h.spread_upper_ = number(spread, "upper_deg", "spread") * kDeg;
+  h.spread_default_ = number_or(spread, "default_deg", 0.0, "spread") * kDeg;
+  if (h.spread_lower_ > h.spread_upper_) fail("spread", "lower_deg > upper_deg");
+
+  const json& fingers = need(root, "fingers", "top level");
+  if (!fingers.is_array() || fingers.empty()) fail("fingers", "must be a non-empty list");
+  int joint = 1;
+  for (size_t f = 0; f < fingers.size(); ++f) {
+    const std::string w = "fingers[" + std::to_string(f) + "]";
+    const json& jf = fingers[f];
+    Finger finger;
+    finger.name = jf.contains("name") ? jf.at("name").get<std::string>() : "finger" + std::to_string(f + 1);
+    finger.base = vec3(jf, "base", w);
+    finger.base_yaw = number(jf, "base_yaw_deg", w) * kDeg;
+    finger.spread_sign = number_or(jf, "spread_sign", 0.0, w);
+    if (jf.contains("knuckle")) {
+      const json& k = jf.at("knuckle");
+      finger.knuckle_length = number_or(k, "length", 0.0, w + ".knuckle");
+      finger.knuckle_shapes = shapes(k, w + ".knuckle");
+    }
+    if (!finger.knuckle_shapes.empty()) {
+      Link link;
+      link.name = finger.name + "/knuckle";
+      link.finger = static_cast<int>(f);
+      link.shapes = finger.knuckle_shapes;
+      finger.knuckle_link = static_cast<int>(h.links_.size());
+      h.links_.push_back(link);
+    }
+    const json& ph = need(jf, "phalanges", w);
+    if (!ph.is_array() || ph.empty()) fail(w, "'phalanges' must be a non-empty list");
+    finger.first_joint = joint;
+    for (size_t p = 0; p < ph.size(); ++p) {
+      const std::string wp = w + ".phalanges[" + std::to_string(p) + "]";
+      Phalanx phalanx;
+      phalanx.name = ph[p].contains("name") ? ph[p].at("name").get<std::string>() : "phalanx" + std::to_string(p);
+      phalanx.length = number(ph[p], "length", wp);
+      if (!(phalanx.length > 0)) fail(wp, "length must be positive");
+      phalanx.lower = number(ph[p], "lower_deg", wp) * kDeg;
+      phalanx.upper = number(ph[p], "upper_deg", wp) * kDeg;
+      if (phalanx.lower > phalanx.upper) fail(wp, "lower_deg > upper_deg");
+      phalanx.offset = number_or(ph[p], "offset_deg", ph[p].contains("lower_deg") ? number(ph[p], "lower_deg", wp) : 0.0, wp) * kDeg;
+      phalanx.ratio = number_or(ph[p], "ratio", 1.0, wp);
+      if (phalanx.ratio < 0) fail(wp, "ratio must be >= 0");
+      phalanx.shapes = shapes(ph[p], wp);
+      Link link;
+      link.name = finger.name + "/" + phalanx.name;
+      link.finger = static_cast<int>(f);
+      link.phalanx = static_cast<int>(p);
+      link.shapes = phalanx.shapes;
+      phalanx.link = static_cast<int>(h.links_.size());
+      h.links_.push_back(link);
+      finger.phalanges.push_back(phalanx);
+      ++joint;
+    }
+    h.fingers_.push_back(finger);
+  }
+  h.num_joints_ = joint;
+  return h;
+}
+
+HandModel HandModel::from_file(const std::string& path) {
+  std::ifstream in(path);
+  if (!in) throw std::invalid_argument("hand file: cannot open '" + path + "'");
+  std::stringstream ss;
+  ss << in.rdbuf();
+  try {
+    return from_json(ss.str());
+  } catch (const std::invalid_argument& e) {
+    throw std::invalid_argument(std::string(e.what()) + " (in '" + path + "')");
+  }
+}
+
+double HandModel::coupled_angle(int f, int p, double t) const {
+  const Phalanx& ph = fingers_.at(f).phalanges.at(p);
+  return std::clamp(ph.offset + ph.ratio * t, ph.lower, ph.upper);
+}
+
+Eigen::VectorXd HandModel::coupled_joints(double spread, double t) const {
+  return coupled_joints(spread, Eigen::VectorXd::Constant(static_cast<Eigen::Index>(fingers_.size()), t));
+}
+
+Eigen::VectorXd HandModel::coupled_joints(double spread, const Eigen::VectorXd& t) const {
+  if (t.size() != static_cast<Eigen::Index>(fingers_.size()))
+    throw std::invalid_argument("one actuator parameter per finger expected");
+  Eigen::VectorXd q(num_joints_);
+  q[0] = std::clamp(spread, spread_lower_, spread_upper_);
+  for (size_t f = 0; f < fingers_.size(); ++f)
+    for (size_t p = 0; p < fingers_[f].phalanges.size(); ++p)
+      q[fingers_[f].first_joint + static_cast<int>(p)] = coupled_angle(static_cast<int>(f), static_cast<int>(p), t[f]);
+  return q;
+}
+
+void HandModel::check_joints(const Eigen::VectorXd& q, double tol) const {
+  if (q.size() != num_joints_)
+    throw std::invalid_argument("joints: expected " + std::to_string(num_joints_) + " values, got " +
+                                std::to_string(q.size()));
+  if (!q.allFinite()) throw std::invalid_argument("joints: contain NaN or infinity");
+  if (q[0] < spread_lower_ - tol || q[0] > spread_upper_ + tol)
+    throw std::invalid_argument("joints: spread outside its limits");
+  for (const Finger& f : fingers_)
+    for (size_t p = 0; p < f.phalanges.size(); ++p) {
+      const double v = q[f.first_joint + static_cast<int>(p)];
+      if (v < f.phalanges[p].lower - tol || v > f.phalanges[p].upper + tol)
+        throw std::invalid_argument("joints: " + f.name + "/" + f.phalanges[p].name + " outside its limits");
+    }
+}
+
+Vec3 HandModel::finger_direction(int f, double spread) const {
+  const Finger& finger = fingers_.at(f);
+  const double yaw = finger.base_yaw + finger.spread_sign * spread;
+  return Vec3(std::cos(yaw), std::sin(yaw), 0.0);
+}
+
+std::vector<Iso3> HandModel::link_poses(const Iso3& hand_pose, const Eigen::VectorXd& q) const {
+  std::vector<Iso3> poses(links_.size(), hand_pose);
+  for (size_t f = 0; f < fingers_.size(); ++f) {
+    const Finger& finger = fingers_[f];
+    const Vec3 d = finger_direction(static_cast<int>(f), q[0]);
+    if (finger.knuckle_link >= 0) {
+      Iso3 local = Iso3::Identity();
+      local.linear() = link_rotation(d, 0.0);
+      local.translation() = finger.base;
+      poses[finger.knuckle_link] = hand_pose * local;
+    }
+    Vec3 joint = finger.base + finger.knuckle_length * d;
+    double theta = 0.0;
+    for (size_t p = 0; p < finger.phalanges.size(); ++p) {
+      theta += q[finger.first_joint + static_cast<int>(p)];
+      Iso3 local = Iso3::Identity();
+      local.linear() = link_rotation(d, theta);
+      local.translation() = joint;
+      poses[finger.phalanges[p].link] = hand_pose * local;
+      joint += finger.phalanges[p].length * local.linear().col(0);
+    }
+  }
+  return poses;
+}
+
+Iso3 HandModel::phalanx_pose(const Iso3& hand_pose, int f, int p, const Eigen::VectorXd& q) const {
+  const Finger& finger = fingers_.at(f);
+  const Vec3 d = finger_direction(f, q[0]);
+  Vec3 joint = finger.base + finger.knuckle_length * d;
+  double theta = 0.0;
+  Iso3 local = Iso3::Identity();
+  for (int i = 0; i <= p; ++i) {
+    theta += q[finger.first_joint + i];
+    local.linear() = link_rotation(d, theta);
+    local.translation() = joint;
+    joint += finger.phalanges[i].length * local.linear().col(0);
+  }
+  return hand_pose * local;
+}
+
+Vec3 HandModel::fingertip(const Iso3& hand_pose, int f, const Eigen::VectorXd& q) const {
+  const Finger& finger = fingers_.at(f);
+  const int last = static_cast<int>(finger.phalanges.size()) - 1;
+  const Iso3 T = phalanx_pose(hand_pose, f, last, q);
+  return T * Vec3(finger.phalanges[last].length, 0.0, 0.0);
+}
+
+Iso3 HandModel::top_grasp_pose(double x, double y, double yaw, double z) {
+  Iso3 T = Iso3::Identity();
+  T.linear() = Eigen::AngleAxisd(yaw, Vec3::UnitZ()).toRotationMatrix() *
+               Eigen::AngleAxisd(M_PI, Vec3::UnitX()).toRotationMatrix();
+  T.translation() = Vec3(x, y, z);
+  return T;
+}
+
+}  // namespace bayesgrasp

@@ -1,0 +1,125 @@
+// A multi-fingered hand described by a data file (JSON): palm, fingers as chains of
+// phalanges, collision shapes per link, and the closing scheme (coupled joints with
+// breakaway). Another hand is another file, not new code.
+//
+// Frames. The hand frame has its origin at the centre of the palm face and +z along the
+// approach direction (out of the palm). Finger f has a base point b_f in the hand frame and
+// an outward direction d_f(s) = Rz(base_yaw_f + spread_sign_f * s) * x in the palm plane,
+// where s is the spread joint. Its first phalanx joint sits at b_f + knuckle_length * d_f.
+// Every phalanx joint axis is a_f = d_f x z, so a cumulative phalanx angle Theta turns the
+// link direction from d_f (Theta = 0, flat in the palm plane, pointing outwards) towards +z
+// (Theta = 90 deg) and then inwards.
+//
+// Link frames. Link 0 is the palm (frame = hand frame). Then, per finger, its knuckle (frame:
+// origin at b_f, x = d_f, y = a_f, z = x X y = -z_hand) and its phalanges (frame: origin at the
+// joint, x along the link, y = a_f, z = x X y). The grasping (inner) face of a phalanx is its
+// local -z side. Shapes are given in link frames.
+//
+// Joint vector q (radians): [spread, f0 phalanx 0, f0 phalanx 1, ..., f1 phalanx 0, ...];
+// phalanx angles are relative to the previous phalanx (or to the palm plane for phalanx 0).
+//
+// Closing. Each finger has one actuator parameter t >= 0; while free, phalanx j follows
+// q_j(t) = offset_j + ratio_j * t, clamped to [lower_j, upper_j]. Breakaway: when phalanx k is
+// stopped by a contact, phalanges 0..k freeze, and phalanges after k keep closing; a phalanx
+// that reaches its upper limit stops alone. The finger is done when every phalanx is frozen
+// or at its limit.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "bayesgrasp/geometry/mesh.hpp"
+
+namespace bayesgrasp {
+
+/// A collision primitive in a link frame.
+struct Shape {
+  enum class Type { Box, Capsule };
+  Type type = Type::Box;
+  Vec3 center = Vec3::Zero();        // Box: centre (box axes = link axes)
+  Vec3 half_extents = Vec3::Zero();  // Box
+  Vec3 p0 = Vec3::Zero();            // Capsule: segment end points and radius
+  Vec3 p1 = Vec3::Zero();
+  double radius = 0.0;
+};
+
+struct Phalanx {
+  std::string name;
+  double length = 0.0;  // joint to next joint / fingertip (m)
+  double lower = 0.0, upper = 0.0;  // joint limits (rad)
+  double offset = 0.0, ratio = 1.0; // coupling: q(t) = offset + ratio * t
+  std::vector<Shape> shapes;
+  int link = -1;  // index into HandModel::links
+};
+
+struct Finger {
+  std::string name;
+  Vec3 base = Vec3::Zero();  // spread axis (hand frame)
+  double base_yaw = 0.0;     // outward direction at spread 0 (rad, about +z)
+  double spread_sign = 0.0;  // d(yaw)/d(spread): +1, -1, or 0 for a fixed finger
+  double knuckle_length = 0.0;
+  std::vector<Shape> knuckle_shapes;
+  int knuckle_link = -1;
+  std::vector<Phalanx> phalanges;
+  int first_joint = -1;  // index in q of phalanx 0
+  /// Actuator parameter at which every phalanx has reached its upper limit.
+  double t_max() const;
+};
+
+struct Link {
+  std::string name;
+  int finger = -1;   // -1 for the palm
+  int phalanx = -1;  // -1 for palm and knuckles
+  std::vector<Shape> shapes;
+};
+
+class HandModel {
+ public:
+  /// Parses the JSON text of a hand file; throws std::invalid_argument naming what is wrong.
+  static HandModel from_json(const std::string& json_text);
+  static HandModel from_file(const std::string& path);
+
+  const std::string& name() const { return name_; }
+  const std::vector<Finger>& fingers() const { return fingers_; }
+  const std::vector<Link>& links() const { return links_; }
+  int num_joints() const { return num_joints_; }
+  int num_links() const { return static_cast<int>(links_.size()); }
+  double spread_lower() const { return spread_lower_; }
+  double spread_upper() const { return spread_upper_; }
+  double spread_default() const { return spread_default_; }
+
+  /// Joint vector with the given spread and every finger at actuator parameter t.
+  Eigen::VectorXd coupled_joints(double spread, double t = 0.0) const;
+  /// Same, one actuator parameter per finger.
+  Eigen::VectorXd coupled_joints(double spread, const Eigen::VectorXd& t_per_finger) const;
+  /// Phalanx j of finger f at actuator parameter t (coupling law, clamped to limits).
+  double coupled_angle(int finger, int phalanx, double t) const;
+
+  /// Throws std::invalid_argument if q has the wrong size, is not finite, or is outside
+  /// the joint limits by more than `tol`.
+  void check_joints(const Eigen::VectorXd& q, double tol = 1e-9) const;
+
+  /// Outward direction of finger f at spread s (hand frame, unit, in the palm plane).
+  Vec3 finger_direction(int finger, double spread) const;
+
+  /// Poses of every link in the frame of `hand_pose` (world if hand_pose is the hand's
+  /// world pose), indexed like links().
+  std::vector<Iso3> link_poses(const Iso3& hand_pose, const Eigen::VectorXd& q) const;
+  /// Pose of one finger's phalanx j (and its predecessors) - cheaper than all links.
+  Iso3 phalanx_pose(const Iso3& hand_pose, int finger, int phalanx, const Eigen::VectorXd& q) const;
+  /// Fingertip (end of the last phalanx) of finger f.
+  Vec3 fingertip(const Iso3& hand_pose, int finger, const Eigen::VectorXd& q) const;
+
+  /// World pose of a palm-down hand above the table at (x, y, yaw), palm face at height z:
+  /// hand +z = world -z, hand x = world Rz(yaw) x.
+  static Iso3 top_grasp_pose(double x, double y, double yaw, double z);
+
+ private:
+  std::string name_;
+  std::vector<Finger> fingers_;
+  std::vector<Link> links_;
+  int num_joints_ = 1;
+  double spread_lower_ = 0.0, spread_upper_ = 0.0, spread_default_ = 0.0;
+};
+
+}  // namespace bayesgrasp

@@ -1,0 +1,35 @@
+// Steepest descent with central-difference gradients and a backtracking (Armijo) line search,
+// optionally projected onto a box. Also the numerical gradient shared by the local optimisers.
+#pragma once
+
+#include "bayesgrasp/optim/objective.hpp"
+
+namespace bayesgrasp::optim {
+
+/// Central differences in one batch of 2D rows; step h_k = h * max(1, |x_k|).
+/// Returns the gradient; adds 2D to *evaluations if given.
+Eigen::VectorXd numerical_gradient(Evaluator& eval, const Eigen::VectorXd& x, double h);
+
+struct DescentOptions {
+  int max_iter = 500;
+  double h = 1e-6;           ///< relative finite-difference step
+  double t0 = 1.0;           ///< first trial step length (later: twice the last accepted one)
+  double armijo = 1e-4;      ///< sufficient-decrease constant c in f(x+) <= f(x) - c g.(x - x+)
+  double backtrack = 0.5;    ///< step shrink factor in (0, 1)
+  int max_backtrack = 40;
+  double gtol = 1e-8;        ///< stop when the (projected) gradient's max-norm is below gtol
+  double ftol = 1e-14;       ///< stop when the relative decrease is below ftol
+  bool record_history = false;
+};
+
+/// bounds may be empty (size-0 vectors): unconstrained. With bounds, x0 is clipped into the box
+/// and every trial point projected onto it.
+Result steepest_descent(const BatchObjective& fun, const Eigen::VectorXd& x0, const Bounds& bounds,
+                        const DescentOptions& opt = {});
+
+/// Clips x into the box (no-op for empty bounds).
+Eigen::VectorXd project(const Eigen::VectorXd& x, const Bounds& b);
+/// Checks x0 is finite and matches the bounds' dimension (if any); validates non-empty bounds.
+void validate_start(const Eigen::VectorXd& x0, const Bounds& b);
+
+}  // namespace bayesgrasp::optim

@@ -1,0 +1,74 @@
+#include "bayesgrasp/optim/objective.hpp"
+
+#include <cmath>
+#include <limits>
+
+namespace bayesgrasp::optim {
+
+void validate_bounds(const Bounds& b) {
+  if (b.low.size() == 0) throw std::invalid_argument("bounds: dimension must be at least 1");
+  if (b.low.size() != b.high.size())
+    throw std::invalid_argument("bounds: low and high have different lengths");
+  if (!b.low.allFinite() || !b.high.allFinite())
+    throw std::invalid_argument("bounds: contains NaN or infinity");
+  for (int i = 0; i < b.dim(); ++i)
+    if (b.low[i] > b.high[i])
+      throw std::invalid_argument("bounds: low > high in dimension " + std::to_string(i));
+}
+
+void Evaluator::operator()(const RowMatrixXd& X, Eigen::VectorXd& f) {
+  f.resize(X.rows());
+  fun_(X, f);
+  n_ += X.rows();
+  for (Eigen::Index i = 0; i < f.size(); ++i)
+    if (!std::isfinite(f[i])) f[i] = std::numeric_limits<double>::infinity();
+}
+
+void sphere(const RowMatrixXd& X, Eigen::VectorXd& f) { f = X.rowwise().squaredNorm(); }
+
+void rastrigin(const RowMatrixXd& X, Eigen::VectorXd& f) {
+  const double two_pi = 2.0 * M_PI;
+  f.resize(X.rows());
+  for (Eigen::Index i = 0; i < X.rows(); ++i) {
+    double s = 10.0 * X.cols();
+    for (Eigen::Index d = 0; d < X.cols(); ++d) s += X(i, d) * X(i, d) - 10.0 * std::cos(two_pi * X(i, d));
+    f[i] = s;
+  }
+}
+
+void ackley(const RowMatrixXd& X, Eigen::VectorXd& f) {
+  const double two_pi = 2.0 * M_PI;
+  const double n = static_cast<double>(X.cols());
+  f.resize(X.rows());
+  for (Eigen::Index i = 0; i < X.rows(); ++i) {
+    double s2 = 0.0, sc = 0.0;
+    for (Eigen::Index d = 0; d < X.cols(); ++d) {
+      s2 += X(i, d) * X(i, d);
+      sc += std::cos(two_pi * X(i, d));
+    }
+    f[i] = -20.0 * std::exp(-0.2 * std::sqrt(s2 / n)) - std::exp(sc / n) + 20.0 + M_E;
+  }
+}
+
+void rosenbrock(const RowMatrixXd& X, Eigen::VectorXd& f) {
+  f.resize(X.rows());
+  for (Eigen::Index i = 0; i < X.rows(); ++i) {
+    double s = 0.0;
+    for (Eigen::Index d = 0; d + 1 < X.cols(); ++d) {
+      const double a = X(i, d + 1) - X(i, d) * X(i, d), b = 1.0 - X(i, d);
+      s += 100.0 * a * a + b * b;
+    }
+    f[i] = s;
+  }
+}
+
+BatchObjective builtin_objective(const std::string& name) {
+  if (name == "sphere") return sphere;
+  if (name == "rastrigin") return rastrigin;
+  if (name == "ackley") return ackley;
+  if (name == "rosenbrock") return rosenbrock;
+  throw std::invalid_argument("objective: unknown built-in '" + name +
+                              "' (expected sphere, rastrigin, ackley or rosenbrock)");
+}
+
+}  // namespace bayesgrasp::optim

@@ -1,0 +1,68 @@
+// Common types of the optimisers: batch objectives, box bounds, results.
+//
+// Every optimiser minimises. An objective is evaluated on a batch of candidates at once
+// (one row per candidate) so that a swarm, a finite-difference stencil or a line search
+// costs one call; the optimisers count the rows they ask for ("evaluations").
+#pragma once
+
+#include <Eigen/Core>
+
+#include <cstdint>
+#include <functional>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+namespace bayesgrasp::optim {
+
+using RowMatrixXd = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
+
+/// Batch objective: X is (N, D), one candidate per row; writes f (already sized N).
+/// Non-finite values are allowed and treated as +infinity (never the best).
+using BatchObjective = std::function<void(const RowMatrixXd& X, Eigen::VectorXd& f)>;
+
+/// Batch residuals for least squares: X is (N, D); writes R (already sized N x n_residuals).
+using BatchResiduals = std::function<void(const RowMatrixXd& X, RowMatrixXd& R)>;
+
+/// Axis-aligned box; low <= high elementwise, both finite.
+struct Bounds {
+  Eigen::VectorXd low, high;
+  int dim() const { return static_cast<int>(low.size()); }
+  Eigen::VectorXd range() const { return high - low; }
+};
+
+/// Throws std::invalid_argument naming the problem (bindings map it to ValueError).
+void validate_bounds(const Bounds& b);
+
+/// What every optimiser reports.
+struct Result {
+  Eigen::VectorXd x;             ///< best candidate found
+  double f = 0.0;                ///< objective at x
+  int iterations = 0;            ///< outer iterations done
+  long long evaluations = 0;     ///< rows passed to the objective
+  std::vector<double> history;   ///< best value after each iteration (if requested)
+  bool converged = false;        ///< a tolerance was met (vs. the budget running out)
+  std::string message;
+};
+
+/// Evaluates, counting rows and mapping non-finite values to +inf.
+class Evaluator {
+ public:
+  explicit Evaluator(const BatchObjective& fun) : fun_(fun) {}
+  void operator()(const RowMatrixXd& X, Eigen::VectorXd& f);
+  long long evaluations() const { return n_; }
+
+ private:
+  const BatchObjective& fun_;
+  long long n_ = 0;
+};
+
+/// Standard test functions (batch form), global minimum 0 at the origin (Rosenbrock: at ones).
+void sphere(const RowMatrixXd& X, Eigen::VectorXd& f);
+void rastrigin(const RowMatrixXd& X, Eigen::VectorXd& f);
+void ackley(const RowMatrixXd& X, Eigen::VectorXd& f);
+void rosenbrock(const RowMatrixXd& X, Eigen::VectorXd& f);
+/// Looks up one of "sphere", "rastrigin", "ackley", "rosenbrock"; throws otherwise.
+BatchObjective builtin_objective(const std::string& name);
+
+}  // namespace bayesgrasp::optim

@@ -1,0 +1,80 @@
+#include "bayesgrasp/optim/pso.hpp"
+
+#include <cmath>
+
+#include "bayesgrasp/optim/random.hpp"
+
+namespace bayesgrasp::optim {
+
+Result pso(const BatchObjective& fun, const Bounds& b, const PSOOptions& o) {
+  validate_bounds(b);
+  if (o.n_particles < 1) throw std::invalid_argument("n_particles: must be at least 1");
+  if (o.max_iter < 0) throw std::invalid_argument("max_iter: must be >= 0");
+  if (!(o.vmax_fraction > 0.0)) throw std::invalid_argument("vmax_fraction: must be positive");
+  const int n = o.n_particles, d = b.dim();
+  if (o.init.size() && (o.init.rows() != n || o.init.cols() != d))
+    throw std::invalid_argument("init: expected shape (n_particles, D)");
+
+  Rng rng(o.seed);
+  const Eigen::VectorXd range = b.range();
+  const Eigen::VectorXd vmax = o.vmax_fraction * range;
+  RowMatrixXd X(n, d), V(n, d);
+  for (int i = 0; i < n; ++i)
+    for (int k = 0; k < d; ++k) {
+      X(i, k) = o.init.size() ? std::min(std::max(o.init(i, k), b.low[k]), b.high[k])
+                              : b.low[k] + range[k] * uniform01(rng);
+      V(i, k) = vmax[k] * (2.0 * uniform01(rng) - 1.0);
+    }
+  Evaluator eval(fun);
+  Eigen::VectorXd f(n);
+  eval(X, f);
+  RowMatrixXd P = X;            // personal bests
+  Eigen::VectorXd pf = f;
+  Eigen::Index g;
+  double gf = pf.minCoeff(&g);
+  Eigen::VectorXd gx = P.row(g).transpose();
+
+  Result r;
+  if (o.record_history) r.history.push_back(gf);
+  int stall = 0;
+  int it = 0;
+  for (; it < o.max_iter && !(gf <= o.target); ++it) {
+    for (int i = 0; i < n; ++i) {
+      double* x = &X(i, 0);
+      double* v = &V(i, 0);
+      const double* p = &P(i, 0);
+      for (int k = 0; k < d; ++k) {
+        const double r1 = uniform01(rng), r2 = uniform01(rng);
+        double vk = o.inertia * v[k] + o.c1 * r1 * (p[k] - x[k]) + o.c2 * r2 * (gx[k] - x[k]);
+        vk = std::min(std::max(vk, -vmax[k]), vmax[k]);
+        double xk = x[k] + vk;
+        if (xk < b.low[k]) { xk = b.low[k]; vk = 0.0; }
+        else if (xk > b.high[k]) { xk = b.high[k]; vk = 0.0; }
+        x[k] = xk;
+        v[k] = vk;
+      }
+    }
+    eval(X, f);
+    const double before = gf;
+    for (int i = 0; i < n; ++i)
+      if (f[i] < pf[i]) {
+        pf[i] = f[i];
+        P.row(i) = X.row(i);
+        if (f[i] < gf) { gf = f[i]; gx = X.row(i).transpose(); }
+      }
+    if (o.record_history) r.history.push_back(gf);
+    if (o.stall_iter > 0) {
+      stall = (before - gf > o.ftol) ? 0 : stall + 1;
+      if (stall >= o.stall_iter) { ++it; r.converged = true; r.message = "no improvement for stall_iter iterations"; break; }
+    }
+  }
+  r.x = gx;
+  r.f = gf;
+  r.iterations = it;
+  r.evaluations = eval.evaluations();
+  if (gf <= o.target) { r.converged = true; r.message = "target reached"; }
+  if (r.message.empty()) r.message = "iteration budget used";
+  return r;
+}
+
+}  // namespace bayesgrasp::optim

@@ -1,0 +1,183 @@
+#include "bayesgrasp/optim/trust_region.hpp"
+
+#include <Eigen/Cholesky>
+#include <cmath>
+#include <limits>
+
+namespace bayesgrasp::optim {
+
+namespace {
+
+struct ResidualEvaluator {
+  const BatchResiduals& fun;
+  long long n = 0;
+  RowMatrixXd operator()(const RowMatrixXd& X) {
+    RowMatrixXd R;
+    fun(X, R);
+    if (R.rows() != X.rows() || R.cols() < 1)
+      throw std::invalid_argument("residuals: callback must return an (N, n_residuals) array with n_residuals >= 1");
+    n += X.rows();
+    return R;
+  }
+};
+
+}  // namespace
+
+Result levenberg_marquardt(const BatchResiduals& fun, const Eigen::VectorXd& x0, const Bounds& b,
+                           const LMOptions& o) {
+  validate_start(x0, b);
+  if (!(o.h > 0.0)) throw std::invalid_argument("h: must be positive");
+  if (!(o.lambda0 > 0.0)) throw std::invalid_argument("lambda0: must be positive");
+  const int d = static_cast<int>(x0.size());
+  ResidualEvaluator ev{fun};
+  Eigen::VectorXd x = project(x0, b);
+  RowMatrixXd one(1, d);
+  one.row(0) = x.transpose();
+  Eigen::VectorXd r = ev(one).row(0).transpose();
+  if (!r.allFinite()) throw std::invalid_argument("x0: residuals are not finite at the start point");
+  const int m = static_cast<int>(r.size());
+  double f = 0.5 * r.squaredNorm();
+  Result res;
+  if (o.record_history) res.history.push_back(f);
+  res.message = "iteration budget used";
+  double lambda = -1.0, nu = 2.0;
+  RowMatrixXd S(2 * d, d);
+  Eigen::MatrixXd J(m, d);
+  bool need_jac = true;
+  Eigen::MatrixXd A;
+  Eigen::VectorXd g;
+  int it = 0;
+  for (; it < o.max_iter; ++it) {
+    if (f <= o.ftol) { res.converged = true; res.message = "residual below ftol"; break; }
+    if (need_jac) {
+      Eigen::VectorXd hk(d);
+      for (int k = 0; k < d; ++k) {
+        hk[k] = o.h * std::max(1.0, std::abs(x[k]));
+        S.row(2 * k) = x.transpose();
+        S.row(2 * k + 1) = x.transpose();
+        S(2 * k, k) += hk[k];
+        S(2 * k + 1, k) -= hk[k];
+      }
+      const RowMatrixXd R = ev(S);
+      if (R.cols() != m) throw std::invalid_argument("residuals: number of residuals changed between calls");
+      for (int k = 0; k < d; ++k) J.col(k) = (R.row(2 * k) - R.row(2 * k + 1)).transpose() / (2.0 * hk[k]);
+      if (!J.allFinite()) { res.message = "Jacobian is not finite"; break; }
+      A = J.transpose() * J;
+      g = J.transpose() * r;
+      need_jac = false;
+      if (lambda < 0.0) lambda = o.lambda0 * std::max(A.diagonal().maxCoeff(), 1e-300);
+    }
+    if (g.lpNorm<Eigen::Infinity>() < o.gtol) { res.converged = true; res.message = "gradient below gtol"; break; }
+    Eigen::MatrixXd Ad = A;
+    for (int k = 0; k < d; ++k) Ad(k, k) += lambda * std::max(A(k, k), 1e-12);
+    const Eigen::VectorXd dx = Ad.ldlt().solve(-g);
+    if (!dx.allFinite()) { res.message = "singular damped normal equations"; break; }
+    if (dx.norm() < o.xtol * (x.norm() + o.xtol)) { res.converged = true; res.message = "step below xtol"; break; }
+    const Eigen::VectorXd xn = project(x + dx, b);
+    const Eigen::VectorXd step = xn - x;
+    one.row(0) = xn.transpose();
+    const Eigen::VectorXd rn = ev(one).row(0).transpose();
+    const double fn = rn.allFinite() ? 0.5 * rn.squaredNorm() : std::numeric_limits<double>::infinity();
+    // Predicted reduction of the Gauss-Newton model: -(g.s + 1/2 s^T A s).
+    const double pred = -(g.dot(step) + 0.5 * step.dot(A * step));
+    const double rho = pred > 0.0 ? (f - fn) / pred : -1.0;
+    if (rho > 0.0 && fn < f) {
+      x = xn;
+      r = rn;
+      f = fn;
+      need_jac = true;
+      lambda *= std::max(1.0 / 3.0, 1.0 - std::pow(2.0 * rho - 1.0, 3));
+      nu = 2.0;
+    } else {
+      lambda *= nu;
+      nu *= 2.0;
+      if (!std::isfinite(lambda) || lambda > 1e300) { res.message = "damping overflow: no decrease found"; break; }
+    }
+    if (o.record_history) res.history.push_back(f);
+  }
+  res.x = x;
+  res.f = f;
+  res.iterations = it;
+  res.evaluations = ev.n;
+  return res;
+}
+
+Result trust_region(const BatchObjective& fun, const Eigen::VectorXd& x0, const Bounds& b,
+                    const TrustRegionOptions& o) {
+  validate_start(x0, b);
+  if (!(o.h > 0.0)) throw std::invalid_argument("h: must be positive");
+  if (!(o.radius0 > 0.0)) throw std::invalid_argument("radius0: must be positive");
+  if (!(o.eta >= 0.0 && o.eta < 0.25)) throw std::invalid_argument("eta: must be in [0, 0.25)");
+  const int d = static_cast<int>(x0.size());
+  Evaluator eval(fun);
+  Eigen::VectorXd x = project(x0, b), fv;
+  RowMatrixXd one(1, d);
+  auto f1 = [&](const Eigen::VectorXd& y) {
+    one.row(0) = y.transpose();
+    eval(one, fv);
+    return fv[0];
+  };
+  double f = f1(x);
+  if (!std::isfinite(f)) throw std::invalid_argument("x0: objective is not finite at the start point");
+  Eigen::VectorXd g = numerical_gradient(eval, x, o.h);
+  Eigen::MatrixXd B = Eigen::MatrixXd::Identity(d, d);
+  bool scaled = false;
+  double radius = o.radius0;
+  Result res;
+  if (o.record_history) res.history.push_back(f);
+  res.message = "iteration budget used";
+  int it = 0;
+  for (; it < o.max_iter; ++it) {
+    if (g.lpNorm<Eigen::Infinity>() < o.gtol) { res.converged = true; res.message = "gradient below gtol"; break; }
+    if (radius < o.xtol * (x.norm() + o.xtol)) { res.converged = true; res.message = "trust radius below xtol"; break; }
+    // Dogleg step.
+    Eigen::VectorXd p;
+    const Eigen::LLT<Eigen::MatrixXd> llt(B);
+    const Eigen::VectorXd pb = llt.solve(-g);
+    if (pb.norm() <= radius) {
+      p = pb;
+    } else {
+      const double gBg = g.dot(B * g);
+      const Eigen::VectorXd pu = -(g.squaredNorm() / gBg) * g;
+      if (pu.norm() >= radius) {
+        p = (radius / pu.norm()) * pu;
+      } else {  // pu + tau (pb - pu), ||.|| = radius
+        const Eigen::VectorXd dp = pb - pu;
+        const double a = dp.squaredNorm(), bb = 2.0 * pu.dot(dp), c = pu.squaredNorm() - radius * radius;
+        const double tau = (-bb + std::sqrt(bb * bb - 4.0 * a * c)) / (2.0 * a);
+        p = pu + tau * dp;
+      }
+    }
+    const Eigen::VectorXd xn = project(x + p, b);
+    const Eigen::VectorXd s = xn - x;
+    const double fn = f1(xn);
+    const double pred = -(g.dot(s) + 0.5 * s.dot(B * s));
+    const double rho = (pred > 0.0 && std::isfinite(fn)) ? (f - fn) / pred : -1.0;
+    if (rho < 0.25) radius = 0.25 * s.norm() > 0 ? 0.25 * s.norm() : 0.25 * radius;
+    else if (rho > 0.75 && s.norm() > 0.99 * radius) radius = std::min(2.0 * radius, o.max_radius);
+    if (rho > o.eta && fn < f) {
+      const Eigen::VectorXd gn = numerical_gradient(eval, xn, o.h);
+      const Eigen::VectorXd y = gn - g;
+      const double sy = s.dot(y);
+      if (sy > 1e-12 * s.norm() * y.norm()) {
+        if (!scaled) {  // Nocedal & Wright (6.20): scale the initial Hessian before the first update
+          B = Eigen::MatrixXd::Identity(d, d) * (y.squaredNorm() / sy);
+          scaled = true;
+        }
+        const Eigen::VectorXd Bs = B * s;
+        B += (y * y.transpose()) / sy - (Bs * Bs.transpose()) / s.dot(Bs);
+      }
+      x = xn;
+      f = fn;
+      g = gn;
+    }
+    if (o.record_history) res.history.push_back(f);
+  }
+  res.x = x;
+  res.f = f;
+  res.iterations = it;
+  res.evaluations = eval.evaluations();
+  return res;
+}
+
+}  // namespace bayesgrasp::optim

@@ -1,0 +1,621 @@
+// Registration against object models. PCL provides voxel downsampling, normals, FPFH and the
+// k-d trees; the RANSAC over feature correspondences and the point-to-plane ICP are ours so that
+// they are seeded (PCL's SampleConsensusPrerejective draws from the global rand(), which is
+// neither seedable per call nor deterministic under OpenMP) and so that the hypothesis choice can
+// use the up prior.
+// All PCL templates are instantiated here, in our own flags, instead of using the instances
+// precompiled into Debian's libpcl_*.so: with -march=native Eigen's heap alignment (and so its
+// aligned_malloc/free) differs from the library's SSE2 build, and memory allocated on one side and
+// freed on the other (e.g. point-cloud storage resized inside a filter) would corrupt the heap.
+#define PCL_NO_PRECOMPILE
+#include "bayesgrasp/vision/registration.hpp"
+
+#include <omp.h>
+#include <pcl/features/fpfh_omp.h>
+#include <pcl/features/normal_3d_omp.h>
+#include <pcl/filters/voxel_grid.h>
+#include <pcl/kdtree/kdtree_flann.h>
+#include <pcl/point_cloud.h>
+#include <pcl/point_types.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <numeric>
+#include <random>
+#include <stdexcept>
+
+namespace bayesgrasp::vision {
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+double seconds_since(Clock::time_point t0) {
+  return std::chrono::duration<double>(Clock::now() - t0).count();
+}
+
+std::uint64_t mix(std::uint64_t x) {
+  x += 0x9E3779B97F4A7C15ull;
+  x = (x ^ (x >> 30)) * 0xBF58476D1CE4E5B9ull;
+  x = (x ^ (x >> 27)) * 0x94D049BB133111EBull;
+  return x ^ (x >> 31);
+}
+
+using CloudN = pcl::PointCloud<pcl::PointNormal>;
+using Features = Eigen::Matrix<float, Eigen::Dynamic, 33, Eigen::RowMajor>;
+
+// A cloud prepared for matching: downsampled points, normals and FPFH descriptors.
+struct Prepared {
+  CloudN::Ptr cloud;   // downsampled, with oriented normals (non-finite normals removed)
+  Features features;   // one row per point of cloud
+};
+
+CloudN::Ptr to_cloud(const Points& P, const Points* N) {
+  CloudN::Ptr c(new CloudN);
+  c->reserve(P.rows());
+  for (Eigen::Index i = 0; i < P.rows(); ++i) {
+    if (!P.row(i).allFinite()) continue;
+    pcl::PointNormal p;
+    p.x = static_cast<float>(P(i, 0));
+    p.y = static_cast<float>(P(i, 1));
+    p.z = static_cast<float>(P(i, 2));
+    if (N) {
+      p.normal_x = static_cast<float>((*N)(i, 0));
+      p.normal_y = static_cast<float>((*N)(i, 1));
+      p.normal_z = static_cast<float>((*N)(i, 2));
+    } else {
+      p.normal_x = p.normal_y = p.normal_z = 0.f;
+    }
+    p.curvature = 0.f;
+    c->push_back(p);
+  }
+  c->width = static_cast<std::uint32_t>(c->size());
+  c->height = 1;
+  c->is_dense = true;
+  return c;
+}
+
+CloudN::Ptr downsample(const CloudN::Ptr& in, double voxel) {
+  CloudN::Ptr out(new CloudN);
+  pcl::VoxelGrid<pcl::PointNormal> vg;
+  vg.setInputCloud(in);
+  vg.setLeafSize(static_cast<float>(voxel), static_cast<float>(voxel), static_cast<float>(voxel));
+  vg.filter(*out);  // averages xyz and the (reference) normals of each voxel
+  return out;
+}
+
+// Normals by PCA over a radius; oriented towards `viewpoint` (scene) or along the averaged
+// reference normals carried by the points (model). Points without a normal are removed.
+// Then FPFH over `feature_radius`.
+enum class Orient { Viewpoint, Reference, AwayFromCentroid };
+Prepared prepare(const CloudN::Ptr& down, double normal_radius, double feature_radius, Orient orient,
+                 const Vec3& viewpoint, int threads) {
+  CloudN::Ptr withn(new CloudN);
+  pcl::NormalEstimationOMP<pcl::PointNormal, pcl::PointNormal> ne(threads);
+  ne.setInputCloud(down);
+  ne.setRadiusSearch(normal_radius);
+  ne.setViewPoint(static_cast<float>(viewpoint.x()), static_cast<float>(viewpoint.y()),
+                  static_cast<float>(viewpoint.z()));
+  CloudN est;
+  ne.compute(est);
+  withn->reserve(down->size());
+  Eigen::Vector3f centroid = Eigen::Vector3f::Zero();
+  for (const auto& p : *down) centroid += p.getVector3fMap();
+  if (!down->empty()) centroid /= static_cast<float>(down->size());
+  for (std::size_t i = 0; i < down->size(); ++i) {
+    pcl::PointNormal p = (*down)[i];
+    Eigen::Vector3f n(est[i].normal_x, est[i].normal_y, est[i].normal_z);
+    if (!n.allFinite() || n.norm() < 0.5f) continue;
+    if (orient == Orient::Reference) {
+      const Eigen::Vector3f ref(p.normal_x, p.normal_y, p.normal_z);
+      if (n.dot(ref) < 0) n = -n;
+    } else if (orient == Orient::AwayFromCentroid) {
+      if (n.dot(p.getVector3fMap() - centroid) < 0) n = -n;
+    }
+    p.normal_x = n.x();
+    p.normal_y = n.y();
+    p.normal_z = n.z();
+    p.curvature = est[i].curvature;
+    withn->push_back(p);
+  }
+  withn->width = static_cast<std::uint32_t>(withn->size());
+  withn->height = 1;
+  Prepared out;
+  out.cloud = withn;
+  if (withn->empty()) return out;
+  pcl::FPFHEstimationOMP<pcl::PointNormal, pcl::PointNormal, pcl::FPFHSignature33> fe(threads);
+  fe.setInputCloud(withn);
+  fe.setInputNormals(withn);
+  fe.setRadiusSearch(feature_radius);
+  pcl::PointCloud<pcl::FPFHSignature33> f;
+  fe.compute(f);
+  out.features.resize(static_cast<Eigen::Index>(f.size()), 33);
+  for (std::size_t i = 0; i < f.size(); ++i)
+    for (int j = 0; j < 33; ++j) out.features(static_cast<Eigen::Index>(i), j) = f[i].histogram[j];
+  return out;
+}
+
+struct Hypothesis {
+  Iso3 T = Iso3::Identity();  // scene -> model
+  int inliers = 0;
+  double cost = 0.0;
+};
+
+bool similar(const Iso3& a, const Iso3& b, double trans_tol, double rot_tol) {
+  const double ang = Eigen::AngleAxisd(a.linear().transpose() * b.linear()).angle();
+  return ang < rot_tol && (a.translation() - b.translation()).norm() < trans_tol;
+}
+
+// Rigid transform (no scale) taking src points onto dst points in the least-squares sense.
+Iso3 kabsch(const Eigen::Matrix3Xd& src, const Eigen::Matrix3Xd& dst) {
+  const Vec3 cs = src.rowwise().mean(), cd = dst.rowwise().mean();
+  const Mat3 Hm = (src.colwise() - cs) * (dst.colwise() - cd).transpose();
+  Eigen::JacobiSVD<Mat3> svd(Hm, Eigen::ComputeFullU | Eigen::ComputeFullV);
+  Mat3 D = Mat3::Identity();
+  if ((svd.matrixV() * svd.matrixU().transpose()).determinant() < 0) D(2, 2) = -1;
+  Iso3 T = Iso3::Identity();
+  T.linear() = svd.matrixV() * D * svd.matrixU().transpose();
+  T.translation() = cd - T.linear() * cs;
+  return T;
+}
+
+// Per-model registration state.
+struct ModelData {
+  bool ok = false;
+  std::string reason;
+  CloudN::Ptr dense;  // all surface samples with exact normals
+  pcl::KdTreeFLANN<pcl::PointNormal> dense_tree;
+  double spacing = 0.0;
+  Prepared prep;
+};
+
+// Distances from each (transformed) scene point to the nearest dense model sample.
+void nearest(const ModelData& m, const std::vector<Vec3>& pts, const Iso3& T, std::vector<double>& d,
+             std::vector<int>& idx) {
+  d.resize(pts.size());
+  idx.resize(pts.size());
+  pcl::Indices k(1);
+  std::vector<float> kd(1);
+  for (std::size_t i = 0; i < pts.size(); ++i) {
+    const Vec3 q = T * pts[i];
+    pcl::PointNormal p;
+    p.x = static_cast<float>(q.x());
+    p.y = static_cast<float>(q.y());
+    p.z = static_cast<float>(q.z());
+    if (m.dense_tree.nearestKSearch(p, 1, k, kd) > 0) {
+      const auto& s = (*m.dense)[k[0]];
+      d[i] = (q - Vec3(s.x, s.y, s.z)).norm();
+      idx[i] = k[0];
+    } else {
+      d[i] = std::numeric_limits<double>::infinity();
+      idx[i] = -1;
+    }
+  }
+}
+
+struct Fit {
+  double fitness = 0, rmse = 0, delta = 0;
+};
+Fit measure(const ModelData& m, const std::vector<Vec3>& pts, const Iso3& T, double tau) {
+  std::vector<double> d;
+  std::vector<int> idx;
+  nearest(m, pts, T, d, idx);
+  Fit f;
+  int n_in = 0;
+  double s_in = 0, s_all = 0;
+  for (double di : d) {
+    if (di < tau) {
+      ++n_in;
+      s_in += di * di;
+    }
+    const double c = std::min(di, tau);
+    s_all += c * c;
+  }
+  f.fitness = pts.empty() ? 0.0 : static_cast<double>(n_in) / pts.size();
+  f.rmse = n_in ? std::sqrt(s_in / n_in) : 0.0;
+  f.delta = pts.empty() ? tau : std::sqrt(s_all / pts.size());
+  return f;
+}
+
+// Point-to-plane ICP, scene -> model, against the dense samples and their exact normals.
+Iso3 icp(const ModelData& m, const std::vector<Vec3>& pts, Iso3 T, double max_dist, int iters, double tol) {
+  std::vector<double> d;
+  std::vector<int> idx;
+  for (int it = 0; it < iters; ++it) {
+    nearest(m, pts, T, d, idx);
+    Eigen::Matrix<double, 6, 6> A = Eigen::Matrix<double, 6, 6>::Zero();
+    Eigen::Matrix<double, 6, 1> b = Eigen::Matrix<double, 6, 1>::Zero();
+    int n = 0;
+    for (std::size_t i = 0; i < pts.size(); ++i) {
+      if (!(d[i] < max_dist)) continue;
+      const auto& s = (*m.dense)[idx[i]];
+      const Vec3 q = T * pts[i];
+      const Vec3 nn(s.normal_x, s.normal_y, s.normal_z);
+      const double r = (q - Vec3(s.x, s.y, s.z)).dot(nn);
+      Eigen::Matrix<double, 6, 1> J;
+      J.head<3>() = q.cross(nn);
+      J.tail<3>() = nn;
+      A.noalias() += J * J.transpose();
+      b.noalias() -= J * r;
+      ++n;
+    }
+    if (n < 6) break;
+    A.diagonal().array() += 1e-9;
+    const Eigen::Matrix<double, 6, 1> x = A.ldlt().solve(b);
+    if (!x.allFinite()) break;
+    Iso3 dT = Iso3::Identity();
+    const double ang = x.head<3>().norm();
+    if (ang > 0) dT.linear() = Eigen::AngleAxisd(ang, x.head<3>() / ang).toRotationMatrix();
+    dT.translation() = x.tail<3>();
+    T = dT * T;
+    if (ang < tol && x.tail<3>().norm() < tol) break;
+  }
+  return T;
+}
+
+}  // namespace
+
+// ---------------------------------------------------------------------------------------
+double surface_area(const TriMesh& mesh) {
+  double a = 0;
+  for (Eigen::Index f = 0; f < mesh.F.rows(); ++f) {
+    const Vec3 v0 = mesh.V.row(mesh.F(f, 0)).transpose();
+    a += 0.5 * (Vec3(mesh.V.row(mesh.F(f, 1)).transpose()) - v0)
+                   .cross(Vec3(mesh.V.row(mesh.F(f, 2)).transpose()) - v0)
+                   .norm();
+  }
+  return a;
+}
+
+SurfaceSamples sample_surface(const TriMesh& mesh, int n, std::uint64_t seed) {
+  validate_mesh(mesh);
+  if (n <= 0) throw std::invalid_argument("number of samples must be positive");
+  const Eigen::Index F = mesh.F.rows();
+  std::vector<double> cum(F);
+  std::vector<Vec3> normals(F);
+  double total = 0;
+  for (Eigen::Index f = 0; f < F; ++f) {
+    const Vec3 v0 = mesh.V.row(mesh.F(f, 0)).transpose();
+    const Vec3 c = (Vec3(mesh.V.row(mesh.F(f, 1)).transpose()) - v0).cross(Vec3(mesh.V.row(mesh.F(f, 2)).transpose()) - v0);
+    const double a = 0.5 * c.norm();
+    total += a;
+    cum[f] = total;
+    normals[f] = a > 0 ? c.normalized() : Vec3::Zero();
+  }
+  if (!(total > 0)) throw std::invalid_argument("mesh has no surface area");
+  std::mt19937_64 rng(mix(seed));
+  std::uniform_real_distribution<double> U(0.0, 1.0);
+  SurfaceSamples s;
+  s.points.resize(n, 3);
+  s.normals.resize(n, 3);
+  for (int i = 0; i < n; ++i) {
+    const double r = U(rng) * total;
+    Eigen::Index f = std::lower_bound(cum.begin(), cum.end(), r) - cum.begin();
+    f = std::min<Eigen::Index>(f, F - 1);
+    while (f > 0 && normals[f].isZero()) --f;  // never a zero-area face
+    double a = U(rng), b = U(rng);
+    if (a + b > 1) {
+      a = 1 - a;
+      b = 1 - b;
+    }
+    const Vec3 v0 = mesh.V.row(mesh.F(f, 0)).transpose(), v1 = mesh.V.row(mesh.F(f, 1)).transpose(),
+               v2 = mesh.V.row(mesh.F(f, 2)).transpose();
+    s.points.row(i) = (v0 + a * (v1 - v0) + b * (v2 - v0)).transpose();
+    s.normals.row(i) = normals[f].transpose();
+  }
+  return s;
+}
+
+ModelCloud model_from_mesh(const TriMesh& mesh, const RegistrationParams& params, std::uint64_t seed) {
+  validate_mesh(mesh);
+  const double area = surface_area(mesh);
+  if (!(area > 0)) throw std::invalid_argument("mesh has no surface area");
+  int n = params.model_samples;
+  if (n <= 0) {
+    const double h = params.voxel / 3.0;
+    n = static_cast<int>(std::clamp(area / (h * h), 2000.0, 200000.0));
+  }
+  ModelCloud m;
+  m.surface = sample_surface(mesh, n, seed);
+  return m;
+}
+
+double rotation_error(const Mat3& Ra, const Mat3& Rb, const Vec3& axis) {
+  if (axis.norm() > 0) {
+    const Vec3 a = axis.normalized();
+    const double c = std::clamp((Ra * a).dot(Rb * a), -1.0, 1.0);
+    return std::acos(c);
+  }
+  const double c = std::clamp(((Ra.transpose() * Rb).trace() - 1.0) / 2.0, -1.0, 1.0);
+  return std::acos(c);
+}
+
+std::vector<RegistrationResult> register_models(const Points& scene, const std::vector<ModelCloud>& models,
+                                                const RegistrationParams& P) {
+  if (!(P.voxel > 0) || !std::isfinite(P.voxel)) throw std::invalid_argument("voxel must be positive and finite");
+  for (double f : {P.normal_radius, P.feature_radius, P.inlier_distance, P.icp_distance, P.weight_sigma})
+    if (!(f > 0) || !std::isfinite(f)) throw std::invalid_argument("radius and distance factors must be positive");
+  if (P.ransac_iterations < 1 || P.restarts < 1 || P.hypotheses < 1 || P.candidates < 1 || P.coarse_points < 1 || P.icp_iterations < 0 || P.coarse_icp_iterations < 0 ||
+      P.feature_neighbours < 1)
+    throw std::invalid_argument("iteration, restart, hypothesis and neighbour counts must be positive");
+  if (!(P.ransac_confidence > 0 && P.ransac_confidence < 1)) throw std::invalid_argument("ransac_confidence must be in (0, 1)");
+  if (!(P.edge_similarity > 0 && P.edge_similarity < 1)) throw std::invalid_argument("edge_similarity must be in (0, 1)");
+  if (P.use_up_prior && !(P.up.norm() > 0)) throw std::invalid_argument("up must be a non-zero vector");
+  if (models.empty()) throw std::invalid_argument("no models given");
+  CloudN::Ptr raw = to_cloud(scene, nullptr);
+  if (raw->empty()) throw std::invalid_argument("scene cloud has no finite points");
+
+  const double voxel = P.voxel, tau = P.inlier_distance * voxel;
+  const int nthreads = P.threads > 0 ? P.threads : omp_get_max_threads();
+  std::vector<RegistrationResult> results(models.size());
+
+  // Scene: downsample, normals towards the viewpoint (or away from the centroid), FPFH.
+  const auto t_scene = Clock::now();
+  CloudN::Ptr sdown = downsample(raw, voxel);
+  Prepared sprep = prepare(sdown, P.normal_radius * voxel, P.feature_radius * voxel,
+                           P.has_viewpoint ? Orient::Viewpoint : Orient::AwayFromCentroid, P.viewpoint, nthreads);
+  const double scene_time = seconds_since(t_scene);
+  const int ns = static_cast<int>(sprep.cloud->size());
+  std::vector<Vec3> spts(ns);
+  for (int i = 0; i < ns; ++i) spts[i] = (*sprep.cloud)[i].getVector3fMap().cast<double>();
+  if (ns < P.min_scene_points) {
+    for (auto& r : results) {
+      r.reason = "scene has " + std::to_string(ns) + " points with normals after downsampling at voxel " +
+                 std::to_string(voxel) + " m; at least " + std::to_string(P.min_scene_points) + " are needed";
+      r.scene_points = ns;
+    }
+    return results;
+  }
+  // Squared norms of the scene features, for the distance matrix.
+  Features sfeat = sprep.features;
+  if (P.hellinger) sfeat = sfeat.cwiseMax(0.f).cwiseSqrt();  // Hellinger: L2 between sqrt histograms
+  const Eigen::VectorXf sf_norm = sfeat.rowwise().squaredNorm();
+
+  std::vector<Vec3> snrm(ns);
+  for (int i = 0; i < ns; ++i) snrm[i] = (*sprep.cloud)[i].getNormalVector3fMap().cast<double>();
+  const Vec3 up = P.up.norm() > 0 ? P.up.normalized() : Vec3::UnitZ();
+  const double cos_tilt = std::cos(P.max_tilt);
+  // Rotation taking the scene's up onto +z (the model's up), for the 4-DOF hypotheses.
+  const Mat3 R0 = Eigen::Quaterniond::FromTwoVectors(up, Vec3::UnitZ()).toRotationMatrix();
+
+#pragma omp parallel for schedule(dynamic, 1) num_threads(nthreads)
+  for (int mi = 0; mi < static_cast<int>(models.size()); ++mi) {
+    RegistrationResult& res = results[mi];
+    res.scene_points = ns;
+    res.time_features = scene_time;
+    const SurfaceSamples& S = models[mi].surface;
+    if (S.points.rows() == 0 || S.points.rows() != S.normals.rows()) {
+      res.reason = "model has no surface points";
+      continue;
+    }
+    if (!S.points.allFinite() || !S.normals.allFinite()) {
+      res.reason = "model points or normals contain NaN or infinity";
+      continue;
+    }
+    // ---- model features
+    auto t0 = Clock::now();
+    ModelData md;
+    md.dense = to_cloud(S.points, &S.normals);
+    md.dense_tree.setInputCloud(md.dense);
+    CloudN::Ptr mdown = downsample(md.dense, voxel);
+    md.prep = prepare(mdown, P.normal_radius * voxel, P.feature_radius * voxel, Orient::Reference, Vec3::Zero(), 1);
+    const int nm = static_cast<int>(md.prep.cloud->size());
+    res.model_points = nm;
+    res.time_features += seconds_since(t0);
+    if (nm < 3) {
+      res.reason = "model has too few points after downsampling (" + std::to_string(nm) + ")";
+      continue;
+    }
+
+    // ---- correspondences: each scene feature's k nearest model features (brute force, L2).
+    t0 = Clock::now();
+    const int k = std::min(P.feature_neighbours, nm);
+    Features mfeat = md.prep.features;
+    if (P.hellinger) mfeat = mfeat.cwiseMax(0.f).cwiseSqrt();
+    const Eigen::VectorXf mf_norm = mfeat.rowwise().squaredNorm();
+    std::vector<std::pair<int, int>> corr;
+    corr.reserve(static_cast<std::size_t>(ns) * k + nm);
+    {
+      // Forward: each scene feature's k nearest model features. Reverse (optional): each model
+      // feature's nearest scene feature, which keeps the matches spread over the model when many
+      // scene features share a few nearest model features ("hubs", e.g. on flat faces).
+      const int block = 256;
+      Eigen::MatrixXf D;
+      std::vector<int> order(nm);
+      std::vector<float> rbest(nm, std::numeric_limits<float>::infinity());
+      std::vector<int> rarg(nm, -1);
+      for (int s0 = 0; s0 < ns; s0 += block) {
+        const int bs = std::min(block, ns - s0);
+        D.noalias() = -2.0f * sfeat.middleRows(s0, bs) * mfeat.transpose();
+        for (int i = 0; i < bs; ++i) {
+          std::iota(order.begin(), order.end(), 0);
+          auto row = D.row(i);
+          std::partial_sort(order.begin(), order.begin() + k, order.end(), [&](int a, int b) {
+            const float da = row(a) + mf_norm(a), db = row(b) + mf_norm(b);
+            return da < db || (da == db && a < b);
+          });
+          for (int j = 0; j < k; ++j) corr.emplace_back(s0 + i, order[j]);
+          if (P.reverse_matches)
+            for (int j = 0; j < nm; ++j) {
+              const float dj = row(j) + sf_norm(s0 + i);
+              if (dj < rbest[j]) {
+                rbest[j] = dj;
+                rarg[j] = s0 + i;
+              }
+            }
+        }
+      }
+      if (P.reverse_matches)
+        for (int j = 0; j < nm; ++j)
+          if (rarg[j] >= 0) corr.emplace_back(rarg[j], j);
+    }
+    const int nc = static_cast<int>(corr.size());
+    std::vector<Vec3> mpts(nm);
+    for (int i = 0; i < nm; ++i) mpts[i] = (*md.prep.cloud)[i].getVector3fMap().cast<double>();
+
+    // ---- RANSAC over correspondences, several restarts; keep distinct good hypotheses.
+    std::vector<Vec3> mnrm(nm);
+    for (int i = 0; i < nm; ++i) mnrm[i] = (*md.prep.cloud)[i].getNormalVector3fMap().cast<double>();
+    std::vector<Hypothesis> hyps;
+    const double tau2 = tau * tau;
+    const double min_edge = 2.0 * voxel;
+    const double sim = P.edge_similarity;
+    const double cos_normal = std::cos(P.max_normal_angle);
+    const bool four_dof = P.use_up_prior && P.upright;
+    const int sample_size = four_dof ? 2 : 3;
+    for (int rs = 0; rs < P.restarts; ++rs) {
+      std::mt19937_64 rng(mix(P.seed * 0x100000001B3ull + static_cast<std::uint64_t>(rs)));
+      std::uniform_int_distribution<int> pick(0, nc - 1);
+      std::vector<Hypothesis> top;  // best distinct hypotheses of this restart
+      int best = 0;
+      long needed = P.ransac_iterations;
+      int it = 0;
+      for (; it < P.ransac_iterations && it < needed; ++it) {
+        int s_id[3], m_id[3];
+        for (int j = 0; j < sample_size; ++j) {
+          const int c = pick(rng);
+          s_id[j] = corr[c].first;
+          m_id[j] = corr[c].second;
+        }
+        if (s_id[0] == s_id[1] || (sample_size == 3 && (s_id[0] == s_id[2] || s_id[1] == s_id[2]))) continue;
+        Iso3 T = Iso3::Identity();
+        bool okay = true;
+        if (four_dof) {
+          // Yaw about the up axis and a translation from two correspondences (the model's +z is
+          // the scene's up): levelled scene points q = R0 p, then a rotation about z.
+          const Vec3 qa = R0 * spts[s_id[0]], qb = R0 * spts[s_id[1]];
+          const Vec3 dq = qb - qa, dm = mpts[m_id[1]] - mpts[m_id[0]];
+          const double lq = dq.head<2>().norm(), lm = dm.head<2>().norm();
+          if (lq < min_edge || lm < min_edge || std::min(lq, lm) < sim * std::max(lq, lm) ||
+              std::abs(dq.z() - dm.z()) > tau)
+            continue;
+          const double yaw = std::atan2(dm.y(), dm.x()) - std::atan2(dq.y(), dq.x());
+          T.linear() = Eigen::AngleAxisd(yaw, Vec3::UnitZ()).toRotationMatrix() * R0;
+          T.translation() = 0.5 * (mpts[m_id[0]] + mpts[m_id[1]]) - T.linear() * 0.5 * (spts[s_id[0]] + spts[s_id[1]]);
+        } else {
+          const int pairs[3][2] = {{0, 1}, {1, 2}, {0, 2}};
+          for (const auto& pr : pairs) {
+            const double ls = (spts[s_id[pr[0]]] - spts[s_id[pr[1]]]).norm();
+            const double lm = (mpts[m_id[pr[0]]] - mpts[m_id[pr[1]]]).norm();
+            if (ls < min_edge || lm < min_edge || std::min(ls, lm) < sim * std::max(ls, lm)) {
+              okay = false;
+              break;
+            }
+          }
+          if (!okay) continue;
+          Eigen::Matrix3Xd src(3, 3), dst(3, 3);
+          for (int j = 0; j < 3; ++j) {
+            src.col(j) = spts[s_id[j]];
+            dst.col(j) = mpts[m_id[j]];
+          }
+          T = kabsch(src, dst);
+          // model +z in the scene frame = R^T e_z (T maps scene -> model).
+          if (P.use_up_prior && T.linear().row(2).dot(up) < cos_tilt) continue;
+        }
+        // The sampled points must land near their matches with agreeing normals.
+        for (int j = 0; j < sample_size && okay; ++j)
+          okay = (T * spts[s_id[j]] - mpts[m_id[j]]).squaredNorm() < tau2 &&
+                 (T.linear() * snrm[s_id[j]]).dot(mnrm[m_id[j]]) > cos_normal;
+        if (!okay) continue;
+        int inl = 0;
+        for (int j = 0; j < nc; ++j)
+          inl += (T * spts[corr[j].first] - mpts[corr[j].second]).squaredNorm() < tau2;
+        if (inl < sample_size) continue;
+        if (inl > best) {
+          best = inl;
+          const double w = std::min(0.999, static_cast<double>(best) / ns);
+          const double denom = std::log(1.0 - std::pow(w, sample_size));
+          if (denom < 0)
+            needed = std::max<long>(P.ransac_min_iterations,
+                                    static_cast<long>(std::ceil(std::log(1.0 - P.ransac_confidence) / denom)));
+        }
+        // Keep the `hypotheses` best distinct ones.
+        const double ttol = 4.0 * voxel, rtol = 20.0 * 3.14159265358979323846 / 180.0;
+        bool merged = false;
+        for (auto& h : top) {
+          if (similar(h.T, T, ttol, rtol)) {
+            if (inl > h.inliers) {
+              h.T = T;
+              h.inliers = inl;
+            }
+            merged = true;
+            break;
+          }
+        }
+        if (!merged) {
+          if (static_cast<int>(top.size()) < P.candidates) {
+            top.push_back({T, inl, 0.0});
+          } else {
+            auto worst = std::min_element(top.begin(), top.end(),
+                                          [](const Hypothesis& a, const Hypothesis& b) { return a.inliers < b.inliers; });
+            if (inl > worst->inliers) *worst = {T, inl, 0.0};
+          }
+        }
+      }
+      res.ransac_iterations += it;
+      for (const auto& h : top) hyps.push_back(h);
+    }
+    res.time_global = seconds_since(t0);
+    if (hyps.empty()) {
+      res.reason = "no transform hypothesis found (too few consistent feature matches)";
+      continue;
+    }
+
+    // ---- refine the best distinct hypotheses by ICP and choose by fitting error + up penalty.
+    t0 = Clock::now();
+    // Candidates (distinct, by consensus) are ranked by their fitting error on a scene subsample;
+    // the best `hypotheses` get a coarse ICP.
+    std::vector<Vec3> sub;
+    const int stride = std::max(1, ns / P.coarse_points);
+    for (int i = 0; i < ns; i += stride) sub.push_back(spts[i]);
+    std::stable_sort(hyps.begin(), hyps.end(), [](const Hypothesis& a, const Hypothesis& b) { return a.inliers > b.inliers; });
+    std::vector<Hypothesis> distinct;
+    for (const auto& h : hyps) {
+      bool dup = false;
+      for (const auto& g : distinct) dup = dup || similar(g.T, h.T, 4.0 * voxel, 20.0 * 3.14159265358979323846 / 180.0);
+      if (!dup) distinct.push_back(h);
+    }
+    for (auto& h : distinct) h.cost = measure(md, sub, h.T, tau).delta;
+    std::stable_sort(distinct.begin(), distinct.end(), [](const Hypothesis& a, const Hypothesis& b) { return a.cost < b.cost; });
+    if (static_cast<int>(distinct.size()) > P.hypotheses) distinct.resize(P.hypotheses);
+    // Coarse: a short ICP on a subsample of the scene for every hypothesis; fine: the winner.
+    auto cost_of = [&](const Fit& f, const Iso3& T) {
+      const double up_cos = T.linear().row(2).dot(up);
+      return f.delta / tau + (P.use_up_prior ? P.up_weight * (1.0 - up_cos) / 2.0 : 0.0);
+    };
+    double best_cost = std::numeric_limits<double>::infinity();
+    Iso3 best_T = Iso3::Identity();
+    for (auto& h : distinct) {
+      const Iso3 T = icp(md, sub, h.T, P.icp_distance * voxel, P.coarse_icp_iterations, P.icp_tolerance);
+      const double cost = cost_of(measure(md, sub, T, tau), T);
+      if (cost < best_cost) {
+        best_cost = cost;
+        best_T = T;
+      }
+    }
+    const Iso3 T = icp(md, spts, best_T, P.icp_distance * voxel, P.icp_iterations, P.icp_tolerance);
+    const Fit f = measure(md, spts, T, tau);
+    const double sigma = P.weight_sigma * voxel;
+    res.transform = T.inverse().matrix();
+    res.fitness = f.fitness;
+    res.rmse = f.rmse;
+    res.delta = f.delta;
+    res.phi = std::exp(-f.delta * f.delta / (2 * sigma * sigma));
+    res.up_cos = T.linear().row(2).dot(up);
+    res.cost = cost_of(f, T);
+    res.time_icp = seconds_since(t0);
+    if (!res.transform.allFinite()) {
+      res.reason = "registration produced a non-finite transform";
+      res.transform.setIdentity();
+      continue;
+    }
+    res.success = true;
+  }
+  double total = 0;
+  for (const auto& r : results)
+    if (r.success) total += r.phi;
+  for (auto& r : results) r.weight = (r.success && total > 0) ? r.phi / total : 0.0;
+  return results;
+}
+
+}  // namespace bayesgrasp::vision

@@ -1,0 +1,135 @@
+"""Hands described by data files: the Barrett BH8 (the thesis's hand) and others.
+
+A hand file (JSON) gives the palm, the fingers as chains of phalanges, their collision
+shapes (boxes and capsules) and the closing scheme (coupled joints with breakaway). Built-in
+files live in ``bayesgrasp/data/hands/``::
+
+    hand = Hand.load("barrett_bh8")           # or Hand.load("path/to/my_hand.json")
+    q = hand.open_joints(spread=np.pi / 2)     # open preshape
+    poses = hand.link_poses(q, hand_pose)      # (L, 4, 4)
+    parts = hand.link_geometry(q, hand_pose)   # world-frame shapes, for plotting
+
+Joint vector q (radians): [spread, finger 0 phalanx 0, finger 0 phalanx 1, ..., finger 1
+phalanx 0, ...]; phalanx angles are relative to the previous phalanx. The hand frame has its
+origin at the centre of the palm face and +z along the approach direction.
+"""
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+
+from bayesgrasp import _core
+
+__all__ = ["Hand", "HANDS_DIR", "builtin_hands"]
+
+HANDS_DIR = Path(__file__).parent / "data" / "hands"
+
+
+def builtin_hands() -> list[str]:
+    """Names of the built-in hand files (without ``.json``)."""
+    return sorted(p.stem for p in HANDS_DIR.glob("*.json"))
+
+
+def _pose(hand_pose):
+    if hand_pose is None:
+        return None
+    return np.asarray(hand_pose, dtype=float)
+
+
+class Hand:
+    """A hand model (wraps :class:`bayesgrasp._core.hand.Hand`)."""
+
+    def __init__(self, core: _core.hand.Hand, source: str = ""):
+        if not isinstance(core, _core.hand.Hand):
+            raise ValueError("core: expected a bayesgrasp._core.hand.Hand; use Hand.load(...)")
+        self.core = core
+        self.source = source
+
+    @classmethod
+    def load(cls, name_or_path: str | Path = "barrett_bh8") -> "Hand":
+        """A built-in hand by name (see :func:`builtin_hands`) or a hand file by path."""
+        p = Path(name_or_path)
+        if not p.suffix and not p.exists():
+            p = HANDS_DIR / f"{name_or_path}.json"
+            if not p.exists():
+                raise ValueError(f"name_or_path: no built-in hand '{name_or_path}' "
+                                 f"(available: {', '.join(builtin_hands())}) and no such file")
+        if not p.exists():
+            raise ValueError(f"name_or_path: file not found: {p}")
+        return cls(_core.hand.Hand.from_file(str(p)), str(p))
+
+    @classmethod
+    def from_json(cls, text: str) -> "Hand":
+        """A hand from the JSON text of a hand file."""
+        return cls(_core.hand.Hand.from_json(text), "<json>")
+
+    @property
+    def path(self) -> str:
+        """The hand file this hand was loaded from ('<json>' when built from text)."""
+        return self.source
+
+    # ---- structure ----
+    name = property(lambda self: self.core.name, doc="The hand's name.")
+    num_joints = property(lambda self: self.core.num_joints, doc="Length of the joint vector q.")
+    num_links = property(lambda self: self.core.num_links, doc="Number of links (0 is the palm).")
+    num_fingers = property(lambda self: self.core.num_fingers, doc="Number of fingers.")
+    links = property(lambda self: list(self.core.link_names), doc="Link names.")
+    joint_names = property(lambda self: list(self.core.joint_names), doc="Names of the entries of q.")
+    joint_limits = property(lambda self: self.core.joint_limits, doc="(J, 2) joint limits (rad).")
+    spread_limits = property(lambda self: tuple(self.core.spread_limits), doc="(lower, upper) spread (rad).")
+    phalanx_links = property(lambda self: self.core.phalanx_links,
+                             doc="Per finger, the link indices of its phalanges (base to tip).")
+
+    def __repr__(self) -> str:
+        return f"Hand({self.name!r}, fingers={self.num_fingers}, joints={self.num_joints})"
+
+    # ---- kinematics ----
+    def coupled_joints(self, spread: float, t=0.0) -> np.ndarray:
+        """Joint vector at `spread` with every finger at actuator parameter t (number or per finger)."""
+        t = float(t) if np.isscalar(t) else np.asarray(t, dtype=float)
+        return self.core.coupled_joints(float(spread), t)
+
+    def open_joints(self, spread: float | None = None) -> np.ndarray:
+        """The open preshape (actuator t = 0) at `spread` (default: the hand's default spread)."""
+        return self.coupled_joints(self.core.spread_default if spread is None else spread, 0.0)
+
+    def link_poses(self, q, hand_pose=None) -> np.ndarray:
+        """(L, 4, 4) link poses for joint vector q, in the frame of hand_pose (default: hand frame)."""
+        return self.core.link_poses(np.asarray(q, dtype=float), _pose(hand_pose))
+
+    def fingertips(self, q, hand_pose=None) -> np.ndarray:
+        """(F, 3) fingertip positions."""
+        return self.core.fingertips(np.asarray(q, dtype=float), _pose(hand_pose))
+
+    @staticmethod
+    def top_grasp_pose(x: float, y: float, yaw: float, z: float) -> np.ndarray:
+        """4x4 pose of a palm-down hand at (x, y, yaw), palm face at height z."""
+        return _core.hand.Hand.top_grasp_pose(float(x), float(y), float(yaw), float(z))
+
+    def link_shapes(self) -> list[list[dict]]:
+        """Per link, its collision shapes in the link frame (dicts, see the hand file)."""
+        return self.core.link_shapes()
+
+    def link_geometry(self, q=None, hand_pose=None) -> list[dict]:
+        """World-frame geometry of every shape, for plotting.
+
+        Returns a list of dicts, one per shape, with ``link`` (index), ``name`` (link name) and
+        ``type``: a ``'capsule'`` has ``p0``, ``p1`` (3,) and ``radius``; a ``'box'`` has
+        ``center`` (3,), ``rotation`` (3, 3) (columns = box axes) and ``half_extents`` (3,).
+        q defaults to the open preshape at the default spread; hand_pose to identity.
+        """
+        q = self.open_joints() if q is None else np.asarray(q, dtype=float)
+        poses = self.link_poses(q, hand_pose)
+        out = []
+        for li, (shapes, T) in enumerate(zip(self.link_shapes(), poses)):
+            R, t = T[:3, :3], T[:3, 3]
+            for s in shapes:
+                d = {"link": li, "name": self.links[li], "type": s["type"]}
+                if s["type"] == "capsule":
+                    d.update(p0=R @ np.asarray(s["p0"]) + t, p1=R @ np.asarray(s["p1"]) + t, radius=float(s["radius"]))
+                else:
+                    d.update(center=R @ np.asarray(s["center"]) + t, rotation=R.copy(),
+                             half_extents=np.asarray(s["half_extents"], dtype=float))
+                out.append(d)
+        return out

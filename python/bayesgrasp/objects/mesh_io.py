@@ -1,0 +1,348 @@
+"""Triangle-mesh objects: loading OBJ / STL / PLY files and their mass properties.
+
+An :class:`ObjectModel` is a closed triangle mesh in metres (vertices ``(N, 3)`` float64, faces
+``(M, 3)`` int32, counter-clockwise seen from outside) with a uniform density. Its mass properties
+(volume, mass, centre of mass, inertia about the centre of mass) come from the C++ core
+(:func:`bayesgrasp._core.geometry.mass_properties`).
+
+Bad input raises clear exceptions: a missing file :class:`FileNotFoundError`, a file that is not a
+mesh or has an unsupported extension :class:`ValueError`, a mesh without faces or with non-finite
+vertices :class:`ValueError`. A mesh that is not watertight only warns (:class:`MeshWarning`); its
+mass properties are then computed from its convex hull.
+"""
+from __future__ import annotations
+
+import os
+import warnings
+from collections import deque
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Optional, Union
+
+import numpy as np
+
+#: Default density for meshes loaded from files, kg/m^3. Water's density: typical of household
+#: objects as a whole (a full bottle, a plastic box, a wooden toy are 500-1200 kg/m^3); pass
+#: ``density=`` to load_mesh / load_object for anything else. Built-in objects carry their own.
+DEFAULT_DENSITY = 1000.0
+
+#: File extensions load_mesh reads (and ObjectModel.save writes).
+MESH_EXTENSIONS = (".obj", ".stl", ".ply")
+
+
+class MeshWarning(UserWarning):
+    """A mesh problem that does not stop loading (e.g. it is not watertight)."""
+
+
+def _core_mass_properties(V: np.ndarray, F: np.ndarray, density: float) -> dict:
+    from bayesgrasp import _core
+
+    mp = _core.geometry.mass_properties(V, F, float(density))
+    return {
+        "volume": float(mp["volume"]),
+        "mass": float(mp["mass"]),
+        "com": np.asarray(mp["com"], dtype=np.float64).reshape(3),
+        "inertia": np.asarray(mp["inertia"], dtype=np.float64).reshape(3, 3),
+    }
+
+
+def _edge_use_counts(F: np.ndarray) -> np.ndarray:
+    """Number of faces using each undirected edge (one entry per distinct edge)."""
+    e = np.concatenate([F[:, [0, 1]], F[:, [1, 2]], F[:, [2, 0]]])
+    e = np.sort(e, axis=1)
+    _, counts = np.unique(e, axis=0, return_counts=True)
+    return counts
+
+
+def mesh_is_watertight(F: np.ndarray) -> bool:
+    """True when every edge is shared by exactly two faces (closed, edge-manifold)."""
+    F = np.asarray(F)
+    if len(F) == 0:
+        return False
+    return bool(np.all(_edge_use_counts(F) == 2))
+
+
+def _winding_is_consistent(F: np.ndarray) -> bool:
+    """True when no directed edge appears twice (neighbours traverse shared edges oppositely)."""
+    e = np.concatenate([F[:, [0, 1]], F[:, [1, 2]], F[:, [2, 0]]])
+    return len(np.unique(e, axis=0)) == len(e)
+
+
+def _fix_winding(F: np.ndarray) -> np.ndarray:
+    """Make face orientation consistent across shared edges (breadth-first over each component).
+
+    Each connected component keeps the orientation of its lowest-index face; the caller flips whole
+    components afterwards if their signed volume is negative.
+    """
+    F = F.copy()
+    M = len(F)
+    # map undirected edge -> faces using it
+    edges = np.concatenate([F[:, [0, 1]], F[:, [1, 2]], F[:, [2, 0]]])
+    face_of = np.tile(np.arange(M), 3)
+    key = np.sort(edges, axis=1)
+    order = np.lexsort((key[:, 1], key[:, 0]))
+    key_sorted = key[order]
+    same = np.all(key_sorted[1:] == key_sorted[:-1], axis=1)
+    neighbours = [[] for _ in range(M)]
+    for k in np.nonzero(same)[0]:
+        a, b = face_of[order[k]], face_of[order[k + 1]]
+        if a != b:
+            neighbours[a].append(b)
+            neighbours[b].append(a)
+    visited = np.zeros(M, dtype=bool)
+
+    def directed(f):
+        t = F[f]
+        return {(t[0], t[1]), (t[1], t[2]), (t[2], t[0])}
+
+    for seed in range(M):
+        if visited[seed]:
+            continue
+        visited[seed] = True
+        queue = deque([seed])
+        while queue:
+            f = queue.popleft()
+            df = directed(f)
+            for g in neighbours[f]:
+                if visited[g]:
+                    continue
+                # consistent neighbours share an edge in opposite directions
+                if df & directed(g):
+                    F[g] = F[g][::-1]
+                visited[g] = True
+                queue.append(g)
+    return F
+
+
+def _components(F: np.ndarray, n_vertices: int) -> np.ndarray:
+    """Connected-component label per face (faces connected through shared vertices)."""
+    from scipy.sparse import coo_matrix
+    from scipy.sparse.csgraph import connected_components
+
+    rows = np.concatenate([F[:, 0], F[:, 1], F[:, 2]])
+    cols = np.concatenate([F[:, 1], F[:, 2], F[:, 0]])
+    A = coo_matrix((np.ones(len(rows)), (rows, cols)), shape=(n_vertices, n_vertices))
+    _, labels = connected_components(A, directed=False)
+    return labels[F[:, 0]]
+
+
+def orient_outward(V: np.ndarray, F: np.ndarray) -> np.ndarray:
+    """Faces with consistent winding and every closed component's signed volume positive."""
+    F = np.asarray(F, dtype=np.int64)
+    if not _winding_is_consistent(F):
+        F = _fix_winding(F)
+    labels = _components(F, len(V))
+    a, b, c = V[F[:, 0]], V[F[:, 1]], V[F[:, 2]]
+    signed = np.einsum("ij,ij->i", a, np.cross(b, c))  # 6 x signed tetra volume about the origin
+    vol = np.bincount(labels, weights=signed)
+    flip = vol[labels] < 0
+    F[flip] = F[flip][:, ::-1]
+    return F
+
+
+@dataclass
+class ObjectModel:
+    """A rigid object: a closed triangle mesh (metres) of uniform density (kg/m^3).
+
+    Attributes:
+        name: built-in name (e.g. ``"mug/3"``) or the file's stem.
+        vertices: (N, 3) float64, metres, in the object's own frame.
+        faces: (M, 3) int32 vertex indices, counter-clockwise seen from outside.
+        density: kg/m^3 (> 0).
+        source: where it came from (``"builtin:mug/3"`` or the file path).
+        params: the parameter dict that generated a built-in object (empty for files).
+
+    Mass properties (``volume``, ``mass``, ``com``, ``inertia`` about the centre of mass, in this
+    frame) are computed once at construction. For a mesh that is not watertight they come from its
+    convex hull (``mass_from_hull`` is then True).
+    """
+
+    name: str
+    vertices: np.ndarray
+    faces: np.ndarray
+    density: float = DEFAULT_DENSITY
+    source: str = ""
+    params: dict = field(default_factory=dict)
+    warn_if_open: bool = True
+
+    def __post_init__(self):
+        V = np.ascontiguousarray(np.asarray(self.vertices, dtype=np.float64))
+        F = np.asarray(self.faces)
+        if V.ndim != 2 or V.shape[1] != 3:
+            raise ValueError(f"vertices of '{self.name}' must have shape (N, 3), got {V.shape}")
+        if F.ndim != 2 or F.shape[1] != 3:
+            raise ValueError(f"faces of '{self.name}' must have shape (M, 3), got {F.shape}")
+        if len(F) == 0:
+            raise ValueError(f"mesh '{self.name}' has no faces")
+        if not np.issubdtype(F.dtype, np.integer):
+            raise ValueError(f"faces of '{self.name}' must be integer indices, got {F.dtype}")
+        if not np.all(np.isfinite(V)):
+            raise ValueError(f"mesh '{self.name}' has NaN or infinite vertex coordinates")
+        if F.min() < 0 or F.max() >= len(V):
+            raise ValueError(f"faces of '{self.name}' index vertices out of range [0, {len(V)})")
+        if not (np.isfinite(self.density) and self.density > 0):
+            raise ValueError(f"density must be finite and > 0 kg/m^3, got {self.density}")
+        self.density = float(self.density)
+        self.vertices = V
+        self.faces = np.ascontiguousarray(F, dtype=np.int32)
+        self._watertight = mesh_is_watertight(self.faces)
+        self.mass_from_hull = not self._watertight
+        if self._watertight:
+            mp = _core_mass_properties(self.vertices, self.faces, self.density)
+        else:
+            if self.warn_if_open:
+                warnings.warn(
+                    f"mesh '{self.name}' ({self.source or 'in memory'}) is not watertight: "
+                    "its mass properties are computed from its convex hull (best effort)",
+                    MeshWarning, stacklevel=3)
+            hull = self.to_trimesh().convex_hull
+            mp = _core_mass_properties(np.asarray(hull.vertices, dtype=np.float64),
+                                       np.asarray(hull.faces, dtype=np.int32), self.density)
+        self._mp = mp
+
+    # ---- mass properties -------------------------------------------------------------------
+    @property
+    def mass_properties(self) -> dict:
+        """dict with ``volume`` (m^3), ``mass`` (kg), ``com`` (3,), ``inertia`` (3, 3) about com."""
+        return {k: (v.copy() if isinstance(v, np.ndarray) else v) for k, v in self._mp.items()}
+
+    @property
+    def volume(self) -> float:
+        return self._mp["volume"]
+
+    @property
+    def mass(self) -> float:
+        return self._mp["mass"]
+
+    @property
+    def com(self) -> np.ndarray:
+        return self._mp["com"].copy()
+
+    @property
+    def inertia(self) -> np.ndarray:
+        return self._mp["inertia"].copy()
+
+    # ---- geometry --------------------------------------------------------------------------
+    @property
+    def bounds(self) -> np.ndarray:
+        """(2, 3): row 0 the minimum corner, row 1 the maximum corner of the bounding box."""
+        return np.stack([self.vertices.min(axis=0), self.vertices.max(axis=0)])
+
+    @property
+    def extent(self) -> np.ndarray:
+        """(3,) bounding-box size along x, y, z (metres)."""
+        b = self.bounds
+        return b[1] - b[0]
+
+    @property
+    def is_watertight(self) -> bool:
+        """Every edge shared by exactly two faces."""
+        return self._watertight
+
+    @property
+    def max_radius_from_com(self) -> float:
+        """Largest distance from the centre of mass to a vertex: the torque scale of the GWS."""
+        return float(np.linalg.norm(self.vertices - self._mp["com"], axis=1).max())
+
+    @property
+    def n_faces(self) -> int:
+        return int(len(self.faces))
+
+    def transformed(self, T: np.ndarray, name: Optional[str] = None) -> "ObjectModel":
+        """A copy with vertices mapped by the rigid 4x4 transform ``T``."""
+        T = np.asarray(T, dtype=np.float64)
+        if T.shape != (4, 4) or not np.all(np.isfinite(T)):
+            raise ValueError(f"T must be a finite 4x4 transform, got shape {T.shape}")
+        V = self.vertices @ T[:3, :3].T + T[:3, 3]
+        return ObjectModel(name or self.name, V, self.faces.copy(), self.density, self.source,
+                           dict(self.params), warn_if_open=False)
+
+    def to_trimesh(self):
+        """A ``trimesh.Trimesh`` view of the mesh (no processing)."""
+        import trimesh
+
+        return trimesh.Trimesh(vertices=self.vertices.copy(), faces=self.faces.copy(), process=False)
+
+    def save(self, path: Union[str, os.PathLike]) -> Path:
+        """Write the mesh to ``path`` (.obj, .stl or .ply, chosen by the extension)."""
+        path = Path(path)
+        ext = path.suffix.lower()
+        if ext not in MESH_EXTENSIONS:
+            raise ValueError(f"cannot save '{path}': unsupported extension '{ext}' "
+                             f"(use one of {', '.join(MESH_EXTENSIONS)})")
+        path.parent.mkdir(parents=True, exist_ok=True)
+        self.to_trimesh().export(str(path), file_type=ext[1:])
+        return path
+
+    def __repr__(self) -> str:
+        e = self.extent
+        return (f"ObjectModel('{self.name}', {len(self.vertices)} vertices, {len(self.faces)} faces, "
+                f"extent=({e[0]:.3f}, {e[1]:.3f}, {e[2]:.3f}) m, mass={self.mass:.3f} kg)")
+
+
+def load_mesh(path: Union[str, os.PathLike], density: Optional[float] = None,
+              name: Optional[str] = None) -> ObjectModel:
+    """Load an OBJ, STL or PLY triangle mesh (coordinates in metres) as an :class:`ObjectModel`.
+
+    Vertices are merged (STL stores each triangle separately), inconsistent face winding is made
+    consistent and inward-facing closed components are flipped so that their volume is positive.
+
+    Args:
+        path: the mesh file.
+        density: kg/m^3 (default :data:`DEFAULT_DENSITY`).
+        name: object name (default: the file's stem).
+
+    Raises:
+        FileNotFoundError: the file does not exist.
+        ValueError: unsupported extension, not a mesh, no faces, NaN/infinite coordinates.
+
+    Warns:
+        MeshWarning: the mesh is not watertight (mass properties then from its convex hull).
+    """
+    import trimesh
+
+    p = Path(path)
+    if not p.is_file():
+        raise FileNotFoundError(f"mesh file not found: '{p}'")
+    ext = p.suffix.lower()
+    if ext not in MESH_EXTENSIONS:
+        raise ValueError(f"'{p}': unsupported mesh file extension '{ext}' "
+                         f"(supported: {', '.join(MESH_EXTENSIONS)})")
+    try:
+        loaded = trimesh.load(str(p), file_type=ext[1:], process=False)
+        if isinstance(loaded, trimesh.Scene):   # several geometries (or none): one mesh
+            loaded = (trimesh.util.concatenate(list(loaded.geometry.values()))
+                      if len(loaded.geometry) else trimesh.Trimesh())
+    except Exception as e:  # trimesh raises many kinds on garbage
+        raise ValueError(f"'{p}' is not a readable {ext[1:].upper()} mesh: {e}") from e
+    if isinstance(loaded, trimesh.PointCloud):
+        raise ValueError(f"'{p}': mesh has no faces (a point cloud of {len(loaded.vertices)} "
+                         "vertices)")
+    if isinstance(loaded, (list, tuple)):
+        raise ValueError(f"'{p}' is not a triangle mesh")
+    if not isinstance(loaded, trimesh.Trimesh):
+        raise ValueError(f"'{p}' is not a triangle mesh (read as {type(loaded).__name__})")
+    V = np.asarray(loaded.vertices, dtype=np.float64)
+    F = np.asarray(loaded.faces)
+    if len(V) == 0 and len(F) == 0:
+        raise ValueError(f"'{p}' is not a {ext[1:].upper()} mesh: no vertices or faces could be read")
+    if len(F) == 0:
+        raise ValueError(f"'{p}': mesh has no faces ({len(V)} vertices)")
+    if V.ndim != 2 or V.shape[1] != 3:
+        raise ValueError(f"'{p}': vertices must be 3-D, got shape {V.shape}")
+    if not np.all(np.isfinite(V)):
+        bad = int(np.count_nonzero(~np.all(np.isfinite(V), axis=1)))
+        raise ValueError(f"'{p}': mesh has {bad} vertices with NaN or infinite coordinates")
+    mesh = trimesh.Trimesh(vertices=V, faces=F, process=False)
+    mesh.merge_vertices(merge_tex=True, merge_norm=True)
+    mesh.remove_unreferenced_vertices()
+    V = np.asarray(mesh.vertices, dtype=np.float64)
+    F = np.asarray(mesh.faces, dtype=np.int64)
+    # drop faces that collapse to a line or point (repeated indices)
+    keep = (F[:, 0] != F[:, 1]) & (F[:, 1] != F[:, 2]) & (F[:, 2] != F[:, 0])
+    F = F[keep]
+    if len(F) == 0:
+        raise ValueError(f"'{p}': mesh has no non-degenerate faces")
+    F = orient_outward(V, F)
+    d = DEFAULT_DENSITY if density is None else density
+    return ObjectModel(name or p.stem, V, F.astype(np.int32), d, source=str(p))

@@ -1,0 +1,330 @@
+// Tests of the GP concept: FITC vs exact GP, analytic gradients vs finite differences,
+// predictions against closed forms, robustness, seeds.
+#include <gtest/gtest.h>
+
+#include <Eigen/LU>
+
+#include <cmath>
+#include <random>
+
+#include "bayesgrasp/gp/gp.hpp"
+
+using namespace bayesgrasp::gp;
+
+namespace {
+
+void make_data(int N, int D, int P, std::uint64_t seed, Eigen::MatrixXd& X, Eigen::MatrixXd& Y,
+               double noise_sd = 0.1) {
+  std::mt19937_64 rng(seed);
+  std::uniform_real_distribution<double> U(-2.0, 2.0);
+  std::normal_distribution<double> nd(0.0, noise_sd);
+  X.resize(N, D);
+  Y.resize(N, P);
+  for (int i = 0; i < N; ++i)
+    for (int d = 0; d < D; ++d) X(i, d) = U(rng);
+  for (int i = 0; i < N; ++i)
+    for (int p = 0; p < P; ++p) {
+      double s = 0.0;
+      for (int d = 0; d < D; ++d) s += std::sin((1.0 + p + d) * X(i, d));
+      Y(i, p) = s + 0.3 * p + nd(rng);
+    }
+}
+
+GPOptions fixed_options(KernelType t = KernelType::SquaredExponential) {
+  GPOptions o;
+  o.kernel = t;
+  o.optimize = false;
+  o.normalize_x = false;
+  o.normalize_y = false;
+  o.lengthscale = Eigen::VectorXd::Constant(1, 0.8);
+  o.variance = 1.3;
+  o.noise = 0.05;
+  return o;
+}
+
+}  // namespace
+
+TEST(GPKernel, SquaredExponentialAndMaternClosedForms) {
+  Eigen::MatrixXd A(1, 2), B(1, 2);
+  A << 0.0, 0.0;
+  B << 1.0, 2.0;
+  Eigen::VectorXd ls(2);
+  ls << 0.5, 2.0;
+  const Kernel se(KernelType::SquaredExponential, ls, 2.0);
+  const double r2 = 4.0 + 1.0;
+  EXPECT_NEAR(se(A, B)(0, 0), 2.0 * std::exp(-0.5 * r2), 1e-14);
+  const Kernel m52(KernelType::Matern52, ls, 2.0);
+  const double s = std::sqrt(5.0 * r2);
+  EXPECT_NEAR(m52(A, B)(0, 0), 2.0 * (1 + s + s * s / 3) * std::exp(-s), 1e-14);
+  EXPECT_NEAR(se(A)(0, 0), 2.0, 1e-15);
+  EXPECT_THROW(Kernel(KernelType::SquaredExponential, Eigen::VectorXd::Constant(2, -1.0), 1.0),
+               std::invalid_argument);
+}
+
+namespace {
+// Central finite differences of the objective against its analytic gradient.
+void check_gradient(const GaussianProcess& gp, const Eigen::VectorXd& theta, double rtol) {
+  Eigen::VectorXd g;
+  const double f0 = gp.objective(theta, g);
+  ASSERT_TRUE(std::isfinite(f0));
+  ASSERT_EQ(g.size(), theta.size());
+  for (Eigen::Index i = 0; i < theta.size(); ++i) {
+    const double h = 1e-5 * std::max(1.0, std::abs(theta[i]));
+    Eigen::VectorXd tp = theta, tm = theta, gd;
+    tp[i] += h;
+    tm[i] -= h;
+    const double fd = (gp.objective(tp, gd) - gp.objective(tm, gd)) / (2 * h);
+    EXPECT_NEAR(g[i], fd, rtol * std::max(1.0, std::abs(fd))) << "parameter " << i;
+  }
+}
+}  // namespace
+
+TEST(GPFitc, EqualsExactGPWhenInducingInputsAreTrainingInputs) {
+  Eigen::MatrixXd X, Y;
+  make_data(40, 2, 2, 1, X, Y);
+  for (KernelType t : {KernelType::SquaredExponential, KernelType::Matern52}) {
+    GPOptions o = fixed_options(t);
+    o.jitter = 1e-10;
+    ExactGP exact(o);
+    exact.fit(X, Y);
+    o.inducing = X;
+    SparseGP fitc(o);
+    fitc.fit(X, Y);
+    EXPECT_NEAR(fitc.log_marginal_likelihood(), exact.log_marginal_likelihood(), 1e-6);
+    Eigen::MatrixXd Xs, Ys;
+    make_data(25, 2, 2, 2, Xs, Ys);
+    Eigen::MatrixXd me, ve, ms, vs;
+    exact.predict(Xs, me, ve);
+    fitc.predict(Xs, ms, vs);
+    EXPECT_LT((me - ms).cwiseAbs().maxCoeff(), 1e-6);
+    EXPECT_LT((ve - vs).cwiseAbs().maxCoeff(), 1e-6);
+    EXPECT_LT((exact.log_predictive_density(Xs, Ys) - fitc.log_predictive_density(Xs, Ys)).cwiseAbs().maxCoeff(),
+              1e-5);
+    // Analytic gradients agree too (same model, same hyper-parameters).
+    Eigen::VectorXd ge, gs;
+    const Eigen::VectorXd th = exact.parameters();
+    exact.objective(th, ge);
+    fitc.objective(th, gs);
+    EXPECT_LT((ge - gs).cwiseAbs().maxCoeff(), 1e-4);
+  }
+}
+
+TEST(GPExact, MatchesDirectLinearAlgebra) {
+  Eigen::MatrixXd X, Y;
+  make_data(30, 3, 1, 3, X, Y);
+  GPOptions o = fixed_options();
+  ExactGP gp(o);
+  gp.fit(X, Y);
+  const Kernel k(KernelType::SquaredExponential, Eigen::VectorXd::Constant(3, 0.8), 1.3);
+  Eigen::MatrixXd K = k(X);
+  K.diagonal().array() += 0.05;
+  const Eigen::MatrixXd Kinv = K.inverse();
+  Eigen::MatrixXd Xs, Ys;
+  make_data(7, 3, 1, 4, Xs, Ys);
+  const Eigen::MatrixXd Ks = k(Xs, X);
+  const Eigen::VectorXd mean = Ks * Kinv * Y;
+  const Eigen::VectorXd var = (k(Xs).diagonal() - (Ks * Kinv * Ks.transpose()).diagonal());
+  Eigen::MatrixXd m, v;
+  gp.predict(Xs, m, v);
+  EXPECT_LT((m.col(0) - mean).cwiseAbs().maxCoeff(), 1e-9);
+  EXPECT_LT((v.col(0) - var).cwiseAbs().maxCoeff(), 1e-9);
+  EXPECT_LT((gp.predict_mean(Xs) - m).cwiseAbs().maxCoeff(), 1e-12);
+  const double lml = -0.5 * (Y.transpose() * Kinv * Y)(0, 0) - 0.5 * std::log(K.determinant()) -
+                     0.5 * 30 * std::log(2 * M_PI);
+  EXPECT_NEAR(gp.log_marginal_likelihood(), lml, 1e-8);
+  // log predictive density: Gaussian with variance var + noise
+  const Eigen::VectorXd lp = gp.log_predictive_density(Xs, Ys);
+  for (int i = 0; i < 7; ++i) {
+    const double s2 = var[i] + 0.05;
+    EXPECT_NEAR(lp[i], -0.5 * std::log(2 * M_PI * s2) - 0.5 * std::pow(Ys(i, 0) - mean[i], 2) / s2, 1e-9);
+  }
+  // full covariance diagonal equals the variance
+  EXPECT_LT((gp.predict_cov(Xs).diagonal() - var).cwiseAbs().maxCoeff(), 1e-9);
+}
+
+TEST(GPGradient, ExactMatchesFiniteDifferences) {
+  Eigen::MatrixXd X, Y;
+  make_data(35, 2, 2, 5, X, Y);
+  for (KernelType t : {KernelType::SquaredExponential, KernelType::Matern52}) {
+    GPOptions o = fixed_options(t);
+    o.mean = MeanType::Constant;
+    o.lengthscale = Eigen::Vector2d(0.7, 1.4);
+    ExactGP gp(o);
+    gp.fit(X, Y);
+    check_gradient(gp, gp.parameters(), 1e-5);
+  }
+}
+
+TEST(GPGradient, FitcMatchesFiniteDifferencesIncludingInducingInputs) {
+  Eigen::MatrixXd X, Y;
+  make_data(80, 3, 2, 6, X, Y);
+  for (KernelType t : {KernelType::SquaredExponential, KernelType::Matern52}) {
+    GPOptions o = fixed_options(t);
+    o.mean = MeanType::Constant;
+    o.lengthscale = Eigen::Vector3d(0.7, 1.4, 1.0);
+    o.n_inducing = 12;
+    o.optimize_inducing = true;
+    o.normalize_x = true;
+    SparseGP gp(o);
+    gp.fit(X, Y);
+    ASSERT_EQ(gp.parameters().size(), 3 + 2 + 2 + 12 * 3);
+    check_gradient(gp, gp.parameters(), 1e-5);
+  }
+}
+
+TEST(GPFit, OptimisationIncreasesLikelihoodAndRecoversNoise) {
+  Eigen::MatrixXd X, Y;
+  make_data(300, 2, 1, 7, X, Y, 0.1);
+  GPOptions o;
+  o.n_inducing = 40;
+  o.noise = 0.5;
+  SparseGP fixed([&] { GPOptions f = o; f.optimize = false; return f; }());
+  fixed.fit(X, Y);
+  SparseGP gp(o);
+  gp.fit(X, Y);
+  EXPECT_GT(gp.log_marginal_likelihood(), fixed.log_marginal_likelihood() + 10.0);
+  // noise sd 0.1 in raw units: noise variance in standardised units times y_scale^2
+  const double noise_raw = gp.noise() * gp.y_scale()[0] * gp.y_scale()[0];
+  EXPECT_NEAR(std::sqrt(noise_raw), 0.1, 0.03);
+  EXPECT_GT(gp.fit_info().evaluations, 1);
+  ExactGP ex(o);
+  ex.fit(X, Y);
+  EXPECT_NEAR(std::sqrt(ex.noise()) * ex.y_scale()[0], 0.1, 0.03);
+  // the exact fit is at least as good as FITC's on the same data
+  EXPECT_GE(ex.log_marginal_likelihood(), gp.log_marginal_likelihood() - 1.0);
+}
+
+TEST(GPSeeds, SameSeedSameResult) {
+  Eigen::MatrixXd X, Y;
+  make_data(200, 2, 1, 8, X, Y);
+  GPOptions o;
+  o.n_inducing = 20;
+  o.seed = 42;
+  SparseGP a(o), b(o);
+  a.fit(X, Y);
+  b.fit(X, Y);
+  EXPECT_EQ(a.inducing_inputs(), b.inducing_inputs());
+  EXPECT_EQ(a.log_marginal_likelihood(), b.log_marginal_likelihood());
+  std::mt19937_64 r1(3), r2(3);
+  const auto s1 = a.sample(X.topRows(10), 4, r1), s2 = b.sample(X.topRows(10), 4, r2);
+  for (int k = 0; k < 4; ++k) EXPECT_EQ(s1[k], s2[k]);
+  o.seed = 43;
+  SparseGP c(o);
+  c.fit(X, Y);
+  EXPECT_NE(a.inducing_inputs(), c.inducing_inputs());
+}
+
+TEST(GPSample, MarginalAndJointMomentsMatchPrediction) {
+  Eigen::MatrixXd X, Y;
+  make_data(60, 1, 1, 9, X, Y);
+  ExactGP gp(fixed_options());
+  gp.fit(X, Y);
+  Eigen::MatrixXd Xs(3, 1);
+  Xs << -1.0, 0.3, 5.0;
+  Eigen::MatrixXd m, v;
+  gp.predict(Xs, m, v, true);
+  std::mt19937_64 rng(1);
+  const int S = 20000;
+  for (bool joint : {false, true}) {
+    const auto s = joint ? gp.sample_joint(Xs, S, rng) : gp.sample(Xs, S, rng);
+    for (int i = 0; i < 3; ++i) {
+      double mu = 0, m2 = 0;
+      for (int k = 0; k < S; ++k) mu += s[k](i, 0);
+      mu /= S;
+      for (int k = 0; k < S; ++k) m2 += std::pow(s[k](i, 0) - mu, 2);
+      m2 /= S;
+      EXPECT_NEAR(mu, m(i, 0), 5 * std::sqrt(v(i, 0) / S));
+      EXPECT_NEAR(m2, v(i, 0), 0.05 * v(i, 0));
+    }
+  }
+}
+
+TEST(GPMultiOutput, SharedHyperparametersEqualSeparateFitsAndIndependentModelsWork) {
+  Eigen::MatrixXd X, Y;
+  make_data(50, 2, 3, 10, X, Y);
+  GPOptions o = fixed_options();
+  o.n_inducing = 15;
+  SparseGP all(o);
+  all.fit(X, Y);
+  Eigen::MatrixXd Xs, Ys;
+  make_data(9, 2, 3, 11, Xs, Ys);
+  const Eigen::MatrixXd m = all.predict_mean(Xs);
+  double lml = 0;
+  Eigen::VectorXd lp = Eigen::VectorXd::Zero(9);
+  for (int p = 0; p < 3; ++p) {
+    GPOptions op = o;
+    op.inducing = all.inducing_inputs();
+    SparseGP one(op);
+    one.fit(X, Y.col(p));
+    EXPECT_LT((one.predict_mean(Xs).col(0) - m.col(p)).cwiseAbs().maxCoeff(), 1e-9);
+    lml += one.log_marginal_likelihood();
+    lp += one.log_predictive_density(Xs, Ys.col(p));
+  }
+  EXPECT_NEAR(all.log_marginal_likelihood(), lml, 1e-8);
+  EXPECT_LT((all.log_predictive_density(Xs, Ys) - lp).cwiseAbs().maxCoeff(), 1e-9);
+  GPOptions oi;
+  oi.max_iter = 30;
+  IndependentOutputsGP ind(oi, [oi] { return std::make_unique<ExactGP>(oi); });
+  ind.fit(X, Y);
+  ASSERT_EQ(ind.n_models(), 3);
+  const Eigen::MatrixXd mi = ind.predict_mean(Xs);
+  for (int p = 0; p < 3; ++p)
+    EXPECT_LT((mi.col(p) - ind.model(p).predict_mean(Xs).col(0)).cwiseAbs().maxCoeff(), 1e-12);
+  EXPECT_NE(ind.model(0).kernel().log_lengthscale, ind.model(2).kernel().log_lengthscale);
+}
+
+TEST(GPRobustness, DuplicatesZeroNoiseAndExtremeScales) {
+  Eigen::MatrixXd X, Y;
+  make_data(30, 2, 1, 12, X, Y);
+  Eigen::MatrixXd Xd(60, 2), Yd(60, 1);
+  Xd << X, X;
+  Yd << Y, Y;
+  GPOptions o = fixed_options();
+  o.noise = 0.0;
+  ExactGP ex(o);
+  ex.fit(Xd, Yd);  // singular without jitter
+  EXPECT_GT(ex.fit_info().jitter_used, 0.0);
+  EXPECT_TRUE(ex.predict_mean(X).allFinite());
+  EXPECT_LT((ex.predict_mean(X) - Y).cwiseAbs().maxCoeff(), 1e-3);  // interpolates
+  EXPECT_TRUE(std::isfinite(ex.log_marginal_likelihood()));
+  SparseGP sp(o);
+  sp.fit(Xd, Yd);
+  EXPECT_LE(sp.n_inducing(), 30);  // k-means++ finds only the distinct inputs
+  EXPECT_TRUE(sp.predict_mean(X).allFinite());
+  EXPECT_TRUE(sp.log_predictive_density(X, Y).allFinite());
+  // Tiny and huge scales: with normalisation the fit is scale-equivariant.
+  GPOptions on;
+  on.n_inducing = 20;
+  SparseGP base(on), tiny(on), huge(on);
+  base.fit(X, Y);
+  tiny.fit(X * 1e-6, Y * 1e-8);
+  huge.fit(X * 1e6 + Eigen::MatrixXd::Constant(30, 2, 1e9), Y * 1e8);
+  const Eigen::MatrixXd mb = base.predict_mean(X);
+  EXPECT_LT((tiny.predict_mean(X * 1e-6) * 1e8 - mb).cwiseAbs().maxCoeff(), 1e-5);
+  EXPECT_LT((huge.predict_mean(X * 1e6 + Eigen::MatrixXd::Constant(30, 2, 1e9)) * 1e-8 - mb).cwiseAbs().maxCoeff(),
+            1e-4);
+  // Constant outputs: no NaN.
+  SparseGP flat(on);
+  flat.fit(X, Eigen::MatrixXd::Constant(30, 1, 2.5));
+  EXPECT_LT((flat.predict_mean(X).array() - 2.5).abs().maxCoeff(), 1e-6);
+}
+
+TEST(GPErrors, BadInputIsRejected) {
+  Eigen::MatrixXd X, Y;
+  make_data(20, 2, 1, 13, X, Y);
+  GPOptions o;
+  o.lengthscale = Eigen::VectorXd::Constant(1, -1.0);
+  EXPECT_THROW(ExactGP{o}, std::invalid_argument);
+  o = GPOptions{};
+  o.noise = -1;
+  EXPECT_THROW(SparseGP{o}, std::invalid_argument);
+  ExactGP gp{GPOptions{}};
+  EXPECT_THROW(gp.predict_mean(X), std::logic_error);
+  EXPECT_THROW(gp.fit(X, Y.topRows(10)), std::invalid_argument);
+  Eigen::MatrixXd Xn = X;
+  Xn(3, 1) = NAN;
+  EXPECT_THROW(gp.fit(Xn, Y), std::invalid_argument);
+  gp.fit(X, Y);
+  EXPECT_THROW(gp.predict_mean(Eigen::MatrixXd::Zero(3, 3)), std::invalid_argument);
+  EXPECT_THROW(gp.log_predictive_density(X, Eigen::MatrixXd::Zero(20, 2)), std::invalid_argument);
+}

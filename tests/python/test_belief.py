@@ -1,0 +1,144 @@
+"""Python-level tests of bayesgrasp.belief: callables called once per batch, the all-zero
+likelihood warning, KDE entropy against scipy's gaussian_kde, expected posterior entropy, the GP
+measurement model paths, the relative pose, bad input."""
+import warnings
+
+import numpy as np
+import pytest
+from scipy.stats import gaussian_kde
+
+from bayesgrasp import belief
+from bayesgrasp.belief import AllZeroLikelihoodWarning, ParticleBelief
+
+LOW, HIGH, WRAPS = belief.planar_pose_bounds((-0.1, 0.1), (-0.1, 0.1))
+
+
+def test_uniform_weights_entropy_and_ess():
+    b = ParticleBelief.uniform(LOW, HIGH, 500, WRAPS, seed=0)
+    assert b.weight_entropy() == pytest.approx(np.log(500))
+    assert b.ess() == pytest.approx(500)
+    P = b.particles
+    assert P.shape == (500, 3) and np.all(P >= LOW) and np.all(P[:, :2] <= HIGH[:2]) and np.all(P[:, 2] < np.pi)
+
+
+def test_update_calls_once_and_matches_bayes():
+    b = ParticleBelief(np.array([[0.0, 0, 0], [0.05, 0, 0], [0.1, 0, 0]]), LOW, HIGH, WRAPS)
+    calls = []
+
+    def ll(P):
+        calls.append(P.shape)
+        return -0.5 * ((P[:, 0] - 0.05) / 0.05) ** 2
+
+    assert b.update(ll) is False
+    assert calls == [(3, 3)]
+    e = np.exp(-0.5)
+    np.testing.assert_allclose(b.weights, np.array([e, 1, e]) / (1 + 2 * e))
+    assert b.ess() == pytest.approx(1 / np.sum((np.array([e, 1, e]) / (1 + 2 * e)) ** 2))
+
+
+def test_all_zero_likelihood_warns_and_resets():
+    b = ParticleBelief.uniform(LOW, HIGH, 20, WRAPS, seed=1)
+    b.reweight(np.linspace(-2, 2, 20))
+    with pytest.warns(AllZeroLikelihoodWarning):
+        assert b.reweight(np.full(20, -np.inf)) is True
+    np.testing.assert_allclose(b.weights, np.full(20, 1 / 20))
+    with pytest.warns(AllZeroLikelihoodWarning):
+        b.update(lambda P: np.full(len(P), -np.inf))
+    assert np.all(np.isfinite(b.log_weights))
+
+
+def test_metropolis_calls_once_per_sweep_and_is_seeded():
+    def run(seed):
+        b = ParticleBelief.uniform(LOW, HIGH, 300, WRAPS, seed=seed)
+        calls = []
+
+        def target(P):
+            calls.append(len(P))
+            return -0.5 * ((P[:, 0] - 0.02) / 0.01) ** 2
+
+        st = b.metropolis(target, [0.01, 0.01, 0.1], n_steps=5)
+        assert calls == [300] * 6 and st["evaluations"] == 1800
+        b.resample("stratified")
+        b.roughen(0.2)
+        return b.particles
+
+    np.testing.assert_array_equal(run(4), run(4))
+    assert not np.array_equal(run(4), run(5))
+
+
+def test_kde_entropy_matches_scipy_gaussian_kde():
+    # Independent implementation: scipy's weighted gaussian_kde, entropy by resubstitution.
+    rng = np.random.default_rng(0)
+    X = rng.normal(size=(300, 2)) * [0.02, 0.05]
+    w = rng.uniform(0.2, 1.0, size=300)
+    w /= w.sum()
+    for bw in ("scott", "silverman"):
+        kde = gaussian_kde(X.T, bw_method=bw, weights=w)
+        expect = -np.sum(w * np.log(kde(X.T)))
+        got = belief.kde_entropy(X, np.log(w), [-1, -1], [1, 1], bandwidth=bw)
+        assert got == pytest.approx(expect, rel=1e-9)
+
+
+def test_expected_posterior_entropy_uninformative_vs_informative():
+    n = 100
+    lw = np.zeros(n)
+    const = np.full((n, 2), 0.3)
+    h, se = belief.expected_posterior_entropy(lw, const, np.full((n, 2), 0.01), n_samples=50, seed=0)
+    assert h == pytest.approx(np.log(n)) and se == pytest.approx(0, abs=1e-12)
+    informative = np.arange(n, dtype=float)[:, None] / n
+    H, SE = belief.expected_posterior_entropy(lw, np.stack([np.repeat(0.3, n)[:, None], informative]),
+                                              np.full((2, n, 1), 1e-4), n_samples=100, seed=0)
+    assert H.shape == (2,) and SE.shape == (2,)
+    assert H[0] == pytest.approx(np.log(n))
+    assert H[1] < np.log(n) - 2.0  # sigma = 0.01 = the spacing: a few particles remain plausible
+
+
+def test_relative_planar_pose_by_hand():
+    R = belief.relative_planar_pose([[1.0, 0.0, np.pi / 2]], [[0.0, 0.0, np.pi / 2], [1.0, 1.0, 0.0]])
+    np.testing.assert_allclose(R, [[0, -1, 0], [0, -1, np.pi / 2]], atol=1e-12)
+
+
+def _identity_gp():
+    from bayesgrasp.gp import ExactGP
+    rng = np.random.default_rng(0)
+    X = np.column_stack([rng.uniform(-0.3, 0.3, 200), rng.uniform(-0.3, 0.3, 200), rng.uniform(-1, 1, 200)])
+    return ExactGP(lengthscale=[0.5, 0.5, 1.0], noise=1e-4, optimize=False).fit(X, X.copy())
+
+
+def test_gp_update_paths_agree_and_entropy_gp_matches_manual():
+    gp = _identity_gp()
+    a = ParticleBelief.gaussian(LOW, HIGH, [0, 0, 0.2], [0.05, 0.05, 0.15], 300, WRAPS, seed=2)
+    b = ParticleBelief(a.particles, LOW, HIGH, WRAPS)
+    action, meas = np.array([0.0, 0.0, 0.5]), np.array([-0.03, 0.04, 0.25])
+    a.update_gp(gp, action, meas)                                  # one C++ call
+    b.update(belief.gp_log_likelihood(gp, action, meas))           # Python callable path
+    np.testing.assert_allclose(a.log_weights, b.log_weights, atol=1e-8)
+    actions = np.array([[0.0, 0.0, 0.0], [0.05, 0.02, 0.4]])
+    h, se = belief.expected_posterior_entropy_gp(gp, a, actions, n_samples=30, seed=1)
+    X = belief.relative_planar_pose(actions, a.particles)
+    mv = [gp.models_[0].predict(X, True)]
+    mean, var = mv[0][0].reshape(2, len(a), 3), mv[0][1].reshape(2, len(a), 3)
+    h2, _ = belief.expected_posterior_entropy(a.log_weights, mean, var, n_samples=30, seed=1)
+    np.testing.assert_allclose(h, h2, atol=1e-9)
+
+
+@pytest.mark.parametrize("call, match", [
+    (lambda: ParticleBelief(np.zeros((0, 3)), LOW, HIGH, WRAPS), "zero particles"),
+    (lambda: ParticleBelief(np.zeros((2, 3)), HIGH, LOW, WRAPS), "low > high"),
+    (lambda: ParticleBelief(np.full((2, 3), np.nan), LOW, HIGH, WRAPS), "NaN"),
+    (lambda: ParticleBelief(np.full((2, 3), 0.5), LOW, HIGH, WRAPS), "outside"),
+    (lambda: ParticleBelief(np.zeros((2, 3)), LOW, HIGH, WRAPS, log_weights=[-np.inf, -np.inf]), "all weights are zero"),
+    (lambda: ParticleBelief(np.zeros((2, 3)), LOW, HIGH, [True]), "wraps"),
+    (lambda: ParticleBelief(np.zeros((2, 3)), LOW, HIGH, WRAPS).reweight([0.0, np.nan]), "NaN"),
+    (lambda: ParticleBelief(np.zeros((2, 3)), LOW, HIGH, WRAPS).update(lambda P: np.zeros(3)), "shape"),
+    (lambda: ParticleBelief(np.zeros((2, 3)), LOW, HIGH, WRAPS).update(lambda P: np.full(2, np.nan)), "NaN"),
+    (lambda: ParticleBelief(np.zeros((2, 3)), LOW, HIGH, WRAPS).resample("residual"), "scheme"),
+    (lambda: ParticleBelief.uniform(LOW, HIGH, 0, WRAPS), "zero particles"),
+    (lambda: belief.weight_entropy(np.array([])), "zero particles"),
+    (lambda: belief.expected_posterior_entropy([0.0, 0.0], np.zeros((2, 1)), np.zeros((2, 1))), "var"),
+    (lambda: belief.expected_posterior_entropy([0.0, 0.0], np.zeros((3, 1)), np.ones((3, 1))), "mean"),
+    (lambda: belief.resample_indices([0.0, 0.0], 3), "zero"),
+])
+def test_bad_input(call, match):
+    with pytest.raises(ValueError, match=match):
+        call()

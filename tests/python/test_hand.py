@@ -1,0 +1,85 @@
+"""Hand models from data files: structure and kinematics against the published BH8 lengths."""
+import json
+
+import numpy as np
+import pytest
+
+from bayesgrasp.hand import HANDS_DIR, Hand, builtin_hands
+
+DEG = np.pi / 180
+
+
+def test_builtin_hands_listed_and_loaded():
+    assert {"barrett_bh8", "robotiq_3f"} <= set(builtin_hands())
+    h = Hand.load()
+    assert h.num_joints == 7 and h.num_links == 9 and h.num_fingers == 3
+    assert h.joint_names[0] == "spread"
+    assert h.links[0] == "palm"
+    np.testing.assert_allclose(h.spread_limits, (0.0, np.pi))
+    # by path too
+    assert Hand.load(HANDS_DIR / "barrett_bh8.json").num_joints == 7
+
+
+def test_barrett_fingertips_from_published_lengths():
+    h = Hand.load("barrett_bh8")
+    q = h.open_joints(spread=0.0)
+    np.testing.assert_allclose(q[[1, 2]], [0.0, 42 * DEG])
+    tips = h.fingertips(q)
+    # finger 3: joint 50 mm along -y, proximal 70 mm flat, distal 55 mm at 42 deg towards +z
+    np.testing.assert_allclose(tips[2], [0.0, -(0.05 + 0.07 + 0.055 * np.cos(42 * DEG)), 0.055 * np.sin(42 * DEG)],
+                               atol=1e-12)
+    # spread 90, proximal 90: fingers 1 and 2 point along the approach axis, distal at 30 + 42
+    q = h.coupled_joints(np.pi / 2, np.pi / 2)
+    np.testing.assert_allclose(q[2], 72 * DEG)
+    tips = h.fingertips(q)
+    a = (90 + 72) * DEG
+    np.testing.assert_allclose(tips[0], [0.075 + 0.055 * np.cos(a), 0.0, 0.07 + 0.055 * np.sin(a)], atol=1e-12)
+    np.testing.assert_allclose(tips[1][0], -tips[0][0], atol=1e-12)
+
+
+def test_link_geometry_in_world_frame():
+    h = Hand.load()
+    T = Hand.top_grasp_pose(0.1, 0.2, 0.0, 0.3)  # palm down, palm face at z = 0.3
+    q = h.open_joints(0.0)
+    parts = h.link_geometry(q, T)
+    names = {p["name"] for p in parts}
+    assert "finger3/distal" in names and "palm" in names
+    palm = next(p for p in parts if p["name"] == "palm")
+    # palm box centre 30 mm behind the palm face: above it in the world
+    np.testing.assert_allclose(palm["center"], [0.1, 0.2, 0.33], atol=1e-12)
+    prox3 = next(p for p in parts if p["name"] == "finger3/proximal")
+    # finger 3 (hand -y) lies along world +y after the flip about x; the capsule spans 70 mm
+    np.testing.assert_allclose(prox3["p0"], [0.1, 0.2 + 0.05, 0.3], atol=1e-12)
+    np.testing.assert_allclose(prox3["p1"], [0.1, 0.2 + 0.12, 0.3], atol=1e-12)
+    assert prox3["radius"] == pytest.approx(0.0125)
+    poses = h.link_poses(q, T)
+    assert poses.shape == (9, 4, 4)
+    np.testing.assert_allclose(poses[0], T)
+
+
+def test_robotiq_file_loads():
+    h = Hand.load("robotiq_3f")
+    assert h.num_fingers == 3 and h.num_joints == 10 and h.num_links == 10
+    assert "approximate" in h.name.lower()
+    lo, hi = h.spread_limits
+    assert lo < 0 < hi
+
+
+def test_bad_hand_input():
+    with pytest.raises(ValueError, match="name_or_path"):
+        Hand.load("no_such_hand")
+    with pytest.raises(ValueError, match="not valid JSON"):
+        Hand.from_json("{not json")
+    bad = json.loads((HANDS_DIR / "barrett_bh8.json").read_text())
+    del bad["fingers"][0]["phalanges"][0]["length"]
+    with pytest.raises(ValueError, match="length"):
+        Hand.from_json(json.dumps(bad))
+    h = Hand.load()
+    with pytest.raises(ValueError, match="q"):
+        h.link_poses(np.zeros(3))
+    with pytest.raises(ValueError, match="q"):
+        h.link_poses(np.full(7, np.nan))
+    with pytest.raises(ValueError, match="hand_pose"):
+        h.link_poses(h.open_joints(), np.eye(3))
+    with pytest.raises(ValueError, match="spread"):
+        h.coupled_joints(4.0)
