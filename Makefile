@@ -66,7 +66,7 @@ $(BENCH_VENV)/.base: build/.deps-ok
 	@touch $@
 
 bench: $(VENV)/.installed $(BENCH_VENV)/.base
-	BENCH_PY=$(BENCH_VENV)/bin/python BAYESGRASP_PY=$(PY) BUILD_DIR=build/py bash bench/run_all.sh
+	BENCH_PY=$(BENCH_VENV)/bin/python BAYESGRASP_PY=$(PY) BUILD_DIR=build/py bash bench/bench_all.sh
 
 clean:
 	rm -rf build/py out

@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # Belief benchmarks: C++ throughput (update cycle, expected posterior entropy, KDE entropy,
 # relative poses) with Google Benchmark, then the Python API against a vectorised numpy
-# implementation of the same algorithms. Env (set by bench/run_all.sh): BUILD_DIR, BAYESGRASP_PY.
+# implementation of the same algorithms. Env (set by bench/bench_all.sh): BUILD_DIR, BAYESGRASP_PY.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 BUILD_DIR=${BUILD_DIR:-build/py}

@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # Optimiser benchmarks: C++ overhead per evaluation (Google Benchmark) and PSO against pyswarms
 # on the same budget (ours with BAYESGRASP_PY, pyswarms with BENCH_PY, in this same run).
-# Env (set by bench/run_all.sh): BUILD_DIR, BAYESGRASP_PY, BENCH_PY.
+# Env (set by bench/bench_all.sh): BUILD_DIR, BAYESGRASP_PY, BENCH_PY.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 BUILD_DIR=${BUILD_DIR:-build/py}

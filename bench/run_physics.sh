@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # Lift-test benchmark (issue 2, sections 6 and 10): lift tests per second on one core
 # (bench_physics: a held box, an open hand, a held concave cup with the tetrahedra shape).
-# No peer is run here. Env (set by bench/run_all.sh): BUILD_DIR.
+# No peer is run here. Env (set by bench/bench_all.sh): BUILD_DIR.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 BUILD_DIR=${BUILD_DIR:-build/py}

@@ -7,7 +7,7 @@
 #     (scipy's bundled Qhull, options "Qt"; epsilon = min facet offset, volume = hull volume;
 #     BENCH_PY) - what a user would write otherwise. Wrenches are generated once by ours and
 #     saved to bench/results/quality_wrenches.npz, so both sides hull identical points.
-# Env (set by bench/run_all.sh): BUILD_DIR, BAYESGRASP_PY, BENCH_PY.
+# Env (set by bench/bench_all.sh): BUILD_DIR, BAYESGRASP_PY, BENCH_PY.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 BUILD_DIR=${BUILD_DIR:-build/py}

@@ -14,7 +14,6 @@ import time
 
 import numpy as np
 
-sys.path.insert(0, os.path.join(os.path.dirname(__file__), "..", "python"))
 from bayesgrasp.objects import load_object  # noqa: E402
 from bayesgrasp.vision import Camera, model_samples, segment_table  # noqa: E402
 

@@ -9,7 +9,6 @@ import time
 
 import numpy as np
 
-sys.path.insert(0, os.path.join(os.path.dirname(__file__), "..", "python"))
 sys.path.insert(0, os.path.dirname(__file__))
 from bayesgrasp import _core  # noqa: E402
 from vision_common import errors, load_views, summarise  # noqa: E402

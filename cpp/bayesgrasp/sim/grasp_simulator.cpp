@@ -630,6 +630,30 @@ struct GraspSimulator::Impl {
   }
 
   // ---- top grasps ----
+  double sweep = 0.0;  // sweep_depth(), computed once
+  /// Deepest point below the palm face reached by any link shape along the coupled closing
+  /// path (t from 0 to the largest t_max, every 0.5 deg).
+  double sweep_depth(double spread) const {
+    double t_end = 0.0;
+    for (const Finger& f : hand.fingers()) t_end = std::max(t_end, f.t_max());
+    const int L = hand.num_links();
+    const double step = 0.5 * M_PI / 180.0;
+    double depth = 0.0;
+    for (double t = 0.0; t <= t_end + 0.5 * step; t += step) {
+      const std::vector<Iso3> local = hand.link_poses(Iso3::Identity(), hand.coupled_joints(spread, t));
+      for (int l = 0; l < L; ++l)
+        for (const ShapeG& sh : links[l]) {
+          if (sh.capsule) {
+            depth = std::max(depth, std::max((local[l] * sh.p0).z(), (local[l] * sh.p1).z()) + sh.r);
+          } else {
+            const Vec3 c = local[l] * sh.c;
+            depth = std::max(depth, c.z() + (local[l].linear().row(2).cwiseAbs() * sh.h)(0));
+          }
+        }
+    }
+    return depth;
+  }
+
   GraspResult top_grasp(double x, double y, double yaw, double spread, double standoff) const {
     const double tol = opt.contact_tolerance;
     const Eigen::VectorXd q0 = hand.coupled_joints(spread, 0.0);
@@ -674,11 +698,14 @@ struct GraspSimulator::Impl {
         z = z_floor;
       }
     }
-    // The descent's last distances hold at the start pose when standoff is 0; after raising
-    // the hand every link is evaluated again. The hand is free either way (the swept volume
+    // Keep the closing fingers' sweep above the table (see the header).
+    double raise = standoff;
+    if (opt.table && opt.table_clearance >= 0.0) raise = std::max(raise, sweep + opt.table_clearance - z);
+    // The descent's last distances hold at the start pose when the hand is not raised; after
+    // raising it every link is evaluated again. The hand is free either way (the swept volume
     // of the descent was free).
-    if (standoff > 0.0) {
-      z += standoff;
+    if (raise > 0.0) {
+      z += raise;
       H = HandModel::top_grasp_pose(x, y, yaw, z);
       for (LinkCache& c : cache) c.fresh = false, c.guess = 0.0;
     }
@@ -787,6 +814,8 @@ GraspSimulator::GraspSimulator(const HandModel& hand, const TriMesh& object, con
       m.links[l].push_back(g);
     }
   }
+  // The sweep's depth does not depend on the spread (a rotation about the palm normal).
+  m.sweep = m.sweep_depth(hand.spread_default());
   m.bound.resize(hand.fingers().size());
   m.finger_reach.resize(hand.fingers().size());
   for (size_t f = 0; f < hand.fingers().size(); ++f) {

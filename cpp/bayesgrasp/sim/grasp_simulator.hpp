@@ -23,7 +23,11 @@
 //
 // Top grasps: the hand, palm down (HandModel::top_grasp_pose), starts above the object and
 // descends along -z by conservative advancement (speed bound 1) until any link is within the
-// tolerance of the object or the table; it is then raised by `standoff` and closed.
+// tolerance of the object or the table; it is then raised by `standoff` and closed. With a
+// table, the palm is kept at least `table_clearance` above the deepest point the closing
+// fingers sweep (the coupled closing path, sampled every 0.5 deg): on an object lower than
+// the fingers are long, the fingers then wrap it near its base instead of striking the table
+// (a hand descending to the object's top would otherwise only ever grasp the table).
 //
 // Thread safety: all queries are const and keep their state on the stack, so one simulator
 // can serve many threads (FCL's BVH model is only read by distance queries).
@@ -58,6 +62,9 @@ struct SimOptions {
   enum class LinkGeometry { Segments, Primitives, Meshes };
   LinkGeometry links = LinkGeometry::Segments;
   int max_iterations = 5000;  // per finger and per descent (a safety net; never hit in practice)
+  /// Top grasps with a table: minimum height of the fingers' closing sweep above the table (m);
+  /// negative disables the rule (the hand then stops at the first contact).
+  double table_clearance = 0.005;
 };
 
 struct GraspResult {
