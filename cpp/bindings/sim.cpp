@@ -142,22 +142,25 @@ close from the open preshape by conservative advancement with FCL distance queri
 phalanx stops within contact_tolerance of the object or the table, with breakaway (a stopped
 phalanx freezes itself and the earlier ones; the later ones keep closing). Thread-safe.)doc")
       .def(py::init([](const HandModel& hand, const DArray& vertices, const IArray& faces, bool table,
-                       double contact_tolerance) {
+                       double contact_tolerance, double table_clearance) {
              const TriMesh mesh = bind::mesh(vertices, faces, "object");
              SimOptions o;
              o.table = table;
+             o.table_clearance = finite(table_clearance, "table_clearance");
              o.contact_tolerance = positive(contact_tolerance, "contact_tolerance");
              o.box_skip = std::max(o.box_skip, 2.5 * o.contact_tolerance);
              return GraspSimulator(hand, mesh, o);
            }),
            py::arg("hand"), py::arg("vertices"), py::arg("faces"), py::arg("table") = true,
-           py::arg("contact_tolerance") = 2e-4,
+           py::arg("contact_tolerance") = 2e-4, py::arg("table_clearance") = SimOptions{}.table_clearance,
            R"doc(Args:
     hand: a bayesgrasp._core.hand.Hand.
     vertices: (N, 3) float object vertices (m, world frame).
     faces: (M, 3) int triangles, counter-clockwise seen from outside.
     table: add the table plane z = 0.
-    contact_tolerance: a link touches when closer than this (m, default 0.2 mm).)doc")
+    contact_tolerance: a link touches when closer than this (m, default 0.2 mm).
+    table_clearance: top grasps keep the fingers' closing sweep at least this far above the
+        table (m, default 5 mm); negative: stop at the first contact instead.)doc")
       .def_property_readonly("num_links", [](const GraspSimulator& s) { return s.hand().num_links(); })
       .def_property_readonly("num_joints", [](const GraspSimulator& s) { return s.hand().num_joints(); })
       .def(

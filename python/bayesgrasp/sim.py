@@ -76,7 +76,8 @@ def _hand(hand) -> _core.hand.Hand:
 class GraspSimulator:
     """Auto-grasp of a hand on one static triangle-mesh object (world frame, z up)."""
 
-    def __init__(self, hand, vertices, faces, table: bool = True, contact_tolerance: float = 2e-4):
+    def __init__(self, hand, vertices, faces, table: bool = True, contact_tolerance: float = 2e-4,
+                 table_clearance: float = 0.005):
         self.hand = hand if isinstance(hand, Hand) else Hand(_hand(hand))
         try:
             V = np.asarray(vertices, dtype=float)
@@ -87,7 +88,8 @@ class GraspSimulator:
             if F.size and not np.all(np.equal(np.mod(F, 1), 0)):
                 raise ValueError("faces: must be integer vertex indices")
         self.vertices, self.faces = V, F.astype(np.int32)
-        self.core = _core.sim.GraspSimulator(self.hand.core, V, self.faces, bool(table), float(contact_tolerance))
+        self.core = _core.sim.GraspSimulator(self.hand.core, V, self.faces, bool(table), float(contact_tolerance),
+                                             float(table_clearance))
 
     @classmethod
     def from_mesh(cls, hand, mesh, **kwargs) -> "GraspSimulator":
