@@ -1,0 +1,57 @@
+import numpy as np
+import pytest
+
+from bayesgrasp.models import ModelSettings, build_models, relative_top_grasps
+from bayesgrasp.models.grasp_models import simulate_training_data
+from bayesgrasp.world import World
+
+SMALL = ModelSettings(n_samples=400, n_inducing=60, xy_range=0.03, max_iter=40, seed=3)
+
+
+def test_relative_top_grasps_by_hand():
+    # object at (0.1, 0, 90 deg): a world grasp at (0.1, 0.02, 90 deg) is 2 cm along the object's -x
+    rel = relative_top_grasps([[0.1, 0.02, np.pi / 2]], [[0.1, 0.0, np.pi / 2]])
+    np.testing.assert_allclose(rel[0, 0], [0.02, 0.0, 0.0], atol=1e-12)
+    rel = relative_top_grasps([[0.0, 0.0, -3.0]], [[0.0, 0.0, 3.0]])
+    assert -np.pi <= rel[0, 0, 2] < np.pi and rel[0, 0, 2] == pytest.approx(-6.0 + 2 * np.pi)
+
+
+def test_models_predict_held_out_simulations_and_are_cached(tmp_path):
+    msgs = []
+    models = build_models("cylinder", settings=SMALL, cache_dir=tmp_path, progress=msgs.append)
+    assert any("simulating" in m for m in msgs)
+    # held-out grasps simulated independently
+    held = ModelSettings(n_samples=120, n_inducing=60, xy_range=0.03, seed=99)
+    rel, q, eps = simulate_training_data(World.single("cylinder"), held)
+    mean, var = models.predict_measurement(rel)
+    err = np.abs(mean - q[:, models.joint_index])
+    # the GP explains most of the joint-angle variation of unseen grasps
+    r2 = 1 - np.mean(err ** 2) / np.mean((q[:, models.joint_index] - q[:, models.joint_index].mean(0)) ** 2)
+    assert r2 > 0.5
+    # the true measurement is more likely at its own grasp than at a shifted one
+    ll_true = models.log_likelihood(rel[:20], q[0, models.joint_index])
+    assert ll_true[0] > np.median(ll_true)
+    p = models.stability_probability(rel)
+    assert np.all((p >= 0) & (p <= 1))
+    # stable grasps (by simulation) get a higher predicted stability on average
+    stable = eps > SMALL.eps_stable
+    if stable.any() and (~stable).any():
+        assert p[stable].mean() > p[~stable].mean()
+
+    msgs.clear()
+    again = build_models("cylinder", settings=SMALL, cache_dir=tmp_path, progress=msgs.append)
+    assert any("cache" in m for m in msgs) and not any("simulating" in m for m in msgs)
+    np.testing.assert_allclose(again.predict_measurement(rel[:5])[0], mean[:5], atol=1e-10)
+    # other settings or another object: a new key, the models are rebuilt
+    msgs.clear()
+    build_models("cylinder", settings=ModelSettings(**{**SMALL.__dict__, "seed": 4}), cache_dir=tmp_path,
+                 progress=msgs.append)
+    assert any("simulating" in m for m in msgs)
+    assert len(list(tmp_path.glob("*.json"))) == 2
+
+
+def test_bad_settings():
+    with pytest.raises(ValueError, match="n_samples"):
+        ModelSettings(n_samples=2)
+    with pytest.raises(ValueError, match="xy_range"):
+        ModelSettings(xy_range=-1.0)
