@@ -7,7 +7,8 @@ yaw wraps. Two sparse (FITC) GPs are fitted on simulated grasps of the object wi
 * measurement model P(M|A,O): the hand's phalanx joint angles after closing (one output per
   phalanx joint, shared hyper-parameters), Gaussian with the GP's predictive variance plus noise;
 * stability model P(S|A,O): the GP regression of the grasp's epsilon quality (0 without force
-  closure), mapped to a probability with a probit, P(S) = Phi((mu - eps_stable) / sd).
+  closure), mapped to a probability with a probit of the latent epsilon,
+  P(S) = Phi((mu - eps_stable) / sd).
 
 Models are cached on disk under a key made of the object's mesh, the hand file and the settings;
 they are rebuilt only when one of those changes.
@@ -62,6 +63,12 @@ def relative_top_grasps(grasps, object_poses) -> np.ndarray:
     return np.stack([c * dx + s * dy, -s * dx + c * dy, yaw], axis=-1)
 
 
+def _mean_var(model: _gp.SparseGP, X: np.ndarray, include_noise: bool):
+    """Predictive mean and variance (N, P) in the outputs' units, with or without the noise."""
+    mv = [m.predict(np.ascontiguousarray(X), include_noise) for m in model.models_]
+    return np.concatenate([a for a, _ in mv], axis=1), np.concatenate([b for _, b in mv], axis=1)
+
+
 def features(rel) -> np.ndarray:
     """(..., 3) relative grasps -> (..., 4) GP inputs (x, y, cos yaw, sin yaw)."""
     rel = np.asarray(rel, dtype=float)
@@ -80,9 +87,7 @@ class GraspModels:
     def predict_measurement(self, rel):
         """Mean and variance (incl. noise) of the joint angles at relative grasps (..., 3)."""
         rel = np.asarray(rel, dtype=float)
-        X = features(rel).reshape(-1, 4)
-        mean, std = self.measurement.predict(X, return_std=True)
-        var = std ** 2 + self.measurement.noise_
+        mean, var = _mean_var(self.measurement, features(rel).reshape(-1, 4), include_noise=True)
         shape = rel.shape[:-1] + (len(self.joint_index),)
         return mean.reshape(shape), var.reshape(shape)
 
@@ -94,18 +99,20 @@ class GraspModels:
         Y = np.broadcast_to(m, (len(X), m.shape[-1]))
         return self.measurement.log_predictive_density(X, Y).reshape(rel.shape[:-1])
 
-    def stability_probability(self, rel) -> np.ndarray:
-        """P(S | A, O) at relative grasps (..., 3)."""
+    def _stability_z(self, rel) -> np.ndarray:
+        # The latent epsilon's predictive distribution (without the observation noise, which
+        # in epsilon is mostly the simulator's discontinuity, not uncertainty about the grasp).
         rel = np.asarray(rel, dtype=float)
-        mean, std = self.stability.predict(features(rel).reshape(-1, 4), return_std=True)
-        sd = np.sqrt(std ** 2 + self.stability.noise_)
-        return ndtr((mean - self.settings.eps_stable) / sd).reshape(rel.shape[:-1])
+        mean, var = _mean_var(self.stability, features(rel).reshape(-1, 4), include_noise=False)
+        z = (mean[:, 0] - self.settings.eps_stable) / np.sqrt(np.maximum(var[:, 0], 1e-12))
+        return z.reshape(rel.shape[:-1])
+
+    def stability_probability(self, rel) -> np.ndarray:
+        """P(S | A, O) at relative grasps (..., 3): Phi((mu - eps_stable) / sd) of the latent epsilon."""
+        return ndtr(self._stability_z(rel))
 
     def log_stability_probability(self, rel) -> np.ndarray:
-        rel = np.asarray(rel, dtype=float)
-        mean, std = self.stability.predict(features(rel).reshape(-1, 4), return_std=True)
-        sd = np.sqrt(std ** 2 + self.stability.noise_)
-        return log_ndtr((mean - self.settings.eps_stable) / sd).reshape(rel.shape[:-1])
+        return log_ndtr(self._stability_z(rel))
 
 
 def _cache_key(obj: ObjectModel, hand_text: str, settings: ModelSettings) -> str:
