@@ -33,10 +33,10 @@ build/.deps-ok: Makefile
 deps: build/.deps-ok
 
 # ---- Python virtual environment ----------------------------------------------------------
-$(VENV)/.base: build/.deps-ok
+$(VENV)/.base: build/.deps-ok Makefile
 	$(PYTHON) -m venv $(VENV)
 	$(PY) -m pip install -q --upgrade pip
-	$(PY) -m pip install -q "scikit-build-core>=0.10" "pybind11>=2.12" ninja numpy scipy matplotlib trimesh tqdm pytest scikit-learn
+	$(PY) -m pip install -q "scikit-build-core>=0.10" "pybind11>=2.12" ninja numpy scipy matplotlib trimesh manifold3d tqdm pytest scikit-learn
 	@touch $@
 
 # The package is built by scikit-build-core in build/py (kept between builds, so a second
