@@ -11,12 +11,9 @@ from .cli import CliError, _floats, _out_dir
 
 
 def _world(object_name: str, pose, hand: str = "barrett_bh8", keep_origin: bool = False, **kwargs):
-    from .objects import list_objects
     from .world import World
 
-    if not Path(object_name).exists() and object_name not in list_objects():
-        raise CliError(f"--object: {object_name!r} is neither a built-in object nor an existing file "
-                       f"(built-ins: {', '.join(list_objects())})")
+    # load_object names the problem (unknown name, missing file, not a mesh) in a ValueError
     return World.single(object_name, pose=pose, keep_origin=keep_origin, hand=hand, **kwargs)
 
 

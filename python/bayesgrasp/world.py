@@ -65,7 +65,7 @@ class World:
         self.sim = GraspSimulator(self.hand, V, F)
         mp = self.scene.object_mass_properties_world(self.object_index)
         self.com = np.asarray(mp["com"], dtype=float)
-        self.torque_scale = float(np.sqrt(((V - self.com) ** 2).sum(axis=1).max()))
+        self.torque_scale = self.object.max_radius_from_com  # rigid motion keeps it
         self._lift = None
 
     def set_object_pose(self, x: float, y: float, yaw: float) -> None:

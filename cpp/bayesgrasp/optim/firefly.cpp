@@ -67,12 +67,7 @@ Result firefly(const BatchObjective& fun, const Bounds& b, const FireflyOptions&
     alpha *= o.alpha_decay;
     if (o.record_history) r.history.push_back(bf);
   }
-  r.x = bx;
-  r.f = bf;
-  r.iterations = it;
-  r.evaluations = eval.evaluations();
-  r.converged = bf <= o.target;
-  r.message = r.converged ? "target reached" : "iteration budget used";
+  finish(r, bx, bf, it, eval.evaluations(), o.target);
   return r;
 }
 

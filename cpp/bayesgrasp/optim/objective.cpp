@@ -71,4 +71,14 @@ BatchObjective builtin_objective(const std::string& name) {
                               "' (expected sphere, rastrigin, ackley or rosenbrock)");
 }
 
+void finish(Result& r, const Eigen::VectorXd& best_x, double best_f, int iterations, long long evaluations,
+            double target) {
+  r.x = best_x;
+  r.f = best_f;
+  r.iterations = iterations;
+  r.evaluations = evaluations;
+  r.converged = best_f <= target;
+  r.message = r.converged ? "target reached" : "iteration budget used";
+}
+
 }  // namespace bayesgrasp::optim

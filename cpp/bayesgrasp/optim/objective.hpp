@@ -45,6 +45,11 @@ struct Result {
   std::string message;
 };
 
+/// Fills a global optimiser's result: best point and value, counts, and whether the value
+/// reached `target` (else the iteration budget was used).
+void finish(Result& r, const Eigen::VectorXd& best_x, double best_f, int iterations, long long evaluations,
+            double target);
+
 /// Evaluates, counting rows and mapping non-finite values to +inf.
 class Evaluator {
  public:
