@@ -367,3 +367,33 @@ TEST(Sim, RepresentationsAgree) {
   EXPECT_LT((a.joints - b.joints).cwiseAbs().maxCoeff(), 0.2 * kDeg);
   EXPECT_LT((a.joints - c.joints).cwiseAbs().maxCoeff(), 0.2 * kDeg);
 }
+
+// Query pruning skips FCL queries that cannot change the result: the same grasps as one query
+// per link and step, with fewer queries.
+TEST(Sim, QueryPruningKeepsTheResult) {
+  const HandModel hand = HandModel::from_file(kBarrett);
+  TriMesh scene = cylinder(0.035, 0.0, 0.11, 64, 0.005, -0.004);
+  const TriMesh knob = sphere(Vec3(0.03, 0.02, 0.11), 0.02, 32, 16);  // an off-centre bump
+  const int base = static_cast<int>(scene.V.rows());
+  scene.V.conservativeResize(base + knob.V.rows(), 3);
+  scene.V.bottomRows(knob.V.rows()) = knob.V;
+  const int nf = static_cast<int>(scene.F.rows());
+  scene.F.conservativeResize(nf + knob.F.rows(), 3);
+  scene.F.bottomRows(knob.F.rows()) = knob.F.array() + base;
+  SimOptions on, off;
+  off.prune_queries = false;
+  const GraspSimulator a(hand, scene, on), b(hand, scene, off);
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<double> U(-1, 1);
+  long qa = 0, qb = 0;
+  for (int i = 0; i < 40; ++i) {
+    const double x = 0.05 * U(rng), y = 0.05 * U(rng), yaw = M_PI * U(rng), spread = (0.5 + 0.5 * U(rng)) * M_PI / 2;
+    const GraspResult ga = a.top_grasp(x, y, yaw, spread), gb = b.top_grasp(x, y, yaw, spread);
+    EXPECT_LT((ga.joints - gb.joints).cwiseAbs().maxCoeff(), 1e-6) << "grasp " << i;
+    EXPECT_LT((ga.hand_pose.translation() - gb.hand_pose.translation()).norm(), 1e-9) << "grasp " << i;
+    EXPECT_EQ(ga.link_contact, gb.link_contact) << "grasp " << i;
+    EXPECT_EQ(ga.contacts.size(), gb.contacts.size()) << "grasp " << i;
+    qa += ga.distance_queries, qb += gb.distance_queries;
+  }
+  EXPECT_LT(qa, qb);
+}

@@ -11,6 +11,7 @@
 #include <fcl/math/bv/OBBRSS.h>
 #include <fcl/math/bv/RSS.h>
 #include <fcl/narrowphase/collision.h>
+#include <fcl/narrowphase/detail/primitive_shape_algorithm/triangle_distance.h>
 #include <fcl/narrowphase/distance.h>
 #include <limits>
 #include <stdexcept>
@@ -38,6 +39,16 @@ inline Mat3 link_rotation(const Vec3& d, double theta) {
   R.col(1) = a;
   R.col(2) = x.cross(a);
   return R;
+}
+
+/// Vertex and triangle arrays of an FCL triangle BVH (either bounding-volume type).
+struct MeshView {
+  const fcl::Vector3d* v = nullptr;
+  const fcl::Triangle* t = nullptr;
+};
+template <class BV>
+MeshView view_of(const fcl::BVHModel<BV>& m) {
+  return {m.vertices, m.tri_indices};
 }
 
 template <class BV>
@@ -104,6 +115,7 @@ void tessellate_box(const Vec3& h, std::vector<fcl::Vector3d>& v, std::vector<fc
 
 struct ShapeG {
   Geom geom;                      // for distance queries
+  MeshView mesh;                  // geom's triangles when it is a BVH (warm starts), else empty
   Iso3 local = Iso3::Identity();  // geom frame in link frame
   double offset = 0.0;            // subtracted from geom distances (segment = capsule axis)
   Geom prim;                      // FCL primitive (boolean collision tests)
@@ -119,6 +131,7 @@ struct GraspSimulator::Impl {
   TriMesh mesh;
   SimOptions opt;
   Geom object;
+  MeshView object_mesh;
   std::vector<Vec3> normals;
   Eigen::AlignedBox3d box;
   std::vector<std::vector<ShapeG>> links;  // per link
@@ -225,9 +238,18 @@ struct GraspSimulator::Impl {
   };
   /// FCL distance from one shape to the object; `offset` (the capsule radius of a segment
   /// shape) is subtracted, and the link-side nearest point moved onto the capsule's surface.
-  double shape_distance(const ShapeG& s, const Iso3& T, const fcl::DistanceRequestd& req, Exact* e) const {
+  /// With a finite `cap`, only distances below it are searched for; kInf if there are none.
+  /// FCL prunes every bounding-volume pair no nearer than its best distance so far, so starting
+  /// that best at cap (+ offset) prunes more without changing the order of the traversal: when
+  /// the distance is below cap, the same triangle pair and nearest points are found as without
+  /// the cap (pairs pruned in addition lie at cap or farther).
+  double shape_distance(const ShapeG& s, const Iso3& T, const fcl::DistanceRequestd& req, Exact* e,
+                        double cap = kInf) const {
     fcl::DistanceResultd res;
+    const bool capped = cap < kInf && cap + s.offset > 0.0;  // FCL stops at once on a best <= 0
+    if (capped) res.min_distance = cap + s.offset;
     fcl::distance(object.get(), fcl::Transform3d::Identity(), s.geom.get(), T * s.local, req, res);
+    if (capped && res.b1 == fcl::DistanceResultd::NONE) return kInf;  // nothing below cap
     const double d = res.min_distance - s.offset;
     if (e && d < e->d) {
       e->d = d;
@@ -241,16 +263,71 @@ struct GraspSimulator::Impl {
     }
     return d;
   }
-  /// Exact distance (FCL, nearest points) from the link to the object.
-  Exact exact_distance(int link, const Iso3& T, int& queries) const {
+  /// Exact distance (FCL, nearest points) from the link to the object; with a finite `cap`,
+  /// e.d = kInf (and e.tri = -1) when the distance is not below cap.
+  Exact exact_distance(int link, const Iso3& T, int& queries, double cap = kInf) const {
     Exact e;
     fcl::DistanceRequestd req(true);
     req.gjk_solver_type = kSolver;
     for (const ShapeG& s : links[link]) {
-      shape_distance(s, T, req, &e);
+      shape_distance(s, T, req, &e, cap);
       ++queries;
     }
     return e;
+  }
+  /// Warm start of a link's distance queries: the nearest triangle pair (object, link mesh)
+  /// of its last query, per shape.
+  static constexpr int kWarmShapes = 2;
+  struct Warm {
+    int tri[kWarmShapes][2] = {{-1, -1}, {-1, -1}};
+  };
+  /// Distance from the link to the object if below `cap`, else kInf (no nearest points).
+  /// With `warm`, each shape's search starts from the distance of its last nearest triangle
+  /// pair (computed as FCL computes it at a leaf): FCL then prunes from the start, and returns
+  /// a pair only if strictly nearer, so the distance is the same minimum over triangle pairs.
+  double distance_below(int link, const Iso3& T, double cap, int& queries, Warm* warm = nullptr) const {
+    fcl::DistanceRequestd req;
+    req.gjk_solver_type = kSolver;
+    double d = kInf;
+    for (size_t k = 0; k < links[link].size(); ++k) {
+      const ShapeG& s = links[link][k];
+      ++queries;
+      int* w = warm && k < kWarmShapes && s.mesh.t ? warm->tri[k] : nullptr;
+      if (!w || w[0] < 0) {
+        d = std::min(d, shape_distance_warm(s, T, req, cap, kInf, w));
+        continue;
+      }
+      // the link mesh's frame relative to the object's (identity), as FCL forms it
+      const fcl::Transform3d tf = fcl::Transform3d::Identity().inverse(Eigen::Isometry) * (T * s.local);
+      const fcl::Triangle& a = object_mesh.t[w[0]];
+      const fcl::Triangle& b = s.mesh.t[w[1]];
+      fcl::Vector3d P, Q;
+      const double start = fcl::detail::TriangleDistance<double>::triDistance(
+          object_mesh.v[a[0]], object_mesh.v[a[1]], object_mesh.v[a[2]], s.mesh.v[b[0]], s.mesh.v[b[1]],
+          s.mesh.v[b[2]], tf, P, Q);
+      d = std::min(d, shape_distance_warm(s, T, req, cap, start, w));
+    }
+    return d;
+  }
+  /// shape_distance from a known pair distance `start` (FCL's raw distance, kInf if none);
+  /// records the nearest pair in w.
+  double shape_distance_warm(const ShapeG& s, const Iso3& T, const fcl::DistanceRequestd& req, double cap,
+                             double start, int* w) const {
+    fcl::DistanceResultd res;
+    const double capped = cap < kInf && cap + s.offset > 0.0 ? cap + s.offset : kInf;
+    const double preset = std::min(capped, start);
+    if (preset < kInf && preset > 0.0) res.min_distance = preset;  // FCL stops at once on a best <= 0
+    else if (preset <= 0.0) return start - s.offset;  // touching pair known (only when start <= 0)
+    fcl::distance(object.get(), fcl::Transform3d::Identity(), s.geom.get(), T * s.local, req, res);
+    double raw;
+    if (res.b1 != fcl::DistanceResultd::NONE) {
+      raw = res.min_distance;
+      if (w) w[0] = static_cast<int>(res.b1), w[1] = static_cast<int>(res.b2);
+    } else {
+      raw = start;  // nothing strictly nearer than the preset
+    }
+    if (raw >= capped) return kInf;
+    return raw - s.offset;
   }
   /// Bounds on the link-object distance for advancing: lower (for the step) and upper (for
   /// the contact decision). Uses the box distance bd when it exceeds box_skip, else FCL with
@@ -325,16 +402,69 @@ struct GraspSimulator::Impl {
 
   // ---- closing ----
   struct LinkCache {
+    Warm warm;
     double lo = 0.0, hi = kInf;  // object distance bounds
     double tab = kInf;           // table distance
     bool fresh = false;          // evaluated at the link's current pose
+    /// (fresh only) lo is a lower bound standing in for an FCL distance not queried yet
+    /// (query pruning); hi is then kInf. The link cannot touch the object (lo >= tolerance).
+    bool pending = false;
     double guess = 0.0;          // a lower bound on the object distance at the current pose
   };
 
+  bool pruning() const { return opt.prune_queries && opt.rel_err == 0.0 && hand.num_links() <= 64; }
+
   void evaluate(int link, const Iso3& T, LinkCache& c, int& queries) const {
-    advance_distance(link, T, c.guess, c.lo, c.hi, queries);
     c.tab = opt.table ? table_distance(link, T) : kInf;
     c.fresh = true;
+    c.pending = false;
+    if (pruning()) {
+      // The unpruned value is the box bound bd when bd > box_skip, else the FCL distance.
+      // That FCL distance is at least max(bd, guess); while that bound reaches the contact
+      // tolerance the link cannot touch, and the query waits until the step needs it
+      // (resolve_pending).
+      const double bd = box_distance(link, T);
+      if (bd > opt.box_skip) {
+        c.lo = bd, c.hi = kInf;
+      } else if (std::max(bd, c.guess) >= opt.contact_tolerance) {
+        c.lo = std::max(bd, c.guess), c.hi = kInf, c.pending = true;
+      } else {
+        c.lo = c.hi = distance_below(link, T, kInf, queries, &c.warm);
+      }
+      return;
+    }
+    advance_distance(link, T, c.guess, c.lo, c.hi, queries);
+  }
+
+  /// Query pruning. `limit` is the minimum of the step terms known so far; pending link k
+  /// (cache entry *c[k]) has the term term(k, d) for object distance d (increasing in d), and
+  /// inverse(k, t) is the distance giving term t. Pending links whose bound gives a term below
+  /// the limit are queried, lowest bound first, each by query(k, cap) capped at the distance
+  /// that would lower the limit. Returns the minimum over all terms: the same as if every
+  /// pending link had been queried.
+  template <class Term, class Inverse, class Query>
+  static double resolve_pending(LinkCache* const* c, int count, double limit, Term term, Inverse inverse,
+                                Query query) {
+    uint64_t tried = 0;  // each link is queried at most once (count <= 64)
+    for (;;) {
+      int best = -1;
+      double best_term = limit;
+      for (int k = 0; k < count; ++k)
+        if (!(tried >> k & 1) && c[k]->pending && term(k, c[k]->lo) < best_term) best = k, best_term = term(k, c[k]->lo);
+      if (best < 0) return limit;
+      tried |= uint64_t{1} << best;
+      LinkCache& b = *c[best];
+      // a hair above the limit's distance, so that round-off in inverse() cannot hide a term
+      // equal to the limit
+      const double cap = inverse(best, limit) * (1.0 + 1e-12) + 1e-12;
+      const double d = query(best, cap);
+      if (d < kInf) {
+        b.lo = b.hi = d, b.pending = false;
+        limit = std::min(limit, term(best, d));
+      } else {
+        b.lo = std::max(b.lo, cap);  // still pending, with a term at or above the limit
+      }
+    }
   }
 
   /// Whether phalanx j of finger f, within the tolerance of the object or the table, moves
@@ -416,10 +546,15 @@ struct GraspSimulator::Impl {
         for (int i = 0; i <= touching; ++i) frozen[i] = true;
         continue;
       }
-      // safe step in t
+      // safe step in t: the minimum over the links' terms (d - tol / 2) / v, d = min(object,
+      // table), and the joint limits. (min(a, b) - x) / v = min((a - x) / v, (b - x) / v)
+      // exactly in floating point, so the object and table terms are taken separately: the
+      // object terms of pending links are then resolved last, against the others' minimum.
       ++iterations;
       double dt = kInf, vmax = 0.0, vlink[kMaxPhalanges] = {0.0};
       bool any_escaping = false;
+      LinkCache* pend[kMaxPhalanges];  // links with pending object terms
+      int pend_j[kMaxPhalanges], npend = 0;
       for (int j = first; j < n; ++j) {
         double v = 0.0;
         for (int i = first; i <= j; ++i)
@@ -427,13 +562,15 @@ struct GraspSimulator::Impl {
         if (v <= 0.0) continue;
         vmax = std::max(vmax, v);
         vlink[j] = v;
-        const LinkCache& c = cache[F.phalanges[j].link];
+        LinkCache& c = cache[F.phalanges[j].link];
         if (escaping[j]) {
           // touching but not clearly moving in: try a step of kEscape travel, checked below
           any_escaping = true;
           dt = std::min(dt, kEscape / v);
         } else {
-          dt = std::min(dt, (std::min(c.lo, c.tab) - 0.5 * tol) / v);
+          dt = std::min(dt, (c.tab - 0.5 * tol) / v);
+          if (c.pending) pend[npend] = &cache[F.phalanges[j].link], pend_j[npend++] = j;
+          else dt = std::min(dt, (c.lo - 0.5 * tol) / v);
         }
       }
       for (int i = first; i < n; ++i)
@@ -441,6 +578,12 @@ struct GraspSimulator::Impl {
           const Phalanx& P = F.phalanges[i];
           dt = std::min(dt, (P.upper - P.offset) / P.ratio - t);
         }
+      dt = resolve_pending(
+          pend, npend, dt, [&](int k, double d) { return (d - 0.5 * tol) / vlink[pend_j[k]]; },
+          [&](int k, double tt) { return tt * vlink[pend_j[k]] + 0.5 * tol; },
+          [&](int k, double cap) {
+            return distance_below(F.phalanges[pend_j[k]].link, T[pend_j[k]], cap, queries, &pend[k]->warm);
+          });
       dt = std::max(dt, 0.0);
       auto set_t = [&](double tt) {
         for (int i = first; i < n; ++i)
@@ -497,8 +640,12 @@ struct GraspSimulator::Impl {
       if (links[l].empty()) continue;
       const LinkCache& c = cache[l];
       const bool known_far = c.fresh && c.lo >= tol;
-      if (!known_far) {
-        const Exact e = exact_distance(l, poses[l], r.distance_queries);
+      // With pruning, a lower bound carried to this pose (guess) can show the link far too,
+      // and the query only looks for distances below the tolerance (the same contact when
+      // there is one: see shape_distance).
+      const bool prune = pruning();
+      if (!known_far && !(prune && !c.fresh && c.guess >= tol)) {
+        const Exact e = exact_distance(l, poses[l], r.distance_queries, prune ? tol : kInf);
         if (e.d < tol && e.tri >= 0) {
           Contact k;
           k.point = e.point;
@@ -677,19 +824,34 @@ struct GraspSimulator::Impl {
     std::vector<LinkCache> cache(L);
     int queries = 0, iterations = 0;
     Iso3 H = HandModel::top_grasp_pose(x, y, yaw, z);
+    // Link poses of the open hand relative to the palm: the descent only translates them.
+    const std::vector<Iso3> local = hand.link_poses(Iso3::Identity(), q0);
+    std::vector<Iso3> poses(L);
+    std::vector<LinkCache*> pend;
+    pend.reserve(L);
+    std::vector<int> pend_l;
+    pend_l.reserve(L);
     for (int it = 0; it < opt.max_iterations; ++it) {
       H = HandModel::top_grasp_pose(x, y, yaw, z);
-      const std::vector<Iso3> poses = hand.link_poses(H, q0);
+      for (int l = 0; l < L; ++l) poses[l] = H * local[l];
       double dmin = kInf;
       bool touch = false;
+      pend.clear(), pend_l.clear();
       for (int l = 0; l < L; ++l) {
         if (links[l].empty()) continue;
         evaluate(l, poses[l], cache[l], queries);
-        dmin = std::min({dmin, cache[l].lo, cache[l].tab});
+        dmin = std::min(dmin, cache[l].tab);
+        if (cache[l].pending) pend.push_back(&cache[l]), pend_l.push_back(l);  // see close_finger
+        else dmin = std::min(dmin, cache[l].lo);
         if (cache[l].hi < tol || cache[l].tab < tol) touch = true;
       }
       if (touch) break;
       if (!opt.table && z < z_floor) break;
+      // every point moves at speed 1 along -z: a link's term is its distance itself
+      dmin = resolve_pending(
+          pend.data(), static_cast<int>(pend.size()), dmin, [](int, double d) { return d; },
+          [](int, double d) { return d; },
+          [&](int k, double cap) { return distance_below(pend_l[k], poses[pend_l[k]], cap, queries, &pend[k]->warm); });
       ++iterations;
       const double dz = std::max(dmin - 0.5 * tol, 0.0);
       z -= dz;
@@ -707,7 +869,9 @@ struct GraspSimulator::Impl {
     if (raise > 0.0) {
       z += raise;
       H = HandModel::top_grasp_pose(x, y, yaw, z);
-      for (LinkCache& c : cache) c.fresh = false, c.guess = 0.0;
+      // every point moved by `raise`: the distances found are still lower bounds after it
+      const bool carry = pruning();  // (without pruning, guess only scales rel_err: kept at 0 as before)
+      for (LinkCache& c : cache) c.guess = carry && c.fresh ? std::max(0.0, c.lo - raise) : 0.0, c.fresh = false;
     }
     GraspResult r = close(H, spread, &cache, false, 0.0);
     r.distance_queries += queries;
@@ -750,9 +914,9 @@ GraspSimulator::GraspSimulator(const HandModel& hand, const TriMesh& object, con
     m.normals[i] = nrm.norm() > 0 ? Vec3(flip * nrm.normalized()) : Vec3::UnitZ();
   }
   if (options.bv == SimOptions::Bv::OBBRSS)
-    m.object = make_bvh<fcl::OBBRSSd>(v, t);
+    m.object = make_bvh<fcl::OBBRSSd>(v, t), m.object_mesh = view_of(static_cast<const fcl::BVHModel<fcl::OBBRSSd>&>(*m.object));
   else
-    m.object = make_bvh<fcl::RSSd>(v, t);
+    m.object = make_bvh<fcl::RSSd>(v, t), m.object_mesh = view_of(static_cast<const fcl::BVHModel<fcl::RSSd>&>(*m.object));
 
   // link geometry
   m.links.resize(hand.num_links());
@@ -762,8 +926,14 @@ GraspSimulator::GraspSimulator(const HandModel& hand, const TriMesh& object, con
       ShapeG g;
       using LG = SimOptions::LinkGeometry;
       auto bvh = [&](const std::vector<fcl::Vector3d>& lv, const std::vector<fcl::Triangle>& lt) -> Geom {
-        if (options.bv == SimOptions::Bv::OBBRSS) return make_bvh<fcl::OBBRSSd>(lv, lt);
-        return make_bvh<fcl::RSSd>(lv, lt);
+        if (options.bv == SimOptions::Bv::OBBRSS) {
+          auto b = make_bvh<fcl::OBBRSSd>(lv, lt);
+          g.mesh = view_of(*b);
+          return b;
+        }
+        auto b = make_bvh<fcl::RSSd>(lv, lt);
+        g.mesh = view_of(*b);
+        return b;
       };
       if (s.type == Shape::Type::Capsule) {
         g.capsule = true;

@@ -29,6 +29,16 @@
 // the fingers are long, the fingers then wrap it near its base instead of striking the table
 // (a hand descending to the object's top would otherwise only ever grasp the table).
 //
+// Query pruning (SimOptions::prune_queries). Almost all the time goes to FCL distance queries,
+// and most of them only confirm that a link is not the one limiting the step. Every link keeps
+// a lower bound on its object distance, carried between steps (its last distance minus the
+// most it can have moved since). A step is the minimum over the links' terms; a link whose
+// bound already gives a term no smaller than the others' is not queried, and a link that is
+// queried gets a capped query (FCL searches only below the distance that would change the
+// minimum). Queries of links that may touch (bound below the tolerance) and final contact
+// queries (capped at the tolerance) are made as before. The steps, contact decisions and
+// contacts are therefore those of the unpruned algorithm, up to round-off.
+//
 // Thread safety: all queries are const and keep their state on the stack, so one simulator
 // can serve many threads (FCL's BVH model is only read by distance queries).
 #pragma once
@@ -65,6 +75,12 @@ struct SimOptions {
   /// Top grasps with a table: minimum height of the fingers' closing sweep above the table (m);
   /// negative disables the rule (the hand then stops at the first contact).
   double table_clearance = 0.005;
+  /// Skip FCL queries whose answer cannot change the result (same joint angles and contacts up
+  /// to round-off; see "Query pruning" in grasp_simulator.cpp): lower bounds carried between
+  /// advancement steps, and queries capped at the only distance that matters. false = one
+  /// query per link near the object and step, as before (for tests and benchmarks). Only
+  /// applies with rel_err = 0.
+  bool prune_queries = true;
 };
 
 struct GraspResult {
