@@ -10,6 +10,7 @@
 #include "bayesgrasp/belief/entropy.hpp"
 #include "bayesgrasp/belief/measurement_model.hpp"
 #include "bayesgrasp/belief/particles.hpp"
+#include "bayesgrasp/belief/pose_grid.hpp"
 #include "bayesgrasp/belief/relative_pose.hpp"
 #include "validate.hpp"
 
@@ -331,6 +332,73 @@ void bind_belief(py::module_& m) {
       "actions"_a, "poses"_a,
       "Grasp poses relative to object poses, for all pairs: actions (A, 3 + extra), poses (N, 3) ->\n"
       "(A*N, 3 + extra), row a*N + j = (R(-yaw_j)(a_xy - o_xy), wrap(a_yaw - yaw_j), extra_a).");
+  py::class_<bl::RelativePoseGrid>(m, "RelativePoseGrid",
+                                   "A regular grid over relative grasp poses (x, y, yaw) with C channels,\n"
+                                   "trilinear interpolation, yaw periodic (a tabulated planning model).")
+      .def(py::init([](const DArray& lo, const DArray& hi, int nx, int ny, int nyaw, const DArray& values,
+                       const DArray& outside) {
+             const Eigen::VectorXd l = vector(lo, "lo", 2), h = vector(hi, "hi", 2);
+             bl::RowMatrixXd V = matrix(values, "values");
+             if (outside.ndim() != 1) throw py::value_error("outside: expected a 1-D array");
+             Eigen::Map<const Eigen::VectorXd> o(outside.data(), outside.shape(0));
+             return guarded([&] {
+               return new bl::RelativePoseGrid({l[0], l[1]}, {h[0], h[1]}, nx, ny, nyaw, std::move(V),
+                                               Eigen::VectorXd(o));
+             });
+           }),
+           "lo"_a, "hi"_a, "nx"_a, "ny"_a, "nyaw"_a, "values"_a, "outside"_a,
+           "Nodes x_i = lo[0] + i (hi[0]-lo[0])/(nx-1), likewise y, yaw_k = -pi + 2 pi k / nyaw; values\n"
+           "(nx*ny*nyaw, C), row (ix*ny + iy)*nyaw + k; outside (C,): value where x or y is outside the\n"
+           "grid, NaN to clamp to the edge.")
+      .def_property_readonly("channels", &bl::RelativePoseGrid::channels)
+      .def_property_readonly("shape", [](const bl::RelativePoseGrid& g) {
+        return py::make_tuple(g.nx(), g.ny(), g.nyaw(), g.channels());
+      })
+      .def(
+          "interpolate",
+          [](const bl::RelativePoseGrid& g, const DArray& rel) {
+            const bl::RowMatrixXd R = matrix(rel, "rel", 3, true);
+            return to_np(released([&] { return g.interpolate(R); }));
+          },
+          "rel"_a, "Values at relative poses (P, 3) -> (P, C).")
+      .def(
+          "interpolate_pairs",
+          [](const bl::RelativePoseGrid& g, const DArray& actions, const DArray& poses, int c0, int nc, int n_threads) {
+            const bl::RowMatrixXd A = matrix(actions, "actions", 3), P = matrix(poses, "poses", 3);
+            return to_np(released([&] { return g.interpolate_pairs(A, P, c0, nc, n_threads); }));
+          },
+          "actions"_a, "poses"_a, "c0"_a = 0, "nc"_a = 1, "n_threads"_a = 1,
+          "Channels [c0, c0+nc) at every action (A, 3) relative to every pose (N, 3): (A*N, nc),\n"
+          "row a*N + j.")
+      .def(
+          "expected",
+          [](const bl::RelativePoseGrid& g, const DArray& actions, const DArray& poses, const DArray& weights,
+             int channel, int n_threads) {
+            const bl::RowMatrixXd A = matrix(actions, "actions", 3), P = matrix(poses, "poses", 3);
+            const Eigen::VectorXd w = vector(weights, "weights", P.rows());
+            return released([&] { return g.expected(A, P, w, channel, n_threads); });
+          },
+          "actions"_a, "poses"_a, "weights"_a, "channel"_a = 0, "n_threads"_a = 1,
+          "sum_j w_j value(action relative to pose_j) for every action (A,): Eq. 3.1's integral over\n"
+          "a particle belief when the channel is P(S | A, O).")
+      .def(
+          "expected_posterior_entropy",
+          [](const bl::RelativePoseGrid& g, const DArray& actions, const DArray& poses, const DArray& log_weights,
+             int mean_c0, int var_c0, int k, int n_samples, std::uint64_t seed, int n_threads) {
+            const bl::RowMatrixXd A = matrix(actions, "actions", 3), P = matrix(poses, "poses", 3);
+            const Eigen::VectorXd lw = log_weights_from(log_weights, "log_weights");
+            if (lw.size() != P.rows()) throw py::value_error("log_weights: expected one per pose");
+            const auto est = released([&] {
+              return g.expected_posterior_entropy(A, P, lw, mean_c0, var_c0, k, n_samples, seed, n_threads);
+            });
+            Eigen::VectorXd h(est.size()), se(est.size());
+            for (size_t i = 0; i < est.size(); ++i) { h[i] = est[i].mean; se[i] = est[i].std_error; }
+            return py::make_tuple(h, se);
+          },
+          "actions"_a, "poses"_a, "log_weights"_a, "mean_c0"_a, "var_c0"_a, "k"_a, "n_samples"_a = 100,
+          "seed"_a = 0, "n_threads"_a = 1,
+          "Expected posterior weight entropy (Eq. 3.2) of every action with the measurement mean in\n"
+          "channels [mean_c0, mean_c0+k) and its variance in [var_c0, var_c0+k). Returns (h (A,), se (A,)).");
 }
 
 }  // namespace bayesgrasp::bind

@@ -1,8 +1,10 @@
 """bayesgrasp command line: grasp planning under uncertainty.
 
 Sub-commands:
-  grasp     close the hand on an object at a top-grasp pose; quality and lift test
-  demo      the main job on a built-in object
+  demo        the main job: plan, grasp, update the belief, re-plan, on a built-in mug
+  plan        the same loop for any object (built-in or mesh file) at a given true pose
+  experiment  the thesis's experiments (pub2, baselines, pub4, entropy_order, landscapes)
+  grasp       close the hand on an object at a top-grasp pose; quality and lift test
   register  simulated depth view, table segmentation, registration against models
   objects   list the built-in objects
 """
@@ -57,10 +59,37 @@ def build_parser() -> argparse.ArgumentParser:
     g.add_argument("--no-lift", action="store_true", help="skip the physical lift test")
     g.add_argument("--json", action="store_true", help="print one JSON object")
 
-    d = sub.add_parser("demo", help="the main job on a built-in object")
-    d.add_argument("--object", default="mug")
+    d = sub.add_parser("demo", help="the main job: grasping a mug whose pose is uncertain")
+    d.add_argument("--object", default="mug", help="built-in object name or mesh file")
+    d.add_argument("--method", default="explore", choices=["stability", "explore", "ml_pose", "open_loop"])
     d.add_argument("--out", default="out/demo", help="directory for the PNG and results")
     d.add_argument("--seed", type=int, default=0)
+    d.add_argument("--cache", default=None, help="model cache directory (default: $BAYESGRASP_CACHE or "
+                                                  "~/.cache/bayesgrasp/models)")
+
+    p = sub.add_parser("plan", help="run the planning loop on an object at a hidden true pose")
+    p.add_argument("--object", required=True, help="built-in object name or mesh file")
+    p.add_argument("--true-pose", required=True, metavar="X,Y,YAW", help="the hidden pose: metres, metres, radians")
+    p.add_argument("--method", default="explore", choices=["stability", "explore", "ml_pose", "open_loop"])
+    p.add_argument("--estimate", default=None, metavar="X,Y,YAW",
+                   help="the initial pose estimate (default: true pose + uniform noise within the belief)")
+    p.add_argument("--attempts", type=int, default=4)
+    p.add_argument("--seed", type=int, default=0)
+    p.add_argument("--noise", type=float, default=0.0, help="joint-angle measurement noise std (rad)")
+    p.add_argument("--hand", default="barrett_bh8", help="hand file name or path")
+    p.add_argument("--cache", default=None, help="model cache directory")
+    p.add_argument("--png", default=None, help="write a PNG of the belief's evolution")
+    p.add_argument("--json", action="store_true", help="print one JSON object")
+
+    e = sub.add_parser("experiment", help="run (or resume) one of the thesis's experiments")
+    e.add_argument("name", help="pub2, baselines, pub4, entropy_order or landscapes")
+    e.add_argument("--runs", type=int, default=None, help="runs per object (default: the experiment's)")
+    e.add_argument("--workers", type=int, default=1, help="worker processes")
+    e.add_argument("--out", default=None, help="output directory (default: out/experiments/NAME)")
+    e.add_argument("--objects", nargs="+", default=None, help="objects (default: the experiment's)")
+    e.add_argument("--seed", type=int, default=0, help="base seed")
+    e.add_argument("--cache", default=None, help="model cache directory")
+    e.add_argument("--no-lift", action="store_true", help="skip the lift tests (faster)")
 
     r = sub.add_parser("register", help="render a view of an object, segment it and register it against models")
     r.add_argument("--scene-object", required=True, help="object placed in the scene (built-in name or mesh file)")

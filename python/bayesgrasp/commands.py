@@ -60,49 +60,113 @@ def objects(args) -> int:
     return 0
 
 
+def _print_attempt(a: dict) -> None:
+    lift = "" if a["lifted"] is None else (", lifted" if a["lifted"] else ", dropped in the lift test")
+    ent = "" if a["expected_entropy"] is None else f", expected entropy {a['expected_entropy']:.2f}"
+    x, y, yaw = a["action"]
+    b = a["belief_before"]
+    print(f"  attempt {a['attempt']}: {a['kind']:<9} grasp ({100 * x:6.1f} cm, {100 * y:6.1f} cm, "
+          f"{np.degrees(yaw):6.1f} deg)  predicted P(S) {a['predicted_stability']:.2f}{ent}  "
+          f"[belief: error {100 * b['position_error']:.1f} cm, entropy {b['kde_entropy']:.2f}]  "
+          f"-> epsilon {a['epsilon']:.3f}: {'STABLE' if a['stable'] else 'not stable'}{lift}  "
+          f"({1e3 * a['plan_seconds']:.0f} ms to plan)", flush=True)
+
+
+def _loop(obj, pose, method, seed, cache, attempts=4, estimate=None, noise=0.0, hand="barrett_bh8",
+          quiet=False) -> dict:
+    from .planners import get_models, run_episode
+
+    if attempts < 1:
+        raise CliError(f"--attempts: must be at least 1, got {attempts}")
+    _world(obj, pose, hand=hand)  # a clear error for an unknown object or a pose off the table
+    say = None if quiet else (lambda m: print(m, file=sys.stderr, flush=True))
+    models = get_models(obj, hand, cache_dir=cache, progress=say)
+    return run_episode(obj, pose, method=method, seed=seed, attempts=attempts, estimate=estimate,
+                       measurement_noise=noise, hand=hand, models=models, keep_planner=True,
+                       on_attempt=None if quiet else _print_attempt)
+
+
+def _belief_png(r: dict, path) -> Path:
+    from .experiments.report import plot_belief_evolution
+
+    return plot_belief_evolution(r["snapshots"], r["true_pose"], Path(path),
+                                 f"{r['object']}, {r['method']}: true pose "
+                                 f"({100 * r['true_pose'][0]:.1f} cm, {100 * r['true_pose'][1]:.1f} cm, "
+                                 f"{np.degrees(r['true_pose'][2]):.0f} deg)", r["attempts"])
+
+
+def _json_ready(r: dict) -> dict:
+    return {k: v for k, v in r.items() if k not in ("planner", "snapshots")}
+
+
 def demo(args) -> int:
-    """Sweep top grasps over a built-in object, print the best ten by epsilon, lift-test them and
-    save a PNG of the best grasp."""
+    """The main job: a mug at a displaced pose the robot knows only to +-4 cm and +-45 deg;
+    plan, grasp, read the fingers, update the belief, re-plan until the grasp is stable."""
     out = _out_dir(args.out)
-    world = _world(args.object, (0.0, 0.0, 0.0))
-    ext = world.object.extent
-    xs = np.linspace(-0.3 * ext[0], 0.3 * ext[0], 7)
-    ys = np.linspace(-0.3 * ext[1], 0.3 * ext[1], 7)
-    yaws = np.linspace(0.0, np.pi, 12, endpoint=False)
-    spreads = [0.0, np.pi / 3, np.pi / 2]
-    grid = np.array([(x, y, a) for x in xs for y in ys for a in yaws])
-    rows = []
-    for spread in spreads:
-        b = world.grasp_batch(grid, spread=spread, threads=0)
-        for i in range(len(grid)):
-            if not b["collision_at_start"][i]:
-                rows.append((float(b["epsilon"][i]), float(b["volume"][i]), spread, *grid[i]))
-    rows.sort(key=lambda r: -r[0])
-    print(f"{len(grid) * len(spreads)} top grasps on {args.object} "
-          f"({int(np.sum([r[0] > 0 for r in rows]))} force-closure); best ten by epsilon:")
-    best = rows[:10]
-    if not best:
-        raise CliError("no collision-free grasp found")
-    # Lift-test the best ten, in C++ threads, one batch per spread.
-    print("lift-testing the best ten (Bullet) ...", file=sys.stderr)
-    lifted = {}
-    for spread in sorted({r[2] for r in best}):
-        idx = [k for k, r in enumerate(best) if r[2] == spread]
-        b = world.grasp_batch(np.array([best[k][3:] for k in idx]), spread=spread, lift=True, threads=0)
-        lifted.update({k: bool(v) for k, v in zip(idx, b["lifted"])})
-    print(f"{'rank':>4} {'x (m)':>8} {'y (m)':>8} {'yaw':>6} {'spread':>7} {'epsilon':>8} {'volume':>10} lifted")
-    table = []
-    for k, (eps, vol, spread, x, y, yaw) in enumerate(best):
-        table.append({"x": x, "y": y, "yaw": yaw, "spread": spread, "epsilon": eps, "volume": vol,
-                      "lifted": lifted[k]})
-        print(f"{k + 1:>4} {x:>8.4f} {y:>8.4f} {np.degrees(yaw):>5.0f}° {np.degrees(spread):>6.0f}° "
-              f"{eps:>8.4f} {vol:>10.3e} {'yes' if lifted[k] else 'no'}")
-    top = best[0]
-    g = world.grasp(*top[3:], spread=top[2])
-    png = world.plot_grasp(g, out / "best_grasp.png",
-                           title=f"best of {len(rows)} top grasps on {args.object}: epsilon {top[0]:.3f}")
-    (out / "best_grasps.json").write_text(json.dumps(table, indent=1))
-    print(f"saved {png} and {out / 'best_grasps.json'}")
+    rng = np.random.default_rng(args.seed)
+    pose = [float(rng.uniform(-0.08, 0.08)), float(rng.uniform(-0.08, 0.08)), float(rng.uniform(-np.pi, np.pi))]
+    print(f"{args.object} at a hidden pose ({100 * pose[0]:.1f} cm, {100 * pose[1]:.1f} cm, "
+          f"{np.degrees(pose[2]):.0f} deg); belief: 500 particles, +-4 cm, +-45 deg; method {args.method}")
+    r = _loop(args.object, pose, args.method, args.seed, args.cache)
+    f = r["final_belief"]
+    print(f"{'success' if r['success'] else 'no stable grasp'} after {len(r['attempts'])} attempt(s); "
+          f"final belief error {100 * f['position_error']:.1f} cm, {np.degrees(f['yaw_error']):.0f} deg")
+    png = _belief_png(r, out / "belief_evolution.png")
+    (out / "demo.json").write_text(json.dumps(_json_ready(r), indent=1))
+    print(f"saved {png} and {out / 'demo.json'}")
+    return 0
+
+
+def plan(args) -> int:
+    pose = _floats(args.true_pose, 3, "--true-pose")
+    est = _floats(args.estimate, 3, "--estimate") if args.estimate else None
+    if not (np.isfinite(args.noise) and args.noise >= 0):
+        raise CliError(f"--noise: must be >= 0, got {args.noise}")
+    if args.png:
+        _out_dir(str(Path(args.png).parent))
+    r = _loop(args.object, pose, args.method, args.seed, args.cache, args.attempts, est, args.noise, args.hand,
+              quiet=args.json)
+    if args.png:
+        _belief_png(r, args.png)
+    if args.json:
+        f = r["final_belief"]
+        out = {"object": args.object, "method": args.method, "true_pose": pose, "estimate": r["estimate"],
+               "success": r["success"],
+               "attempts": [{"plan_type": a["kind"], "grasp": a["action"], "predicted_stability": a["predicted_stability"],
+                             "expected_entropy": a["expected_entropy"], "entropy": a["belief_before"]["kde_entropy"],
+                             "epsilon": a["epsilon"], "lifted": a["lifted"],
+                             "outcome": "stable" if a["stable"] else "unstable", "plan_seconds": a["plan_seconds"],
+                             "joint_angles": a["joint_angles"]} for a in r["attempts"]],
+               "final_belief": {"mean": f["mean"], "std": f["std"], "entropy": f["kde_entropy"], "ess": f["ess"],
+                                "position_error": f["position_error"], "yaw_error": f["yaw_error"]}}
+        print(json.dumps(out))
+    else:
+        print(f"{'success' if r['success'] else 'no stable grasp'} after {len(r['attempts'])} attempt(s)")
+    return 0
+
+
+def experiment(args) -> int:
+    from .experiments.pose_uncertainty import EXPERIMENTS, run
+
+    if args.name not in EXPERIMENTS:
+        raise CliError(f"unknown experiment {args.name!r}; one of: {', '.join(EXPERIMENTS)}")
+    if args.runs is not None and args.runs < 1:
+        raise CliError(f"--runs: must be at least 1, got {args.runs}")
+    if args.workers < 1:
+        raise CliError(f"--workers: must be at least 1, got {args.workers}")
+    if args.objects:
+        from .objects import load_object
+
+        for o in args.objects:
+            load_object(o)  # a clear error for an unknown object
+    out = _out_dir(args.out or f"out/experiments/{args.name}")
+    import time
+
+    t0 = time.perf_counter()
+    summary = run(args.name, out, runs=args.runs, workers=args.workers, base_seed=args.seed, objects=args.objects,
+                  cache_dir=args.cache, lift=not args.no_lift)
+    print((out / "summary.md").read_text())
+    print(f"{args.name}: done in {time.perf_counter() - t0:.0f} s; tables, plots and results.sqlite in {out}")
     return 0
 
 

@@ -1,0 +1,219 @@
+"""The thesis's experiments on known objects under pose uncertainty (§3.2-3.3, Pub. II-IV).
+
+Each experiment is a set of runs; each run is a pure function of (experiment, object, run
+index, seed) that returns a JSON-ready dict, stored as soon as it finishes
+(:mod:`bayesgrasp.experiments.runner`); :func:`run` then writes the tables (Markdown and CSV) and
+the plots. Experiments:
+
+* ``pub2`` - stability maximisation (Pub. II): cube, cylinder, mug, mug2, pitcher; random true
+  poses; up to 4 attempts; success rate, predicted stability, epsilon, pose error and entropy
+  per attempt.
+* ``baselines`` - the same set-up for every planner: stability, explore, ml_pose, open_loop.
+* ``pub4`` - exploration vs stability only (Pub. IV): cube, mug, cylinder; 4 grasps each run
+  (fixed number, as in the thesis); epsilon and entropy per step.
+* ``entropy_order`` - Fig. 3.6: three grasps (lowest, median and highest predicted expected
+  entropy on a grid) executed from the same belief; does the realised entropy keep the order?
+* ``landscapes`` - weight-based vs kernel-based expected-entropy landscapes over the grasp
+  position (their correlation), and the 1,000 vs 10,000 sample comparison for the cube with
+  uncertainty in x only.
+
+True poses: x, y uniform in +-10 cm, yaw uniform; the same for every method at a given
+(object, run index), so methods are compared on the same problems.
+"""
+from __future__ import annotations
+
+import csv
+import json
+from dataclasses import dataclass, field
+from functools import partial
+from pathlib import Path
+from typing import Callable, Dict, List, Optional, Sequence
+
+import numpy as np
+from scipy import stats
+
+from ..belief import relative_planar_pose
+from ..models import ModelSettings, relative_top_grasps
+from ..planners import PlannerSettings, get_models, make_planner, run_episode
+from ..planners.base import wrap_angle
+from ..world import World
+from .runner import ResultStore, run_experiment, run_seed
+
+FIVE = ("cube", "cylinder", "mug", "mug2", "pitcher")
+METHODS = ("stability", "explore", "ml_pose", "open_loop")
+
+
+@dataclass(frozen=True)
+class Experiment:
+    name: str
+    objects: Sequence[str]
+    runs: int
+    methods: Sequence[str] = ("stability",)
+    description: str = ""
+
+
+EXPERIMENTS: Dict[str, Experiment] = {
+    "pub2": Experiment("pub2", FIVE, 100, ("stability",), "stability maximisation (Pub. II)"),
+    "baselines": Experiment("baselines", FIVE, 30, METHODS, "all planners and the two baselines"),
+    "pub4": Experiment("pub4", ("cube", "mug", "cylinder"), 30, ("explore", "stability"),
+                       "exploration vs stability only, 4 grasps per run (Pub. IV)"),
+    "entropy_order": Experiment("entropy_order", ("cube", "mug"), 30, ("explore",),
+                                "predicted vs realised entropy order of three grasps (Fig. 3.6)"),
+    "landscapes": Experiment("landscapes", ("mug", "cube"), 3, ("explore",),
+                             "weight vs kernel entropy landscapes; 1,000 vs 10,000 samples"),
+}
+
+
+def true_pose(experiment: str, obj: str, run_index: int, base_seed: int = 0) -> np.ndarray:
+    """The hidden true pose of a run: the same for every method of the experiment."""
+    rng = np.random.default_rng(run_seed(base_seed, experiment, obj, run_index))
+    return np.array([rng.uniform(-0.1, 0.1), rng.uniform(-0.1, 0.1), rng.uniform(-np.pi, np.pi)])
+
+
+def _strip(result: dict) -> dict:
+    return {k: v for k, v in result.items() if k not in ("planner", "snapshots")}
+
+
+# ---- run functions (module level: sent to worker processes) ----------------------------------------
+def episode_run(experiment: str, obj: str, run_index: int, seed: int, *, base: str, method: str,
+                base_seed: int, stop_when_stable: bool, cache_dir: Optional[str], lift: bool) -> dict:
+    pose = true_pose(base, obj, run_index, base_seed)
+    r = run_episode(obj, pose, method=method, seed=run_seed(base_seed, base, obj, run_index), cache_dir=cache_dir,
+                    stop_when_stable=stop_when_stable, lift=lift)
+    return _strip(r)
+
+
+def entropy_order_run(experiment: str, obj: str, run_index: int, seed: int, *, base_seed: int,
+                      cache_dir: Optional[str], grid: int = 15) -> dict:
+    """Predict the expected entropy of a grid of grasps from the initial belief, execute the best,
+    the median and the worst, and compare the realised weight entropies after reweighting."""
+    pose = true_pose("entropy_order", obj, run_index, base_seed)
+    models = get_models(obj, cache_dir=cache_dir)
+    rng = np.random.default_rng(seed)
+    s = PlannerSettings()
+    est = pose + rng.uniform(-np.asarray(s.half_width), np.asarray(s.half_width))
+    planner = make_planner("explore", models, est, s, seed=int(rng.integers(2**31)))
+    cands = _grid_actions(planner, grid, yaw=planner.belief.mean()[2])
+    h, se = planner.expected_entropy(cands, n_samples=200, seed=1)
+    order = np.argsort(h)
+    picks = {"best": order[0], "good": order[len(order) // 2], "worst": order[-1]}
+    world = World.single(obj, pose=pose)
+    out = {"true_pose": pose.tolist(), "predicted": {}, "realised": {}, "actions": {}, "grid": grid,
+           "landscape": h.tolist(), "candidates": cands.tolist(), "particles": planner.belief.particles.tolist()}
+    P = planner.belief.particles
+    for name, i in picks.items():
+        a = cands[i]
+        rel = relative_top_grasps(a, pose)[0, 0]
+        q = np.asarray(world.grasp_batch(rel[None, :], spread=models.settings.spread)["joint_angles"][0])
+        q = q[models.joint_index]
+        ll = models.log_likelihood(relative_planar_pose(a[None, :], P), q)
+        lw = planner.belief.log_weights + ll
+        lw -= np.logaddexp.reduce(lw)
+        w = np.exp(lw)
+        out["predicted"][name] = float(h[i])
+        out["realised"][name] = float(-np.sum(w[w > 0] * lw[w > 0]))
+        out["actions"][name] = a.tolist()
+    pr = [out["predicted"][k] for k in ("best", "good", "worst")]
+    re = [out["realised"][k] for k in ("best", "good", "worst")]
+    out["order_kept"] = bool(np.all(np.argsort(re) == np.argsort(pr)))
+    out["best_below_worst"] = bool(re[0] < re[2])
+    out["kendall_tau"] = float(stats.kendalltau(pr, re).statistic)
+    return out
+
+
+def _grid_actions(planner, n: int, yaw: float) -> np.ndarray:
+    low, high = planner.action_bounds()
+    xs = np.linspace(low[0], high[0], n)
+    ys = np.linspace(low[1], high[1], n)
+    X, Y = np.meshgrid(xs, ys, indexing="ij")
+    return np.column_stack([X.ravel(), Y.ravel(), np.full(X.size, yaw)])
+
+
+def landscapes_run(experiment: str, obj: str, run_index: int, seed: int, *, base_seed: int,
+                   cache_dir: Optional[str], grid: int = 21) -> dict:
+    """Weight vs kernel expected-entropy landscapes over (x, y) at the belief's mean yaw; for the
+    cube also the 1-D (x only) uncertainty case with 1,000 and 10,000 measurement samples."""
+    pose = true_pose("landscapes", obj, run_index, base_seed)
+    models = get_models(obj, cache_dir=cache_dir)
+    rng = np.random.default_rng(seed)
+    s = PlannerSettings()
+    est = pose + rng.uniform(-np.asarray(s.half_width), np.asarray(s.half_width))
+    planner = make_planner("explore", models, est, s, seed=int(rng.integers(2**31)))
+    cands = _grid_actions(planner, grid, yaw=planner.belief.mean()[2])
+    hw, _ = planner.expected_entropy(cands, n_samples=200, seed=3, method="weight")
+    hk, _ = planner.expected_entropy(cands, n_samples=200, seed=3, method="kernel")
+    out = {"true_pose": pose.tolist(), "grid": grid, "actions": cands.tolist(), "weight": hw.tolist(),
+           "kernel": hk.tolist(), "pearson": float(stats.pearsonr(hw, hk).statistic),
+           "spearman": float(stats.spearmanr(hw, hk).statistic)}
+    if obj == "cube":
+        # 1-DOF: the belief varies in x only (the thesis's cube experiment).
+        s1 = s.with_(half_width=(0.04, 1e-6, 1e-6))
+        p1 = make_planner("explore", models, (pose[0] + rng.uniform(-0.04, 0.04), pose[1], pose[2]), s1,
+                          seed=int(rng.integers(2**31)))
+        xs = np.linspace(pose[0] - 0.07, pose[0] + 0.07, 141)
+        acts = np.column_stack([xs, np.full_like(xs, pose[1]), np.full_like(xs, pose[2])])
+        h1, _ = p1.expected_entropy(acts, n_samples=1000, seed=5)
+        h10, _ = p1.expected_entropy(acts, n_samples=10000, seed=5)
+
+        def rough(h):
+            return float(np.mean(np.abs(np.diff(h, 2))))
+
+        out["one_dof"] = {"x": xs.tolist(), "h1000": h1.tolist(), "h10000": h10.tolist(),
+                          "roughness_1000": rough(h1), "roughness_10000": rough(h10),
+                          "argmin_gap": float(abs(xs[np.argmin(h1)] - xs[np.argmin(h10)])),
+                          "correlation": float(stats.pearsonr(h1, h10).statistic)}
+    return out
+
+
+# ---- driver -----------------------------------------------------------------------------------------
+def run(name: str, out_dir, runs: Optional[int] = None, workers: int = 1, base_seed: int = 0,
+        objects: Optional[Sequence[str]] = None, cache_dir=None, progress: bool = True, lift: bool = True) -> dict:
+    """Runs (or resumes) experiment ``name`` into ``out_dir`` and writes its tables and plots.
+    Returns the summary dict (also written as summary.json)."""
+    if name not in EXPERIMENTS:
+        raise ValueError(f"unknown experiment {name!r}; one of: {', '.join(EXPERIMENTS)}")
+    exp = EXPERIMENTS[name]
+    runs = exp.runs if runs is None else int(runs)
+    if runs < 1:
+        raise ValueError(f"runs: must be at least 1, got {runs}")
+    objects = list(exp.objects if objects is None else objects)
+    out = Path(out_dir)
+    cache = str(cache_dir) if cache_dir is not None else None
+    store = ResultStore(out / "results.sqlite")
+    # Models first, in this process (their disk cache is then shared by the workers).
+    for o in objects:
+        get_models(o, cache_dir=cache, progress=(lambda m: print(m, flush=True)) if progress else None)
+    results: Dict[str, list] = {}
+    try:
+        if name in ("pub2", "baselines", "pub4"):
+            for method in exp.methods:
+                fn = partial(episode_run, base=name, method=method, base_seed=base_seed,
+                             stop_when_stable=(name != "pub4"), cache_dir=cache, lift=lift)
+                results[method] = run_experiment(f"{name}/{method}", objects, runs, fn, store, base_seed, workers,
+                                                 progress)
+        elif name == "entropy_order":
+            fn = partial(entropy_order_run, base_seed=base_seed, cache_dir=cache)
+            results["explore"] = run_experiment(name, objects, runs, fn, store, base_seed, workers, progress)
+        else:
+            fn = partial(landscapes_run, base_seed=base_seed, cache_dir=cache)
+            results["explore"] = run_experiment(name, objects, runs, fn, store, base_seed, workers, progress)
+    finally:
+        store.close()
+    from . import report
+
+    summary = report.write(name, results, out)
+    if name in ("pub2", "pub4"):
+        # Figs. 3.3 / 3.5: the belief's evolution in run 0 of each object (re-run, it is pure).
+        method = exp.methods[0]
+        lines = []
+        for o in objects:
+            pose = true_pose(name, o, 0, base_seed)
+            r = run_episode(o, pose, method=method, seed=run_seed(base_seed, name, o, 0), cache_dir=cache,
+                            stop_when_stable=(name != "pub4"), lift=False, keep_planner=True)
+            p = report.plot_belief_evolution(r["snapshots"], pose, out / f"belief_{o}.png",
+                                             f"{o}, {method}, run 0: true pose {np.round(pose, 3).tolist()}",
+                                             r["attempts"])
+            lines.append(f"![{o}]({p.name})")
+        with open(out / "summary.md", "a") as f:
+            f.write("\n## Belief evolution (run 0)\n\n" + "\n\n".join(lines) + "\n")
+    return summary

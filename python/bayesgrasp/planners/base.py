@@ -1,0 +1,262 @@
+"""What every planner for known objects under pose uncertainty shares (thesis §3.2-3.3).
+
+The unknown is the object's planar pose O = (x, y, yaw) on the table; the belief is a
+:class:`~bayesgrasp.belief.ParticleBelief` over it; an action is a top grasp A = (x, y, yaw) in
+the world frame; the measurement M is the hand's phalanx joint angles after closing; S is
+whether the grasp is stable. Every planner has the same interface::
+
+    planner = StabilityPlanner(models, estimate=(0.01, -0.02, 0.3), seed=0)
+    plan = planner.plan()                      # Plan: action, kind, predicted stability, ...
+    planner.observe(plan.action, joint_angles, stable=False)
+    planner.belief, planner.history
+
+``observe`` is the Bayes update of the thesis: reweight the particles by the GP measurement
+likelihood P(M | A, O) (and, as an option, by P(S = observed | A, O)), resample, then move every
+particle with Metropolis steps whose target is the posterior of all observations so far, so
+that resampled copies spread out again.
+"""
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass, field, replace
+from typing import List, Optional, Sequence
+
+import numpy as np
+
+from .. import optim
+from ..belief import ParticleBelief, relative_planar_pose
+from ..models import GraspModels
+
+
+@dataclass(frozen=True)
+class PlannerSettings:
+    """Settings shared by the planners (defaults reproduce the thesis's set-up)."""
+
+    n_particles: int = 500
+    # Initial belief: uniform over estimate +- half_width (x, y in m, yaw in rad).
+    half_width: Sequence[float] = (0.04, 0.04, np.radians(45.0))
+    # Stability search (Eq. 3.1): PSO over (x, y, yaw).
+    pso_particles: int = 32
+    pso_iter: int = 30
+    # Exploration (Eq. 3.2): used when the best expected stability is below explore_threshold.
+    explore_threshold: float = 0.5
+    entropy: str = "weight"            # "weight" (the thesis's default) or "kernel"
+    entropy_samples: int = 50          # measurement samples per candidate action
+    explore_pso_particles: int = 16
+    explore_pso_iter: int = 12
+    # Belief update.
+    metropolis_steps: int = 10
+    metropolis_step: Sequence[float] = (0.003, 0.003, np.radians(3.0))
+    use_outcome: bool = True           # also weigh particles by P(S = observed | A, O)
+    outcome_floor: float = 0.05        # P(S) is clipped to [floor, 1 - floor] in that factor
+    # Grasp search box: the belief's x, y extent plus this margin (m).
+    action_margin: float = 0.03
+    threads: int = 1
+
+    def __post_init__(self):
+        if self.n_particles < 2:
+            raise ValueError(f"n_particles: need at least 2, got {self.n_particles}")
+        hw = np.asarray(self.half_width, dtype=float)
+        if hw.shape != (3,) or not np.all(np.isfinite(hw)) or np.any(hw <= 0):
+            raise ValueError(f"half_width: expected three positive numbers (m, m, rad), got {self.half_width}")
+        if self.entropy not in ("weight", "kernel"):
+            raise ValueError(f"entropy: 'weight' or 'kernel', got {self.entropy!r}")
+        if not 0.0 <= self.explore_threshold <= 1.0:
+            raise ValueError(f"explore_threshold: must be in [0, 1], got {self.explore_threshold}")
+        for name in ("pso_particles", "pso_iter", "entropy_samples", "explore_pso_particles", "explore_pso_iter"):
+            if getattr(self, name) < 1:
+                raise ValueError(f"{name}: must be at least 1, got {getattr(self, name)}")
+        if self.metropolis_steps < 0:
+            raise ValueError(f"metropolis_steps: must be >= 0, got {self.metropolis_steps}")
+
+    def with_(self, **kw) -> "PlannerSettings":
+        return replace(self, **kw)
+
+
+@dataclass
+class Plan:
+    """A planned grasp. ``kind`` is "stability" or "explore"; ``predicted_stability`` the
+    belief-weighted P(S) of the action (Eq. 3.1's integral), ``objective`` what the planner's
+    own search maximised (equal for the stability planner), ``expected_entropy`` Eq. 3.2's value
+    for exploration plans (else None), ``seconds`` the wall time of the decision."""
+
+    action: np.ndarray
+    kind: str
+    predicted_stability: float
+    objective: float
+    expected_entropy: Optional[float] = None
+    seconds: float = 0.0
+    evaluations: int = 0
+
+
+@dataclass
+class Observation:
+    action: np.ndarray
+    measurement: np.ndarray
+    stable: bool
+
+
+def wrap_angle(a):
+    return np.mod(np.asarray(a, dtype=float) + np.pi, 2 * np.pi) - np.pi
+
+
+class Planner:
+    """Base class: belief, Bayes update and the stability search; subclasses choose the action."""
+
+    method = "base"
+
+    def __init__(self, models: GraspModels, estimate: Sequence[float], settings: Optional[PlannerSettings] = None,
+                 seed: int = 0, table_bounds: Optional[Sequence[float]] = None):
+        self.models = models
+        self.settings = settings or PlannerSettings()
+        est = np.asarray(estimate, dtype=float).ravel()
+        if est.shape != (3,) or not np.all(np.isfinite(est)):
+            raise ValueError(f"estimate: expected a finite pose (x, y, yaw), got {estimate}")
+        self.estimate = est.copy()
+        self.estimate[2] = wrap_angle(est[2])
+        hw = np.asarray(self.settings.half_width, dtype=float)
+        low = np.array([est[0] - hw[0], est[1] - hw[1], -np.pi])
+        high = np.array([est[0] + hw[0], est[1] + hw[1], np.pi])
+        self.seed = int(seed)
+        self._rng = np.random.default_rng(self.seed)
+        # Uniform over the box around the estimate; yaw within +-hw[2] of the estimate (wrapped).
+        n = self.settings.n_particles
+        parts = np.column_stack([self._rng.uniform(low[0], high[0], n), self._rng.uniform(low[1], high[1], n),
+                                 wrap_angle(est[2] + self._rng.uniform(-hw[2], hw[2], n))])
+        self._yaw_lo, self._yaw_hw = est[2], hw[2]
+        self.belief = ParticleBelief(parts, low, high, wraps=[False, False, True], seed=self.seed)
+        self.table = models.table()
+        self.observations: List[Observation] = []
+        self.history: List[dict] = []
+        self._plans = 0
+
+    # ---- the prior box --------------------------------------------------------------------------
+    def _log_prior(self, poses: np.ndarray) -> np.ndarray:
+        """0 inside the initial box (uniform prior), -inf outside."""
+        d = np.abs(wrap_angle(poses[:, 2] - self._yaw_lo))
+        return np.where(d <= self._yaw_hw, 0.0, -np.inf)
+
+    def log_likelihood(self, poses: np.ndarray, obs: Observation) -> np.ndarray:
+        """log P(M = m, S = s | A = a, O = pose) for every pose (N, 3)."""
+        rel = relative_planar_pose(obs.action[None, :], poses)
+        ll = self.models.log_likelihood(rel, obs.measurement)
+        if self.settings.use_outcome:
+            f = self.settings.outcome_floor
+            ps = np.clip(self.table.stability(rel), f, 1.0 - f)
+            ll = ll + np.log(ps if obs.stable else 1.0 - ps)
+        return ll
+
+    def log_posterior(self, poses: np.ndarray) -> np.ndarray:
+        """Unnormalised log posterior of poses (N, 3) under every observation so far."""
+        lp = self._log_prior(poses)
+        for obs in self.observations:
+            ok = np.isfinite(lp)
+            if ok.any():
+                lp[ok] += self.log_likelihood(poses[ok], obs)
+        return lp
+
+    # ---- interface ------------------------------------------------------------------------------
+    def plan(self) -> Plan:
+        t0 = time.perf_counter()
+        p = self._plan()
+        p.seconds = time.perf_counter() - t0
+        self._plans += 1
+        return p
+
+    def _plan(self) -> Plan:
+        raise NotImplementedError
+
+    def observe(self, action, measurement, stable: bool) -> None:
+        """Bayes update after executing ``action`` (world top grasp) and reading ``measurement``
+        (the phalanx joint angles the models predict) and whether the grasp was stable."""
+        a = np.asarray(action, dtype=float).ravel()
+        m = np.asarray(measurement, dtype=float).ravel()
+        if a.shape != (3,) or not np.all(np.isfinite(a)):
+            raise ValueError(f"action: expected (x, y, yaw), got {action}")
+        if m.shape != (self.models.n_joints,) or not np.all(np.isfinite(m)):
+            raise ValueError(f"measurement: expected {self.models.n_joints} finite joint angles, got {m.shape}")
+        obs = Observation(a, m, bool(stable))
+        self.observations.append(obs)
+        self._update(obs)
+        self.history.append({"action": a.tolist(), "measurement": m.tolist(), "stable": bool(stable),
+                             "mean": self.belief.mean().tolist(), "ess": float(self.belief.ess())})
+
+    def _update(self, obs: Observation) -> None:
+        s = self.settings
+        b = self.belief
+        b.reweight(self.log_likelihood(b.particles, obs))
+        b.resample("systematic")
+        if s.metropolis_steps > 0:
+            b.metropolis(self.log_posterior, np.asarray(s.metropolis_step, dtype=float), s.metropolis_steps)
+
+    # ---- the searches ---------------------------------------------------------------------------
+    def action_bounds(self, poses: Optional[np.ndarray] = None):
+        P = self.belief.particles if poses is None else poses
+        m = self.settings.action_margin
+        low = np.array([P[:, 0].min() - m, P[:, 1].min() - m, -np.pi])
+        high = np.array([P[:, 0].max() + m, P[:, 1].max() + m, np.pi])
+        return low, high
+
+    def _seed_actions(self, poses: np.ndarray, weights: np.ndarray, k: int) -> np.ndarray:
+        """k starting grasps: the model's best relative grasps placed at weighted-random particles."""
+        if not hasattr(self, "_best_rel"):
+            g = self.table.grid
+            nx, ny, nyaw, _ = g.shape
+            r = self.table.xy_range
+            xs, yaws = np.linspace(-r, r, nx), -np.pi + 2 * np.pi * np.arange(nyaw) / nyaw
+            X, Y, T = np.meshgrid(xs, xs, yaws, indexing="ij")
+            rel = np.column_stack([X.ravel(), Y.ravel(), T.ravel()])
+            ps = self.table.stability(rel)
+            self._best_rel = rel[np.argsort(-ps)[:64]]
+        j = self._rng.choice(len(poses), size=k, p=weights / weights.sum())
+        rel = self._best_rel[self._rng.integers(0, len(self._best_rel), k)]
+        o = poses[j]
+        c, s = np.cos(o[:, 2]), np.sin(o[:, 2])
+        return np.column_stack([o[:, 0] + c * rel[:, 0] - s * rel[:, 1], o[:, 1] + s * rel[:, 0] + c * rel[:, 1],
+                                wrap_angle(o[:, 2] + rel[:, 2])])
+
+    def maximise_stability(self, poses: np.ndarray, weights: np.ndarray):
+        """PSO over (x, y, yaw) of sum_j w_j P(S | A, O_j) (Eq. 3.1). Returns (action, value, nfev)."""
+        s = self.settings
+        low, high = self.action_bounds(poses)
+        w = np.asarray(weights, dtype=float)
+        init = np.clip(self._seed_actions(poses, w, s.pso_particles), low, high)
+
+        def negative(X):
+            return -self.table.expected_stability(X, poses, w, s.threads)
+
+        r = optim.pso(negative, (low, high), n_particles=s.pso_particles, max_iter=s.pso_iter,
+                      seed=int(self._rng.integers(2**31)), init=init)
+        return r.x, -r.fun, r.nfev
+
+    def expected_stability(self, action) -> float:
+        """The belief-weighted P(S) of one action."""
+        return float(self.table.expected_stability(np.asarray(action, float)[None, :], self.belief.particles,
+                                                   self.belief.weights, self.settings.threads)[0])
+
+    # ---- summaries ------------------------------------------------------------------------------
+    def mode(self) -> np.ndarray:
+        """The particle with the highest posterior density (ties: closest to the weighted mean)."""
+        P = self.belief.particles
+        lp = self.log_posterior(P) + self.belief.log_weights
+        best = np.flatnonzero(lp >= lp.max() - 1e-9)
+        if len(best) > 1:
+            mu = self.belief.mean()
+            d = np.hypot(P[best, 0] - mu[0], P[best, 1] - mu[1]) + 0.05 * np.abs(wrap_angle(P[best, 2] - mu[2]))
+            best = best[np.argsort(d)]
+        return P[best[0]].copy()
+
+    def summary(self, true_pose: Optional[Sequence[float]] = None) -> dict:
+        """The belief in numbers: mean, std per dim, ESS, KDE entropy, and errors to ``true_pose``."""
+        b = self.belief
+        P, w = b.particles, b.weights
+        mu = b.mean()
+        d = P - mu
+        d[:, 2] = wrap_angle(d[:, 2])
+        out = {"mean": mu.tolist(), "std": np.sqrt(np.maximum(w @ (d * d), 0.0)).tolist(), "ess": float(b.ess()),
+               "kde_entropy": float(b.kde_entropy())}
+        if true_pose is not None:
+            t = np.asarray(true_pose, dtype=float)
+            out["position_error"] = float(np.hypot(mu[0] - t[0], mu[1] - t[1]))
+            out["yaw_error"] = float(abs(wrap_angle(mu[2] - t[2])))
+        return out

@@ -1,0 +1,35 @@
+"""Baselines the thesis's planners are compared with.
+
+* :class:`MLPosePlanner` plans the maximally stable grasp for one pose only, the belief's most
+  probable particle (no marginalisation over the uncertainty), and updates the belief as the
+  other planners do.
+* :class:`OpenLoopPlanner` plans like the stability planner but never updates its belief: every
+  attempt is planned on the initial estimate (only the search's random seed changes).
+"""
+from __future__ import annotations
+
+import numpy as np
+
+from .base import Observation, Plan, Planner
+
+
+class MLPosePlanner(Planner):
+    method = "ml_pose"
+
+    def _plan(self) -> Plan:
+        pose = self.mode()
+        a, v, n = self.maximise_stability(pose[None, :], np.ones(1))
+        return Plan(action=a, kind="stability", predicted_stability=self.expected_stability(a), objective=v,
+                    evaluations=n)
+
+
+class OpenLoopPlanner(Planner):
+    method = "open_loop"
+
+    def _plan(self) -> Plan:
+        b = self.belief
+        a, v, n = self.maximise_stability(b.particles, b.weights)
+        return Plan(action=a, kind="stability", predicted_stability=v, objective=v, evaluations=n)
+
+    def _update(self, obs: Observation) -> None:
+        """No belief update: the measurement is recorded and ignored."""
