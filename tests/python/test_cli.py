@@ -47,8 +47,53 @@ def test_grasp_relative_to_the_object_pose_is_invariant():
     (["grasp", "--object", "cube", "--top", "0,0,nan"], "finite"),
     (["grasp", "--object", "cube", "--top", "0,0,0", "--object-pose", "5,0,0"], "table"),
     (["demo", "--out", "/proc/forbidden/dir"], "--out"),
+    (["plan", "--object", "no_such_thing", "--true-pose", "0,0,0"], "neither a built-in"),
+    (["plan", "--object", "cube", "--true-pose", "3,0,0"], "table"),
+    (["plan", "--object", "cube", "--true-pose", "0,0,0", "--attempts", "0"], "--attempts"),
+    (["experiment", "pub9"], "unknown experiment"),
+    (["experiment", "pub2", "--runs", "0"], "--runs"),
+    (["experiment", "pub2", "--workers", "0"], "--workers"),
+    (["experiment", "pub2", "--objects", "no_such_thing"], "neither a built-in"),
+    (["experiment", "pub2", "--out", "/proc/forbidden/dir"], "--out"),
 ])
 def test_bad_input_gives_a_message_and_exit_status_2(args, needle, capsys):
     assert main(args) == 2
     err = capsys.readouterr().err
     assert needle in err and "Traceback" not in err
+
+
+def test_plan_json_on_a_user_mesh_file(tmp_path):
+    # a user's own mesh: the built-in cube written to an STL file
+    import trimesh
+
+    w = World.single("cube", pose=(0.0, 0.0, 0.0))
+    path = tmp_path / "box.stl"
+    trimesh.Trimesh(w.object.vertices, w.object.faces).export(path)
+    code, out, err = run_cli("plan", "--object", str(path), "--true-pose", "0.02,-0.01,0.4", "--json",
+                             "--cache", str(tmp_path / "cache"), "--png", str(tmp_path / "belief.png"))
+    assert code == 0, err
+    r = json.loads(out)
+    assert isinstance(r["success"], bool) and 1 <= len(r["attempts"]) <= 4
+    for a in r["attempts"]:
+        assert a["plan_type"] in ("stability", "explore") and len(a["grasp"]) == 3
+        assert 0.0 <= a["predicted_stability"] <= 1.0 and a["outcome"] in ("stable", "unstable")
+        assert {"entropy", "epsilon", "lifted"} <= set(a)
+    assert r["attempts"][-1]["outcome"] == ("stable" if r["success"] else "unstable")
+    assert {"mean", "std", "entropy", "position_error"} <= set(r["final_belief"])
+    assert (tmp_path / "belief.png").stat().st_size > 1000
+
+
+def test_experiment_writes_tables_and_plots_and_resumes(tmp_path):
+    args = ["experiment", "pub2", "--objects", "cube", "--runs", "2", "--out", str(tmp_path / "e"),
+            "--cache", str(tmp_path / "cache"), "--no-lift"]
+    code, out, err = run_cli(*args)
+    assert code == 0, err
+    for f in ("summary.md", "summary.json", "stability.csv", "per_attempt.png", "belief_cube.png", "results.sqlite"):
+        assert (tmp_path / "e" / f).exists(), f
+    first = json.loads((tmp_path / "e" / "summary.json").read_text())
+    # one more run: the two stored runs are kept, only the third is computed
+    code, out, err = run_cli(*[a if a != "2" else "3" for a in args])
+    assert code == 0, err
+    assert "2/3" in err  # the progress bar starts at the stored runs
+    again = json.loads((tmp_path / "e" / "summary.json").read_text())
+    assert first["stability"]["runs"] == 2 and again["stability"]["runs"] == 3

@@ -22,6 +22,7 @@ RelativePoseGrid::RelativePoseGrid(std::array<double, 2> lo, std::array<double, 
   if (!values_.allFinite()) throw std::invalid_argument("grid: values contain NaN or infinity");
   if (outside_.size() != values_.cols())
     throw std::invalid_argument("grid: outside needs one value (or NaN) per channel");
+  channel_major_ = values_.cast<float>();
   sx_ = (nx - 1) / (hi[0] - lo[0]);
   sy_ = (ny - 1) / (hi[1] - lo[1]);
   syaw_ = nyaw / (2.0 * M_PI);
@@ -47,6 +48,17 @@ void RelativePoseGrid::at(double x, double y, double yaw, int c0, int nc, double
                      base11 = base10 + nyaw_;
   const Eigen::Index rows[8] = {base00 + k, base00 + k1, base01 + k, base01 + k1,
                                 base10 + k, base10 + k1, base11 + k, base11 + k1};
+  if (nc == 1) {
+    if (!in && !std::isnan(outside_[c0])) {
+      *out = outside_[c0];
+      return;
+    }
+    const float* col = channel_major_.col(c0).data();
+    double s = 0.0;
+    for (int q = 0; q < 8; ++q) s += w[q] * col[rows[q]];
+    *out = s;
+    return;
+  }
   for (int c = 0; c < nc; ++c) {
     const int ch = c0 + c;
     if (!in && !std::isnan(outside_[ch])) {

@@ -96,7 +96,7 @@ def plot_per_attempt(tables: Dict[str, List[dict]], path: Path, title: str) -> P
     """Success, predicted stability, epsilon, pose error and entropy vs attempt, one line per
     method (averaged over objects) or per object when there is one method."""
     plt = _mpl()
-    fields = [("success", "success rate (stable by attempt)"), ("predicted_stability", "predicted P(S)"),
+    fields = [("success", "stable by attempt (dashed: lifted)"), ("predicted_stability", "predicted P(S)"),
               ("epsilon", "epsilon"), ("position_error_cm", "posterior mean error (cm)"),
               ("entropy", "belief entropy (KDE, nats)")]
     fig, axes = plt.subplots(1, len(fields), figsize=(4.0 * len(fields), 3.4))
@@ -110,8 +110,11 @@ def plot_per_attempt(tables: Dict[str, List[dict]], path: Path, title: str) -> P
             lines[method] = [r for r in rows if r["object"] == "mean"]
     for ax, (f, label) in zip(axes, fields):
         for name, rs in lines.items():
-            ax.plot([r["attempt"] for r in rs], [r[f] for r in rs], marker="o", label=name,
-                    lw=2.5 if name == "mean" else 1.5)
+            (ln,) = ax.plot([r["attempt"] for r in rs], [r[f] for r in rs], marker="o", label=name,
+                            lw=2.5 if name == "mean" else 1.5)
+            if f == "success":  # dashed: also held in the physical lift test
+                ax.plot([r["attempt"] for r in rs], [r["lifted"] for r in rs], ls="--", marker=".",
+                        color=ln.get_color(), lw=1.0)
         ax.set_xlabel("attempt")
         ax.set_title(label, fontsize=10)
         ax.set_xticks(range(1, ATTEMPTS + 1))
@@ -258,11 +261,16 @@ def write(name: str, results: Dict[str, list], out: Path) -> dict:
             rs = [r for k, r in res if k.object == obj]
             rows.append({"object": obj, "runs": len(rs), "order_kept": float(np.mean([r["order_kept"] for r in rs])),
                          "best_below_worst": float(np.mean([r["best_below_worst"] for r in rs])),
-                         "kendall_tau": float(np.mean([r["kendall_tau"] for r in rs]))})
+                         "kendall_tau": float(np.mean([r["kendall_tau"] for r in rs])),
+                         **{f"realised_{k}": float(np.mean([r["realised"][k] for r in rs])) for k in ("best", "good", "worst")},
+                         **{f"predicted_{k}": float(np.mean([r["predicted"][k] for r in rs])) for k in ("best", "good", "worst")}})
         _write_csv(rows, out / "entropy_order.csv")
-        md += [_markdown(rows, ("object", "runs", "order_kept", "best_below_worst", "kendall_tau")), "",
+        md += [_markdown(rows, ("object", "runs", "order_kept", "best_below_worst", "kendall_tau", "predicted_best",
+                                "predicted_good", "predicted_worst", "realised_best", "realised_good", "realised_worst")), "",
                "order_kept: the realised entropies of the best, good and worst predicted grasps are in the "
-               "predicted order (chance: 1/6); kendall_tau: rank agreement of the three.", ""]
+               "predicted order (chance: 1/6); best_below_worst: the best grasp's realised entropy is below the "
+               "worst's (chance: 1/2); kendall_tau: rank agreement of the three; predicted_* / realised_*: mean "
+               "expected and realised posterior weight entropies (nats; the prior's is log 500 = 6.21).", ""]
         summary["rows"] = rows
         for obj in sorted({k.object for k, _ in res}):
             r0 = next(r for k, r in res if k.object == obj)

@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import hashlib
 import json
+import multiprocessing
 import sqlite3
 import sys
 from concurrent.futures import FIRST_COMPLETED, ProcessPoolExecutor, wait
@@ -96,7 +97,9 @@ def run_experiment(experiment: str, objects: Iterable[str], runs: int, fn: Calla
                 store.add(key, fn(key.experiment, key.object, key.run_index, key.seed))
                 bar.update()
         else:
-            with ProcessPoolExecutor(max_workers=workers) as pool:
+            # spawn, not fork: a forked child inherits OpenMP's thread pool in a broken state
+            # (the parent has run parallel C++ batches) and hangs in its first parallel region
+            with ProcessPoolExecutor(max_workers=workers, mp_context=multiprocessing.get_context("spawn")) as pool:
                 pending = {pool.submit(_call, fn, k) for k in todo}
                 try:
                     while pending:

@@ -174,7 +174,23 @@ class ModelTable:
         outside = np.full(1 + 2 * k, np.nan)
         outside[0] = 0.0
         grid = _core.belief.RelativePoseGrid(np.array([-r, -r]), np.array([r, r]), nx, nx, nyaw, values, outside)
-        return cls(grid, k, r)
+        table = cls(grid, k, r)
+        table.best_relative_grasps(64)  # the planners' PSO seeds, found once with the table
+        return table
+
+    def best_relative_grasps(self, k: int = 64) -> np.ndarray:
+        """The k grid nodes with the highest P(S) (k, 3), best first (computed once per table)."""
+        cached = getattr(self, "_best", None)
+        if cached is None or len(cached) < k:
+            r = self.xy_range
+            nx, ny, nyaw, _ = self.grid.shape
+            xs, ys, yaws = np.linspace(-r, r, nx), np.linspace(-r, r, ny), -np.pi + 2 * np.pi * np.arange(nyaw) / nyaw
+            X, Y, T = np.meshgrid(xs, ys, yaws, indexing="ij")
+            rel = np.column_stack([X.ravel(), Y.ravel(), T.ravel()])
+            ps = self.stability(rel)
+            top = np.argpartition(-ps, k - 1)[:k]
+            cached = self._best = rel[top[np.argsort(-ps[top])]]
+        return cached[:k]
 
     def stability(self, rel) -> np.ndarray:
         """P(S) at relative grasps (P, 3)."""

@@ -199,17 +199,9 @@ class Planner:
 
     def _seed_actions(self, poses: np.ndarray, weights: np.ndarray, k: int) -> np.ndarray:
         """k starting grasps: the model's best relative grasps placed at weighted-random particles."""
-        if not hasattr(self, "_best_rel"):
-            g = self.table.grid
-            nx, ny, nyaw, _ = g.shape
-            r = self.table.xy_range
-            xs, yaws = np.linspace(-r, r, nx), -np.pi + 2 * np.pi * np.arange(nyaw) / nyaw
-            X, Y, T = np.meshgrid(xs, xs, yaws, indexing="ij")
-            rel = np.column_stack([X.ravel(), Y.ravel(), T.ravel()])
-            ps = self.table.stability(rel)
-            self._best_rel = rel[np.argsort(-ps)[:64]]
+        best = self.table.best_relative_grasps(64)
         j = self._rng.choice(len(poses), size=k, p=weights / weights.sum())
-        rel = self._best_rel[self._rng.integers(0, len(self._best_rel), k)]
+        rel = best[self._rng.integers(0, len(best), k)]
         o = poses[j]
         c, s = np.cos(o[:, 2]), np.sin(o[:, 2])
         return np.column_stack([o[:, 0] + c * rel[:, 0] - s * rel[:, 1], o[:, 1] + s * rel[:, 0] + c * rel[:, 1],
