@@ -3,12 +3,19 @@
 //  * BoxOpen:  the same box, open hand - the box stays on the table, early exit.
 //  * CupHeld:  a concave cup (outer radius 4 cm, wall 4 mm, 10 cm tall, 64 segments,
 //              512 triangles) held on its outer wall - full script; with the Auto shape
-//              (fingers outside the hull -> hull) and forced Tetrahedra.
+//              (fingers outside the hull -> hull), forced Tetrahedra and forced
+//              Decomposition (17 convex pieces derived by hand: 16 wall sectors + floor).
+//  * PotPinch: a pot (outer radius 6 cm, 4 mm wall, 12 cm tall, 512 triangles) whose wall is
+//              pinched by finger 3 inside (through the opening) and fingers 1, 2 outside -
+//              the case that needs a concave shape: Tetrahedra, and Auto with the
+//              17-piece decomposition (Auto picks it, finger 3 is inside the hull).
 // Each iteration is one LiftTester::run (its own Bullet world: set-up + simulation); the
 // per-object preprocessing (mass properties, hull / tetrahedra) is done once, outside.
 #include <benchmark/benchmark.h>
 
+#include <algorithm>
 #include <cmath>
+#include <vector>
 
 #include "bayesgrasp/physics/lift_test.hpp"
 
@@ -63,11 +70,37 @@ TriMesh cup_mesh(double R, double r, double h, double t, int n) {
   return m;
 }
 
+// Hand-made convex decomposition of cup_mesh(R, r, h, t, n) centred at c: n / per wall
+// sectors (hull of their outer and inner ring points at z = 0 and h) and the floor.
+std::vector<Eigen::MatrixX3d> cup_pieces(double R, double r, double h, double t, int n, int per, const Vec3& c) {
+  std::vector<Eigen::MatrixX3d> out;
+  auto pt = [&](double rad, int i, double z) {
+    const double a = 2 * M_PI * i / n;
+    return Eigen::RowVector3d(c.x() + rad * std::cos(a), c.y() + rad * std::sin(a), z);
+  };
+  for (int s = 0; s < n / per; ++s) {
+    Eigen::MatrixX3d P(4 * (per + 1), 3);
+    int k = 0;
+    for (int i = s * per; i <= (s + 1) * per; ++i)
+      for (double rad : {R, r})
+        for (double z : {0.0, h}) P.row(k++) = pt(rad, i % n, z);
+    out.push_back(P);
+  }
+  Eigen::MatrixX3d floor(2 * n, 3);
+  for (int i = 0; i < n; ++i) {
+    floor.row(i) = pt(R, i, 0.0);
+    floor.row(n + i) = pt(r, i, t);
+  }
+  out.push_back(floor);
+  return out;
+}
+
 // Closes the fingers (coupled law) until each is within 0.1 mm of `dist` (a signed distance
 // of a point to the object): scan, then bisect. Capsules sampled densely.
 template <class Dist>
-Eigen::VectorXd touch(const HandModel& hand, const Iso3& T, Dist dist) {
+Eigen::VectorXd touch(const HandModel& hand, const Iso3& T, Dist dist, Eigen::VectorXd start = {}) {
   Eigen::VectorXd t = Eigen::VectorXd::Zero(static_cast<Eigen::Index>(hand.fingers().size()));
+  if (start.size() == 0) start = t;
   for (int f = 0; f < static_cast<int>(hand.fingers().size()); ++f) {
     auto d = [&](double tf) {
       Eigen::VectorXd tt = t;
@@ -80,7 +113,7 @@ Eigen::VectorXd touch(const HandModel& hand, const Iso3& T, Dist dist) {
             best = std::min(best, dist(Vec3(poses[ph.link] * (s.p0 + (s.p1 - s.p0) * (k / 200.0)))) - s.radius);
       return best;
     };
-    double a = 0, b = 0;
+    double a = start[f], b = start[f];
     while (b < hand.fingers()[f].t_max() && d(b) > 0) {
       a = b;
       b += 0.01;
@@ -138,7 +171,7 @@ void cup_bench(benchmark::State& state, LiftOptions::Shape shape) {
   LiftOptions o;
   o.density = 1000.0;
   o.shape = shape;
-  const LiftTester tester(hand, cup, o);
+  const LiftTester tester(hand, cup, o, cup_pieces(0.04, 0.036, 0.10, 0.008, 64, 4, Vec3::Zero()));
   // Distance to the outer wall (the fingers close on it from outside).
   auto cup_dist = [](const Vec3& p) {
     const double rr = std::hypot(p.x(), p.y());
@@ -150,7 +183,45 @@ void cup_bench(benchmark::State& state, LiftOptions::Shape shape) {
   run_bench(state, tester, pose, touch(hand, pose, cup_dist));
 }
 
+// The pot of tests/cpp/test_physics.cpp (PhysicsLiftConcave), centre 5.8 cm along +y.
+void pot_bench(benchmark::State& state, LiftOptions::Shape shape, bool pieces) {
+  const HandModel hand = barrett();
+  const double R = 0.06, r = 0.056, h = 0.12, t = 0.008;
+  const Vec3 c(0.0, 0.058, 0.0);
+  // cup_mesh is centred at the origin: shift it.
+  TriMesh pot = cup_mesh(R, r, h, t, 64);
+  pot.V.rowwise() += c.transpose();
+  const Iso3 pose = HandModel::top_grasp_pose(0, 0, 0, h + 0.015);
+  LiftOptions o;
+  o.density = 100.0;
+  o.shape = shape;
+  const LiftTester tester(hand, pot, o,
+                          pieces ? cup_pieces(R, r, h, t, 64, 4, c) : std::vector<Eigen::MatrixX3d>{});
+  auto pot_dist = [&](const Vec3& p) {  // signed distance to the wall or the floor (rho, z)
+    const double rho = std::hypot(p.x() - c.x(), p.y() - c.y());
+    auto rect = [&](double r0, double r1, double z0, double z1) {
+      const double dx = std::max({r0 - rho, rho - r1, 0.0}), dz = std::max({z0 - p.z(), p.z() - z1, 0.0});
+      if (dx == 0 && dz == 0) return -std::min({rho - r0, r1 - rho, p.z() - z0, z1 - p.z()});
+      return std::hypot(dx, dz);
+    };
+    return std::min(rect(r, R, 0, h), rect(0, R, 0, t));
+  };
+  // Finger 3 from 60 deg (hanging inside the pot) to the inner wall, then fingers 1, 2.
+  Eigen::VectorXd start = Eigen::VectorXd::Zero(3);
+  start[2] = M_PI / 3;
+  Eigen::VectorXd q = touch(hand, pose, pot_dist, start);
+  const LiftResult r0 = tester.run(pose, q);
+  state.counters["tetrahedra"] = r0.tetrahedra;
+  state.counters["decomposition"] = r0.shape == LiftOptions::Shape::Decomposition;
+  state.counters["height_gain_m"] = r0.height_gain;
+  run_bench(state, tester, pose, q);
+}
+
 }  // namespace
+
+void BM_LiftCupHeldDecomposition(benchmark::State& state) { cup_bench(state, LiftOptions::Shape::Decomposition); }
+void BM_LiftPotPinchTetrahedra(benchmark::State& state) { pot_bench(state, LiftOptions::Shape::Tetrahedra, false); }
+void BM_LiftPotPinchDecomposition(benchmark::State& state) { pot_bench(state, LiftOptions::Shape::Auto, true); }
 
 void BM_LiftCupHeldTetrahedra(benchmark::State& state) { cup_bench(state, LiftOptions::Shape::Tetrahedra); }
 // Auto: the fingers stay outside the cup's hull, so the hull is used.
@@ -160,5 +231,8 @@ BENCHMARK(BM_LiftBoxHeld)->Unit(benchmark::kMillisecond)->MinTime(2.0);
 BENCHMARK(BM_LiftBoxOpen)->Unit(benchmark::kMillisecond)->MinTime(1.0);
 BENCHMARK(BM_LiftCupHeldAuto)->Unit(benchmark::kMillisecond)->MinTime(2.0);
 BENCHMARK(BM_LiftCupHeldTetrahedra)->Unit(benchmark::kMillisecond)->MinTime(2.0);
+BENCHMARK(BM_LiftCupHeldDecomposition)->Unit(benchmark::kMillisecond)->MinTime(2.0);
+BENCHMARK(BM_LiftPotPinchTetrahedra)->Unit(benchmark::kMillisecond)->MinTime(2.0);
+BENCHMARK(BM_LiftPotPinchDecomposition)->Unit(benchmark::kMillisecond)->MinTime(2.0);
 
 BENCHMARK_MAIN();

@@ -33,6 +33,7 @@ std::string shape_name(LiftOptions::Shape s) {
     case LiftOptions::Shape::Auto: return "auto";
     case LiftOptions::Shape::ConvexHull: return "hull";
     case LiftOptions::Shape::Tetrahedra: return "tetrahedra";
+    case LiftOptions::Shape::Decomposition: return "decomposition";
   }
   return "auto";
 }
@@ -41,7 +42,8 @@ LiftOptions::Shape shape_from(const std::string& s) {
   if (s == "auto") return LiftOptions::Shape::Auto;
   if (s == "hull") return LiftOptions::Shape::ConvexHull;
   if (s == "tetrahedra") return LiftOptions::Shape::Tetrahedra;
-  throw py::value_error("shape: expected 'auto', 'hull' or 'tetrahedra', got '" + s + "'");
+  if (s == "decomposition") return LiftOptions::Shape::Decomposition;
+  throw py::value_error("shape: expected 'auto', 'hull', 'tetrahedra' or 'decomposition', got '" + s + "'");
 }
 
 py::dict result_dict(const LiftResult& r) {
@@ -54,16 +56,41 @@ py::dict result_dict(const LiftResult& r) {
   d["finite"] = r.finite;
   d["steps"] = r.steps;
   d["tetrahedra"] = r.tetrahedra;
+  d["shape"] = shape_name(r.shape);
   return d;
 }
 
 // std::invalid_argument from the core already becomes ValueError (pybind11's default
 // translation); its messages name the argument.
+// convex_pieces: None or a sequence of (K, 3) float arrays (K >= 4, finite).
+std::vector<Eigen::MatrixX3d> pieces_arg(const py::object& pieces) {
+  std::vector<Eigen::MatrixX3d> out;
+  if (pieces.is_none()) return out;
+  if (py::isinstance<py::str>(pieces) || !py::isinstance<py::sequence>(pieces))
+    throw py::value_error("convex_pieces: expected None or a sequence of (K, 3) arrays");
+  const py::sequence seq = pieces.cast<py::sequence>();
+  for (size_t i = 0; i < seq.size(); ++i) {
+    const std::string name = "convex_pieces[" + std::to_string(i) + "]";
+    DArray a;
+    try {
+      a = seq[i].cast<DArray>();
+    } catch (const py::cast_error&) {
+      throw py::value_error(name + ": expected a (K, 3) float array");
+    }
+    const RowMatrixXd m = matrix(a, name.c_str(), 3);
+    if (m.rows() < 4) throw py::value_error(name + ": needs at least 4 points, got " + std::to_string(m.rows()));
+    out.emplace_back(m);
+  }
+  return out;
+}
+
 std::unique_ptr<LiftTester> make_tester(const py::handle& hand, const DArray& vertices, const IArray& faces,
-                                        const LiftOptions& options) {
+                                        const LiftOptions& options, const py::object& convex_pieces) {
   const HandModel h = hand_arg(hand);
   const TriMesh mesh = bind::mesh(vertices, faces, "object");
-  return std::make_unique<LiftTester>(h, mesh, options);
+  const std::vector<Eigen::MatrixX3d> pieces = pieces_arg(convex_pieces);
+  py::gil_scoped_release release;  // the tetrahedra's ray casts take a while on big meshes
+  return std::make_unique<LiftTester>(h, mesh, options, pieces);
 }
 
 }  // namespace
@@ -92,7 +119,7 @@ void bind_physics(py::module_& m) {
       .def_property(
           "shape", [](const LiftOptions& o) { return shape_name(o.shape); },
           [](LiftOptions& o, const std::string& s) { o.shape = shape_from(s); },
-          "object collision shape: 'auto', 'hull' or 'tetrahedra'")
+          "object collision shape: 'auto', 'hull', 'tetrahedra' or 'decomposition' (needs convex pieces)")
       .def_readwrite("tet_depth", &LiftOptions::tet_depth, "m, depth of the tetrahedra skin")
       .def_readwrite("margin", &LiftOptions::margin, "m, collision margin");
 
@@ -102,17 +129,25 @@ Args:
     hand: path to a hand JSON file (or a HandModel).
     vertices: (N, 3) object vertices in the world frame (m).
     faces: (M, 3) int triangles, counter-clockwise seen from outside.
-    options: LiftOptions (defaults if None).)doc")
-      .def(py::init([](const py::handle& hand, const DArray& vertices, const IArray& faces, const py::object& options) {
+    options: LiftOptions (defaults if None).
+    convex_pieces: None or a list of (K, 3) point arrays in the world frame, an approximate
+        convex decomposition of the object (each piece's convex hull is used): needed by
+        shape 'decomposition', used by 'auto' for concave objects instead of the tetrahedra.)doc")
+      .def(py::init([](const py::handle& hand, const DArray& vertices, const IArray& faces, const py::object& options,
+                       const py::object& convex_pieces) {
              const LiftOptions o = options.is_none() ? LiftOptions{} : options.cast<LiftOptions>();
-             return make_tester(hand, vertices, faces, o);
+             return make_tester(hand, vertices, faces, o, convex_pieces);
            }),
-           py::arg("hand"), py::arg("vertices"), py::arg("faces"), py::arg("options") = py::none())
+           py::arg("hand"), py::arg("vertices"), py::arg("faces"), py::arg("options") = py::none(),
+           py::arg("convex_pieces") = py::none())
       .def_property_readonly("mass", [](const LiftTester& t) { return t.mass_properties().mass; }, "object mass, kg")
       .def_property_readonly("com", [](const LiftTester& t) { return Eigen::Vector3d(t.mass_properties().com); },
                              "object centre of mass (world)")
       .def_property_readonly("shape", [](const LiftTester& t) { return shape_name(t.shape()); },
-                             "collision shape used: 'hull' or 'tetrahedra'")
+                             "collision shape prepared: 'hull', 'tetrahedra' or 'decomposition'")
+      .def_property_readonly("concave", &LiftTester::concave,
+                             "the object's hull volume is more than 5% above its volume")
+      .def_property_readonly("num_pieces", &LiftTester::num_pieces, "convex pieces kept (0 without a decomposition)")
       .def(
           "run",
           [](const LiftTester& t, const DArray& hand_pose, const DArray& joints) {
@@ -129,7 +164,7 @@ Args:
           R"doc(One lift test. hand_pose: (4, 4) world pose of the hand; joints: (J,) closed joint
 angles (HandModel layout). Returns a dict: lifted, displacement (m), rotation (rad),
 squeeze_displacement (m), height_gain (m), finite, steps, tetrahedra (the object used the
-tetrahedra shape, else its hull).)doc")
+tetrahedra shape), shape (the shape used: 'hull', 'tetrahedra' or 'decomposition').)doc")
       .def(
           "run_batch",
           [](const LiftTester& t, const DArray& hand_poses, const DArray& joints, int threads) {
@@ -164,7 +199,10 @@ tetrahedra shape, else its hull).)doc")
               rot.mutable_data()[i] = r.rotation;
               gain.mutable_data()[i] = r.height_gain;
             }
+            py::list shapes;
+            for (const LiftResult& r : rs) shapes.append(shape_name(r.shape));
             py::dict d;
+            d["shape"] = shapes;
             d["lifted"] = lifted;
             d["displacement"] = disp;
             d["rotation"] = rot;
@@ -174,7 +212,8 @@ tetrahedra shape, else its hull).)doc")
           py::arg("hand_poses"), py::arg("joints"), py::arg("threads") = 1,
           R"doc(N lift tests in ``threads`` threads (<= 0: all cores), each with its own Bullet
 world; GIL released. hand_poses: (N, 4, 4); joints: (N, J). Returns a dict of (N,) arrays:
-lifted, displacement, rotation, height_gain - equal to ``run`` one by one.)doc");
+lifted, displacement, rotation, height_gain - equal to ``run`` one by one - and shape (list
+of the shapes used).)doc");
 }
 
 }  // namespace bayesgrasp::bind

@@ -10,16 +10,26 @@ centre of mass moved less than 2 cm relative to the palm (after the squeeze)::
     r["lifted"], r["displacement"]
 
 ``LiftTester`` keeps the object's preprocessing for many tests (``run``, ``run_batch``).
+
+Concave objects (a mug, a pitcher) need a concave collision shape when the hand reaches into
+a concavity (the opening, the handle's hole). ``shape="auto"`` (default) then uses an
+approximate convex decomposition of the mesh - a compound of a few dozen convex hulls,
+computed once per mesh by CoACD (:func:`convex_decomposition`, cached as ``.npz``) - instead
+of one tetrahedron per triangle (``shape="tetrahedra"``, ~40x slower; see BENCHMARKS.md).
 """
 from __future__ import annotations
 
+import hashlib
 import os
+from pathlib import Path
+from typing import List, Optional, Sequence, Union
 
 import numpy as np
 
 from bayesgrasp import _core
 
-__all__ = ["BARRETT_HAND", "LiftOptions", "LiftTester", "lift_test", "lift_test_batch", "make_options"]
+__all__ = ["BARRETT_HAND", "LiftOptions", "LiftTester", "convex_decomposition", "decomposition_cache_dir",
+           "is_concave", "lift_test", "lift_test_batch", "make_options"]
 
 #: Path of the built-in Barrett BH8 hand file.
 BARRETT_HAND = os.path.join(os.path.dirname(__file__), "data", "hands", "barrett_bh8.json")
@@ -41,18 +51,113 @@ def _hand(hand):
     return BARRETT_HAND if hand is None else hand
 
 
+def decomposition_cache_dir() -> Path:
+    """Where :func:`convex_decomposition` keeps its results: ``$BAYESGRASP_CACHE_DIR`` (or
+    ``~/.cache/bayesgrasp``) / ``convex_decomposition``."""
+    root = os.environ.get("BAYESGRASP_CACHE_DIR") or os.path.join(os.path.expanduser("~"), ".cache", "bayesgrasp")
+    return Path(root) / "convex_decomposition"
+
+
+def convex_decomposition(vertices, faces, threshold: float = 0.05, seed: int = 0,
+                         cache_dir: Union[str, os.PathLike, None, bool] = None) -> List[np.ndarray]:
+    """Approximate convex decomposition of a closed triangle mesh (CoACD), cached per mesh.
+
+    Args:
+        vertices: (N, 3) float vertices (m). faces: (M, 3) int triangles.
+        threshold: CoACD's concavity threshold (smaller: more, tighter pieces). 0.05 (CoACD's
+            default) cuts the built-in mug into ~25 pieces that keep its opening and handle.
+        seed: CoACD's random seed (same mesh and seed give the same pieces).
+        cache_dir: directory of the ``.npz`` cache (None: :func:`decomposition_cache_dir`;
+            False: no cache). The key is a SHA-256 of the mesh's bytes and the parameters, so
+            a changed mesh is decomposed again.
+
+    Returns:
+        list of (K_i, 3) float64 arrays: the vertices of each convex piece, in the mesh's frame.
+    """
+    V = np.ascontiguousarray(vertices, dtype=np.float64)
+    F = np.ascontiguousarray(faces, dtype=np.int64)
+    if V.ndim != 2 or V.shape[1] != 3 or len(V) < 4:
+        raise ValueError(f"vertices: expected shape (N, 3) with N >= 4, got {V.shape}")
+    if not np.all(np.isfinite(V)):
+        raise ValueError("vertices: contain NaN or infinity")
+    if F.ndim != 2 or F.shape[1] != 3 or len(F) < 4:
+        raise ValueError(f"faces: expected shape (M, 3) with M >= 4, got {F.shape}")
+    if F.min() < 0 or F.max() >= len(V):
+        raise ValueError(f"faces: indices must be in [0, {len(V)}), got [{F.min()}, {F.max()}]")
+    if not (np.isfinite(threshold) and 0 < threshold <= 1):
+        raise ValueError(f"threshold: must be in (0, 1], got {threshold}")
+    import coacd  # only needed here
+
+    path = None
+    if cache_dir is not False:
+        h = hashlib.sha256()
+        h.update(V.tobytes())
+        h.update(F.astype(np.int32).tobytes())
+        h.update(f"coacd-{_coacd_version()}-t{threshold!r}-s{int(seed)}".encode())
+        path = Path(decomposition_cache_dir() if cache_dir is None else cache_dir) / f"{h.hexdigest()[:32]}.npz"
+        if path.exists():
+            with np.load(path, allow_pickle=False) as z:
+                return [np.array(z[f"piece_{i}"], dtype=np.float64) for i in range(int(z["count"]))]
+    coacd.set_log_level("error")
+    parts = coacd.run_coacd(coacd.Mesh(V, F.astype(np.int32)), threshold=float(threshold), seed=int(seed))
+    pieces = [np.ascontiguousarray(p[0], dtype=np.float64) for p in parts if len(p[0]) >= 4]
+    if not pieces:
+        raise ValueError("vertices, faces: CoACD found no convex piece (does the mesh enclose a volume?)")
+    if path is not None:
+        path.parent.mkdir(parents=True, exist_ok=True)
+        tmp = path.with_name(path.stem + f".{os.getpid()}.tmp.npz")
+        np.savez(tmp, count=len(pieces), **{f"piece_{i}": p for i, p in enumerate(pieces)})
+        os.replace(tmp, path)  # atomic: concurrent runs never read a half-written file
+    return pieces
+
+
+def is_concave(vertices, faces, hand=None) -> bool:
+    """Whether the lift test counts the object as concave (its convex hull's volume more than
+    5% above its own): then ``shape="auto"`` needs a convex decomposition."""
+    o = make_options(shape="hull")  # cheap: no tetrahedra, no pieces
+    return _core.physics.LiftTester(_hand(hand), np.asarray(vertices, dtype=float), np.asarray(faces), o).concave
+
+
+def _coacd_version() -> str:
+    try:
+        from importlib.metadata import version
+        return version("coacd")
+    except Exception:  # noqa: BLE001 - the version only salts the cache key
+        return "unknown"
+
+
 class LiftTester:
     """Lift tests of one object (V, F in the world frame) with one hand.
 
     Args:
         hand: path to a hand JSON file (None: the built-in Barrett hand) or a HandModel.
         vertices: (N, 3) object vertices (m). faces: (M, 3) int triangles.
+        convex_pieces: the object's convex decomposition for shapes ``auto`` (concave objects)
+            and ``decomposition``: a list of (K, 3) point arrays in the world frame, or None to
+            compute it with :func:`convex_decomposition` (cached) when needed.
         **options: LiftOptions fields (mu, density, table, shape, time_step, ...).
     """
 
-    def __init__(self, hand, vertices, faces, **options):
-        self._t = _core.physics.LiftTester(_hand(hand), np.asarray(vertices, dtype=float),
-                                           np.asarray(faces), make_options(**options))
+    def __init__(self, hand, vertices, faces, convex_pieces: Optional[Sequence] = None, **options):
+        V, F = np.asarray(vertices, dtype=float), np.asarray(faces)
+        o = make_options(**options)
+        if convex_pieces is None and o.shape in ("auto", "decomposition"):
+            if o.shape == "decomposition" or is_concave(V, F, hand):
+                convex_pieces = convex_decomposition(V, F)
+        elif convex_pieces is not None and (isinstance(convex_pieces, (str, bytes, np.ndarray))
+                                            or not isinstance(convex_pieces, Sequence)):
+            raise ValueError("convex_pieces: expected None or a list of (K, 3) arrays")
+        self._t = _core.physics.LiftTester(_hand(hand), V, F, o, convex_pieces)
+
+    @property
+    def concave(self) -> bool:
+        """The object's hull volume is more than 5% above its volume."""
+        return self._t.concave
+
+    @property
+    def num_pieces(self) -> int:
+        """Convex pieces of the decomposition in use (0: none)."""
+        return self._t.num_pieces
 
     @property
     def mass(self) -> float:
@@ -60,15 +165,18 @@ class LiftTester:
 
     @property
     def shape(self) -> str:
+        """Shape prepared: 'hull', 'tetrahedra' or 'decomposition' (auto on a concave object
+        still uses the hull for grasps that stay outside it; see the results' ``shape``)."""
         return self._t.shape
 
     def run(self, hand_pose, joints) -> dict:
         """One lift test; returns a dict (lifted, displacement, rotation, squeeze_displacement,
-        height_gain, finite, steps)."""
+        height_gain, finite, steps, tetrahedra, shape)."""
         return self._t.run(np.asarray(hand_pose, dtype=float), np.asarray(joints, dtype=float))
 
     def run_batch(self, hand_poses, joints, threads=1) -> dict:
-        """N lift tests ((N, 4, 4) poses, (N, J) joints) in C++ threads; dict of (N,) arrays."""
+        """N lift tests ((N, 4, 4) poses, (N, J) joints) in C++ threads; dict of (N,) arrays
+        (and ``shape``, the list of shapes used)."""
         return self._t.run_batch(np.asarray(hand_poses, dtype=float), np.asarray(joints, dtype=float),
                                  int(threads))
 

@@ -48,6 +48,7 @@ def test_tester_batch_equals_single_runs():
 
 
 def test_options_and_shapes():
+    assert physics.make_options(shape="decomposition").shape == "decomposition"
     o = physics.make_options(mu=0.3, shape="tetrahedra", table=False)
     assert (o.mu, o.shape, o.table) == (0.3, "tetrahedra", False)
     with pytest.raises(ValueError, match="not_an_option"):
@@ -81,3 +82,118 @@ def test_bad_hand_type_and_batch_shapes():
         t.run_batch(np.eye(4), OPEN[None])
     with pytest.raises(ValueError, match="joints"):
         t.run_batch(np.stack([POSE, POSE]), OPEN[None])
+
+
+# ---- concave objects: the convex decomposition ------------------------------------------------
+
+def _in_any_piece(pieces, pt):
+    from scipy.spatial import Delaunay
+    return any(Delaunay(p).find_simplex(np.asarray(pt)) >= 0 for p in pieces)
+
+
+@pytest.fixture(scope="module")
+def mug():
+    """The built-in mug in its object frame (centred on its xy bounding box: body centre at
+    x = -0.0175, radius 4 cm; handle on +x out to x = 0.0575) and its CoACD pieces (computed
+    once, then read from the cache)."""
+    from bayesgrasp.objects import Scene
+    s = Scene()
+    o = s.canonical_object(s.add_object("mug", 0.0, 0.0, 0.0))
+    return o, physics.convex_decomposition(o.vertices, o.faces)
+
+
+def test_mug_decomposition_is_convex_covers_the_mug_and_keeps_its_concavities(mug):
+    import trimesh
+    o, pieces = mug
+    assert 5 <= len(pieces) <= 60
+    hulls = [trimesh.Trimesh(p).convex_hull for p in pieces]
+    assert all(h.volume > 0 for h in hulls)
+    # Convex: every piece's points are on its hull (none inside, no dent).
+    for p, h in zip(pieces, hulls):
+        faces_n = h.face_normals
+        off = np.einsum("ij,ij->i", faces_n, h.triangles[:, 0])
+        gap = np.min(off[None, :] - p @ faces_n.T, axis=1)  # distance inside the hull, per point
+        assert np.all(gap < 1e-7)
+    m = trimesh.Trimesh(o.vertices, o.faces)
+    union = trimesh.boolean.union(hulls, engine="manifold")
+    inside = trimesh.boolean.intersection([union, m], engine="manifold").volume
+    assert inside / m.volume > 0.97  # the pieces cover the mug's volume
+    assert (union.volume - inside) / m.volume < 0.3  # and add little outside it (hull bulges)
+    # The opening and the handle's hole stay open.
+    assert not _in_any_piece(pieces, (-0.0175, 0.0, 0.06))
+    assert not _in_any_piece(pieces, (-0.0175, 0.0, 0.03))
+    assert not _in_any_piece(pieces, (0.035, 0.0, 0.0475))
+    assert _in_any_piece(pieces, (-0.0175 + 0.038, 0.0, 0.05))  # in the wall
+
+
+def test_decomposition_cache(tmp_path):
+    # An L-shaped block (two boxes sharing a face): concave, decomposed in well under a second.
+    L = np.array([[0, 0, 0], [0.06, 0, 0], [0.06, 0.02, 0], [0.02, 0.02, 0], [0.02, 0.06, 0], [0, 0.06, 0]], float)
+    Vs = np.vstack([L, L + [0, 0, 0.02]])
+    n = 6
+    F = [[0, 2, 1], [0, 3, 2], [0, 5, 3], [3, 5, 4]]
+    F += [[n + a, n + c, n + b] for a, b, c in F]
+    for i in range(n):
+        j = (i + 1) % n
+        F += [[i, j, n + j], [i, n + j, n + i]]
+    F = np.array(F)
+    p1 = physics.convex_decomposition(Vs, F, cache_dir=tmp_path)
+    files = list(tmp_path.glob("*.npz"))
+    assert len(files) == 1
+    with np.load(files[0], allow_pickle=False) as z:  # plain arrays, no pickle
+        assert int(z["count"]) == len(p1)
+    p2 = physics.convex_decomposition(Vs, F, cache_dir=tmp_path)
+    assert len(p2) == len(p1) and all(np.array_equal(a, b) for a, b in zip(p1, p2))
+    physics.convex_decomposition(Vs * 1.1, F, cache_dir=tmp_path)  # another mesh, another entry
+    assert len(list(tmp_path.glob("*.npz"))) == 2
+    assert physics.is_concave(Vs, F)
+
+
+def test_decomposed_mug_gives_the_tetrahedra_verdicts_when_the_hand_reaches_into_it():
+    # Two top grasps of the bench grid (bench/bench_physics_concave.py) over the mug's opening,
+    # where a finger starts inside the mug's hull (Auto needs a concave shape): 1.1 cm from
+    # the body's axis away from the handle, yaw 90 deg - both shapes lift it (displacements
+    # 13.4 and 13.6 mm); 2.6 cm from it, y -1.3 cm, yaw 45 deg - both drop it.
+    from bayesgrasp.world import World
+    w = World.single("mug")
+    lo, hi = w.object.vertices.min(0), w.object.vertices.max(0)
+    xs, ys = np.linspace(lo[0], hi[0], 9), np.linspace(lo[1], hi[1], 7)
+    CONCAVE_GRASPS = [[xs[2], ys[3], np.pi / 2], [xs[1], ys[2], np.pi / 4]]
+    CONCAVE_LIFTED = [True, False]
+    dec = w.lift_tester()
+    assert dec.shape == "decomposition" and dec.concave and dec.num_pieces > 0
+    tets = physics.LiftTester(None, w.vertices, w.faces, shape="tetrahedra", mu=w.mu, density=w.object.density)
+    b = w.grasp_batch(CONCAVE_GRASPS, threads=1)
+    assert not np.any(b["collision_at_start"])
+    rd = dec.run_batch(b["hand_pose"], b["joint_angles"])
+    rt = tets.run_batch(b["hand_pose"], b["joint_angles"])
+    assert rd["shape"] == ["decomposition"] * len(CONCAVE_GRASPS)  # the hand reaches into the hull
+    assert rd["lifted"].tolist() == rt["lifted"].tolist() == CONCAVE_LIFTED
+    assert abs(rd["displacement"][0] - rt["displacement"][0]) < 5e-3
+
+
+def test_decomposition_bad_input():
+    with pytest.raises(ValueError, match="convex_pieces"):
+        physics.LiftTester(None, V, F, convex_pieces="pieces")
+    with pytest.raises(ValueError, match=r"convex_pieces\[0\]"):
+        physics.LiftTester(None, V, F, shape="decomposition", convex_pieces=[np.zeros((3, 3))])
+    with pytest.raises(ValueError, match=r"convex_pieces\[1\]"):
+        physics.LiftTester(None, V, F, shape="decomposition", convex_pieces=[V, np.full((4, 3), np.nan)])
+    with pytest.raises(ValueError, match=r"convex_pieces\[0\]"):
+        physics.LiftTester(None, V, F, shape="decomposition", convex_pieces=[np.zeros((5, 2))])
+    with pytest.raises(ValueError, match="vertices"):
+        physics.convex_decomposition(V[:, :2], F)
+    with pytest.raises(ValueError, match="faces"):
+        physics.convex_decomposition(V, F + 100)
+    with pytest.raises(ValueError, match="threshold"):
+        physics.convex_decomposition(V, F, threshold=0.0)
+    assert not physics.is_concave(V, F)
+
+
+def test_box_as_its_own_single_piece_is_lifted_like_its_hull():
+    t = physics.LiftTester(None, V, F, shape="decomposition", convex_pieces=[V], density=400.0)
+    assert t.shape == "decomposition" and t.num_pieces == 1 and not t.concave
+    r, h = t.run(POSE, GOOD), physics.lift_test(None, POSE, GOOD, V, F, density=400.0, shape="hull")
+    assert r["shape"] == "decomposition" and r["lifted"] and h["lifted"]
+    assert r["displacement"] == pytest.approx(h["displacement"], abs=1e-3)
+    assert not t.run(POSE, OPEN)["lifted"]

@@ -108,11 +108,38 @@ struct LiftTester::Impl {
   LiftOptions::Shape shape = LiftOptions::Shape::ConvexHull;
   std::vector<btVector3> hull;                  // body frame
   std::vector<Eigen::Vector4d> planes;          // hull faces n.x <= d (body frame, unit n)
+  bool concave = false;    // hull volume > 1.05 x mesh volume
   bool per_grasp = false;  // Auto on a concave object: choose per grasp (see header)
   std::vector<std::array<btVector3, 4>> tets;   // body frame
+  std::vector<std::vector<btVector3>> pieces;   // hull vertices of each convex piece (body frame)
 };
 
-LiftTester::LiftTester(const HandModel& hand, const TriMesh& object, const LiftOptions& options)
+namespace {
+
+// Hull vertices of a point set (Bullet's btConvexHullComputer) and the hull's volume.
+std::vector<btVector3> hull_of(const std::vector<btVector3>& pts, double* volume) {
+  btConvexHullComputer chc;
+  chc.compute(&pts[0].x(), sizeof(btVector3), static_cast<int>(pts.size()), 0, 0);
+  std::vector<btVector3> out;
+  for (int i = 0; i < chc.vertices.size(); ++i) out.push_back(chc.vertices[i]);
+  double vol = 0.0;
+  for (int f = 0; f < chc.faces.size(); ++f) {
+    const btConvexHullComputer::Edge* e0 = &chc.edges[chc.faces[f]];
+    const btVector3& a = chc.vertices[e0->getSourceVertex()];
+    const btConvexHullComputer::Edge* e = e0->getNextEdgeOfFace();
+    while (e->getTargetVertex() != e0->getSourceVertex()) {
+      vol += a.dot(chc.vertices[e->getSourceVertex()].cross(chc.vertices[e->getTargetVertex()])) / 6.0;
+      e = e->getNextEdgeOfFace();
+    }
+  }
+  *volume = std::abs(vol);
+  return out;
+}
+
+}  // namespace
+
+LiftTester::LiftTester(const HandModel& hand, const TriMesh& object, const LiftOptions& options,
+                       const std::vector<Eigen::MatrixX3d>& convex_pieces)
     : impl_(std::make_unique<Impl>()) {
   check_options(options);
   validate_mesh(object);
@@ -163,12 +190,32 @@ LiftTester::LiftTester(const HandModel& hand, const TriMesh& object, const LiftO
   }
   hull_volume = std::abs(hull_volume);
   const double volume = std::abs(im.mp.volume);
+  im.concave = hull_volume > 1.05 * volume;
   im.shape = options.shape;
   if (im.shape == LiftOptions::Shape::Auto) {
-    // Convex (hull within 5% of the volume): the hull. Concave: prepare the tetrahedra and
-    // decide per grasp.
-    im.per_grasp = hull_volume > 1.05 * volume;
-    im.shape = im.per_grasp ? LiftOptions::Shape::Tetrahedra : LiftOptions::Shape::ConvexHull;
+    // Convex (hull within 5% of the volume): the hull. Concave: prepare the decomposition
+    // (if given) or the tetrahedra, and decide per grasp.
+    im.per_grasp = im.concave;
+    im.shape = !im.concave ? LiftOptions::Shape::ConvexHull
+               : convex_pieces.empty() ? LiftOptions::Shape::Tetrahedra
+                                       : LiftOptions::Shape::Decomposition;
+  }
+  if (im.shape == LiftOptions::Shape::Decomposition) {
+    if (convex_pieces.empty())
+      throw std::invalid_argument("convex_pieces: the decomposition shape needs at least one convex piece");
+    // Each piece's hull in the body frame; a piece must span a volume (> 1e-12 m^3).
+    for (size_t i = 0; i < convex_pieces.size(); ++i) {
+      const Eigen::MatrixX3d& P = convex_pieces[i];
+      const std::string name = "convex_pieces[" + std::to_string(i) + "]";
+      if (P.rows() < 4) throw std::invalid_argument(name + ": needs at least 4 points, got " + std::to_string(P.rows()));
+      if (!P.allFinite()) throw std::invalid_argument(name + " contains NaN or infinity");
+      std::vector<btVector3> pts(static_cast<size_t>(P.rows()));
+      for (Eigen::Index k = 0; k < P.rows(); ++k) pts[k] = bt(Vec3(inv * Vec3(P.row(k).transpose())));
+      double v = 0.0;
+      std::vector<btVector3> h = hull_of(pts, &v);
+      if (!(v > 1e-12)) throw std::invalid_argument(name + ": spans no volume (flat or degenerate)");
+      im.pieces.push_back(std::move(h));
+    }
   }
 
   if (im.shape == LiftOptions::Shape::Tetrahedra) {
@@ -204,6 +251,8 @@ LiftTester& LiftTester::operator=(LiftTester&&) noexcept = default;
 const LiftOptions& LiftTester::options() const { return impl_->opt; }
 const MassProperties& LiftTester::mass_properties() const { return impl_->mp; }
 LiftOptions::Shape LiftTester::shape() const { return impl_->shape; }
+bool LiftTester::concave() const { return impl_->concave; }
+int LiftTester::num_pieces() const { return static_cast<int>(impl_->pieces.size()); }
 
 namespace {
 
@@ -298,7 +347,7 @@ LiftResult LiftTester::run(const Iso3& hand_pose, const Eigen::VectorXd& joints)
 
   const std::vector<Iso3> poses = im.hand.link_poses(hand_pose, joints);
   LiftResult res;
-  res.tetrahedra = im.shape == LiftOptions::Shape::Tetrahedra;
+  res.shape = im.shape;
   if (im.per_grasp) {
     // Auto on a concave object: the hull unless some hand link reaches more than 1 mm into
     // it (then the hand is in a concavity - a mug's opening or handle - and needs the
@@ -325,15 +374,24 @@ LiftResult LiftTester::run(const Iso3& hand_pose, const Eigen::VectorXd& joints)
           }
         }
       }
-    res.tetrahedra = inside;
+    if (!inside) res.shape = LiftOptions::Shape::ConvexHull;
   }
+  res.tetrahedra = res.shape == LiftOptions::Shape::Tetrahedra;
 
   // Object.
   btCollisionShape* object_shape = nullptr;
-  if (res.tetrahedra) {
+  btTransform I;
+  I.setIdentity();
+  if (res.shape == LiftOptions::Shape::Decomposition) {
+    auto* compound = static_cast<btCompoundShape*>(w.keep(new btCompoundShape(true, static_cast<int>(im.pieces.size()))));
+    for (const auto& p : im.pieces) {
+      auto* piece = new btConvexHullShape(&p[0].x(), static_cast<int>(p.size()), sizeof(btVector3));
+      piece->setMargin(margin);
+      compound->addChildShape(I, w.keep(piece));
+    }
+    object_shape = compound;
+  } else if (res.tetrahedra) {
     auto* compound = static_cast<btCompoundShape*>(w.keep(new btCompoundShape(true, static_cast<int>(im.tets.size()))));
-    btTransform I;
-    I.setIdentity();
     for (const auto& t : im.tets) {
       btCollisionShape* tet = w.keep(new btBU_Simplex1to4(t[0], t[1], t[2], t[3]));
       tet->setMargin(margin);
@@ -351,8 +409,6 @@ LiftResult LiftTester::run(const Iso3& hand_pose, const Eigen::VectorXd& joints)
   // Table.
   if (o.table) {
     btCollisionShape* plane = w.keep(new btStaticPlaneShape(btVector3(0, 0, 1), 0));
-    btTransform I;
-    I.setIdentity();
     w.add_body(plane, 0.0, btVector3(0, 0, 0), I, kTable, kObject, o.table_mu);
   }
 

@@ -43,12 +43,17 @@
 //    inside the solid (along the inward normal, `tet_depth` deep, or less where a ray finds
 //    the opposite wall sooner) - a solid skin that keeps concavities (a mug's opening and
 //    handle) with convex pieces only, robust with Bullet's convex-convex contacts;
+//  * Decomposition: a compound of the convex hulls of given pieces (`convex_pieces`, an
+//    approximate convex decomposition of the object computed once per mesh, e.g. by CoACD
+//    in python/bayesgrasp/physics.py) - a handful of convex hulls instead of one
+//    tetrahedron per triangle: keeps the opening and the handle's hole, far cheaper;
 //  * Auto (default): ConvexHull if the hull's volume is within 5% of the mesh's volume.
 //    Otherwise (concave) it is decided per grasp: the hull if no hand link reaches more
 //    than 1 mm into the hull at the start (the hand then meets the object from outside,
-//    where hull and mesh agree near the contacts), else Tetrahedra (the hand is in a
-//    concavity: a mug's opening or handle). The hull is ~50x faster than the tetrahedra
-//    (see bench/bench_physics.cpp).
+//    where hull and mesh agree near the contacts), else the concave shape (the hand is in a
+//    concavity: a mug's opening or handle): Decomposition if pieces were given, else
+//    Tetrahedra. See bench/bench_physics.cpp and BENCHMARKS.md for the costs (hull and
+//    decomposition ~tens of tests/s, tetrahedra ~0.5/s on a 512-triangle cup).
 // Collision margins are `margin` (0.5 mm) on every shape (Bullet's default 4 cm is meant for
 // metre-sized bodies).
 //
@@ -67,7 +72,7 @@
 namespace bayesgrasp {
 
 struct LiftOptions {
-  enum class Shape { Auto, ConvexHull, Tetrahedra };
+  enum class Shape { Auto, ConvexHull, Tetrahedra, Decomposition };
   double mu = 0.5;              // friction between the hand and the object
   double table_mu = 0.5;        // friction between the object and the table
   double density = 1000.0;      // kg/m^3 (mass from the mesh)
@@ -98,15 +103,20 @@ struct LiftResult {
   double squeeze_displacement = 0.0;  // m, how far the squeeze itself moved the object (in the palm frame)
   double height_gain = 0.0;   // m, world z of the object's centre of mass, end minus start
   bool finite = true;         // false if the simulation blew up (then lifted = false)
-  bool tetrahedra = false;    // the object used the tetrahedra shape (else its hull)
+  bool tetrahedra = false;    // the object used the tetrahedra shape
+  LiftOptions::Shape shape = LiftOptions::Shape::ConvexHull;  // the shape used (never Auto)
   int steps = 0;
 };
 
 class LiftTester {
  public:
-  /// `object` in the world frame (the frame of the hand poses). Throws std::invalid_argument
-  /// for a bad mesh, a mesh enclosing no volume, or bad options.
-  LiftTester(const HandModel& hand, const TriMesh& object, const LiftOptions& options = {});
+  /// `object` in the world frame (the frame of the hand poses). `convex_pieces`: optional
+  /// approximate convex decomposition of the object (world frame, one (K, 3) point set per
+  /// piece; each piece's convex hull is used), needed by Shape::Decomposition and used by
+  /// Auto for concave objects. Throws std::invalid_argument for a bad mesh, a mesh
+  /// enclosing no volume, bad options, or a piece that is not finite or spans no volume.
+  LiftTester(const HandModel& hand, const TriMesh& object, const LiftOptions& options = {},
+             const std::vector<Eigen::MatrixX3d>& convex_pieces = {});
   ~LiftTester();
   LiftTester(LiftTester&&) noexcept;
   LiftTester& operator=(LiftTester&&) noexcept;
@@ -115,9 +125,13 @@ class LiftTester {
   /// Mass properties of the object used (world frame).
   const MassProperties& mass_properties() const;
   /// The collision shape prepared (never Auto): ConvexHull for convex objects or when
-  /// asked; Tetrahedra for concave ones under Auto (then each run may still use the hull,
-  /// see LiftResult::tetrahedra).
+  /// asked; for concave ones under Auto, Decomposition (pieces given) or Tetrahedra (then
+  /// each run may still use the hull, see LiftResult::shape).
   LiftOptions::Shape shape() const;
+  /// Whether the object counts as concave (hull volume more than 5% above the mesh's).
+  bool concave() const;
+  /// Number of convex pieces kept (0 without a decomposition).
+  int num_pieces() const;
 
   /// One lift test from the closed grasp (hand pose in the world, joints in HandModel
   /// layout). Throws std::invalid_argument for a non-finite pose or joints of the wrong
