@@ -93,13 +93,14 @@ def convex_decomposition(vertices, faces, threshold: float = 0.05, seed: int = 0
         h = hashlib.sha256()
         h.update(V.tobytes())
         h.update(F.astype(np.int32).tobytes())
-        h.update(f"coacd-{_coacd_version()}-t{threshold!r}-s{int(seed)}".encode())
+        h.update(f"coacd-{_coacd_version()}-t{threshold!r}-s{int(seed)}-{sorted(_COACD_SEARCH.items())}".encode())
         path = Path(decomposition_cache_dir() if cache_dir is None else cache_dir) / f"{h.hexdigest()[:32]}.npz"
         if path.exists():
             with np.load(path, allow_pickle=False) as z:
                 return [np.array(z[f"piece_{i}"], dtype=np.float64) for i in range(int(z["count"]))]
     coacd.set_log_level("error")
-    parts = coacd.run_coacd(coacd.Mesh(V, F.astype(np.int32)), threshold=float(threshold), seed=int(seed))
+    parts = coacd.run_coacd(coacd.Mesh(V, F.astype(np.int32)), threshold=float(threshold), seed=int(seed),
+                            **_COACD_SEARCH)
     pieces = [np.ascontiguousarray(p[0], dtype=np.float64) for p in parts if len(p[0]) >= 4]
     if not pieces:
         raise ValueError("vertices, faces: CoACD found no convex piece (does the mesh enclose a volume?)")
@@ -109,6 +110,12 @@ def convex_decomposition(vertices, faces, threshold: float = 0.05, seed: int = 0
         np.savez(tmp, count=len(pieces), **{f"piece_{i}": p for i, p in enumerate(pieces)})
         os.replace(tmp, path)  # atomic: concurrent runs never read a half-written file
     return pieces
+
+
+#: CoACD's search, lighter than its defaults: on the built-in mug 3.7 s and 24 pieces of at most 48
+#: vertices instead of 21 s and 25 pieces (the lift test needs pieces near the hand's contacts, not
+#: the tightest decomposition).
+_COACD_SEARCH = {"mcts_iterations": 50, "mcts_nodes": 10, "resolution": 1000, "max_ch_vertex": 48}
 
 
 def is_concave(vertices, faces, hand=None) -> bool:
