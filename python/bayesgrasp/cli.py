@@ -64,8 +64,8 @@ def build_parser() -> argparse.ArgumentParser:
     d.add_argument("--method", default="explore", choices=["stability", "explore", "ml_pose", "open_loop"])
     d.add_argument("--out", default="out/demo", help="directory for the PNG and results")
     d.add_argument("--seed", type=int, default=0)
-    d.add_argument("--cache", default=None, help="model cache directory (default: $BAYESGRASP_CACHE or "
-                                                  "~/.cache/bayesgrasp/models)")
+    d.add_argument("--cache", default=None, help="model cache directory (default: $BAYESGRASP_CACHE/models, "
+                                                  "$BAYESGRASP_CACHE defaulting to ~/.cache/bayesgrasp)")
 
     p = sub.add_parser("plan", help="run the planning loop on an object at a hidden true pose")
     p.add_argument("--object", required=True, help="built-in object name or mesh file")

@@ -52,10 +52,15 @@ def _hand(hand):
 
 
 def decomposition_cache_dir() -> Path:
-    """Where :func:`convex_decomposition` keeps its results: ``$BAYESGRASP_CACHE_DIR`` (or
+    """Where :func:`convex_decomposition` keeps its results: ``$BAYESGRASP_CACHE`` (or
     ``~/.cache/bayesgrasp``) / ``convex_decomposition``."""
-    root = os.environ.get("BAYESGRASP_CACHE_DIR") or os.path.join(os.path.expanduser("~"), ".cache", "bayesgrasp")
-    return Path(root) / "convex_decomposition"
+    return cache_root() / "convex_decomposition"
+
+
+def cache_root() -> Path:
+    """bayesgrasp's cache: ``$BAYESGRASP_CACHE``, else ``~/.cache/bayesgrasp`` (models in
+    ``models/``, convex decompositions in ``convex_decomposition/``)."""
+    return Path(os.environ.get("BAYESGRASP_CACHE") or os.path.join(os.path.expanduser("~"), ".cache", "bayesgrasp"))
 
 
 def convex_decomposition(vertices, faces, threshold: float = 0.05, seed: int = 0,

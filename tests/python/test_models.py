@@ -22,15 +22,19 @@ def test_models_predict_held_out_simulations_and_are_cached(tmp_path):
     assert any("simulating" in m for m in msgs)
     # held-out grasps simulated independently
     held = ModelSettings(n_samples=120, n_inducing=60, xy_range=0.03, seed=99)
-    rel, q, eps = simulate_training_data(World.single("cylinder"), held)
+    rel, q, eps = simulate_training_data(World.single("cylinder"), held, spread=models.spread)
     mean, var = models.predict_measurement(rel)
     err = np.abs(mean - q[:, models.joint_index])
     # the GP explains most of the joint-angle variation of unseen grasps
     r2 = 1 - np.mean(err ** 2) / np.mean((q[:, models.joint_index] - q[:, models.joint_index].mean(0)) ** 2)
     assert r2 > 0.5
     # the true measurement is more likely at its own grasp than at a shifted one
-    ll_true = models.log_likelihood(rel[:20], q[0, models.joint_index])
-    assert ll_true[0] > np.median(ll_true)
+    # (for most of 30 held-out grasps: above the median over the other grasps)
+    wins = []
+    for i in range(30):
+        ll = models.log_likelihood(rel[:30], q[i, models.joint_index])
+        wins.append(ll[i] > np.median(np.delete(ll, i)))
+    assert np.mean(wins) > 0.7
     p = models.stability_probability(rel)
     assert np.all((p >= 0) & (p <= 1))
     # stable grasps (by simulation) get a higher predicted stability on average
@@ -55,3 +59,19 @@ def test_bad_settings():
         ModelSettings(n_samples=2)
     with pytest.raises(ValueError, match="xy_range"):
         ModelSettings(xy_range=-1.0)
+
+
+def test_spread_chosen_by_the_pilot_is_recorded_and_fixed_spreads_are_kept(tmp_path):
+    from bayesgrasp.models.grasp_models import AUTO_SPREADS
+
+    auto = build_models("cube", settings=SMALL, cache_dir=tmp_path)
+    assert auto.spread in AUTO_SPREADS
+    pilot = auto.info["spread_pilot"]
+    assert len(pilot) == len(AUTO_SPREADS)
+    # the chosen spread has the best stable x lifted score of the pilot
+    score = {d: f * (l / t if t else 0.0) for d, (f, l, t) in pilot.items()}
+    assert score[round(np.degrees(auto.spread))] == max(score.values())
+    fixed = build_models("cube", settings=ModelSettings(**{**SMALL.__dict__, "spread": 0.5}), cache_dir=tmp_path)
+    assert fixed.spread == 0.5 and fixed.info["spread_pilot"] is None
+    with pytest.raises(ValueError, match="spread"):
+        ModelSettings(spread=4.0)

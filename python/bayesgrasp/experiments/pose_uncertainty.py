@@ -104,7 +104,7 @@ def entropy_order_run(experiment: str, obj: str, run_index: int, seed: int, *, b
     for name, i in picks.items():
         a = cands[i]
         rel = relative_top_grasps(a, pose)[0, 0]
-        q = np.asarray(world.grasp_batch(rel[None, :], spread=models.settings.spread)["joint_angles"][0])
+        q = np.asarray(world.grasp_batch(rel[None, :], spread=models.spread)["joint_angles"][0])
         q = q[models.joint_index]
         ll = models.log_likelihood(relative_planar_pose(a[None, :], P), q)
         lw = planner.belief.log_weights + ll
@@ -125,7 +125,7 @@ def _reweighted(planner, models, world, pose, action):
     """Executes ``action`` at the true pose and reweights the planner's particles by the
     measurement likelihood (no resampling): (log weights, weight entropy, posterior-mean error)."""
     rel = relative_top_grasps(action, pose)[0, 0]
-    q = np.asarray(world.grasp_batch(rel[None, :], spread=models.settings.spread)["joint_angles"][0])
+    q = np.asarray(world.grasp_batch(rel[None, :], spread=models.spread)["joint_angles"][0])
     q = q[models.joint_index]
     P = planner.belief.particles
     lw = planner.belief.log_weights + models.log_likelihood(relative_planar_pose(np.asarray(action)[None, :], P), q)

@@ -88,7 +88,7 @@ def _write_csv(rows: List[dict], path: Path) -> None:
         w.writerows(rows)
 
 
-EPISODE_COLS = ("object", "attempt", "runs", "success", "lifted", "stable_at_attempt", "explore_fraction",
+EPISODE_COLS = ("object", "attempt", "runs", "success", "force_closure", "lifted", "stable_at_attempt", "explore_fraction",
                 "predicted_stability", "epsilon", "position_error_cm", "yaw_error_deg", "entropy", "plan_ms_median")
 
 
@@ -245,6 +245,7 @@ def write(name: str, results: Dict[str, list], out: Path) -> dict:
             md += [f"## method `{method}` ({len(res)} runs)", "", _markdown(rows, EPISODE_COLS), ""]
             last = [r for r in rows if r["object"] == "mean"]
             summary[method] = {"success_by_attempt": [r["success"] for r in last],
+                               "force_closure_by_attempt": [r["force_closure"] for r in last],
                                "lifted_by_attempt": [r["lifted"] for r in last],
                                "entropy_by_attempt": [r["entropy"] for r in last],
                                "position_error_cm_by_attempt": [r["position_error_cm"] for r in last],
@@ -252,6 +253,12 @@ def write(name: str, results: Dict[str, list], out: Path) -> dict:
                                "plan_ms_median": float(np.median([a["plan_seconds"] * 1e3 for _, x in res
                                                                   for a in x["attempts"]])),
                                "runs": len(res)}
+        md += ["Columns (per attempt k, over the runs): success - a stable grasp (epsilon above the models' "
+               "eps_stable, 0.01) by attempt k; force_closure - epsilon > 0 by attempt k; lifted - held in the "
+               "Bullet lift test by attempt k (tested on stable grasps); stable_at_attempt, explore_fraction, "
+               "predicted_stability (the belief-weighted P(S) of the executed grasp), epsilon - over the runs "
+               "that made attempt k; position_error_cm, yaw_error_deg, entropy (KDE, nats) - the belief after "
+               "attempt k (carried forward once a run stopped); plan_ms_median - wall time of one decision.", ""]
         plot_per_attempt(tables, out / "per_attempt.png", f"{name}: per attempt")
         md += ["![per attempt](per_attempt.png)", ""]
     elif name == "entropy_order":

@@ -32,7 +32,10 @@ from .. import gp as _gp
 from ..objects import ObjectModel, load_object
 from ..world import World
 
-CACHE_VERSION = 2
+CACHE_VERSION = 3
+
+#: Candidate finger spreads (rad) when ModelSettings.spread is None.
+AUTO_SPREADS = tuple(float(np.radians(d)) for d in (0.0, 30.0, 45.0, 60.0, 90.0))
 
 
 @dataclass(frozen=True)
@@ -42,10 +45,15 @@ class ModelSettings:
     n_samples: int = 2000         # simulated grasps
     n_inducing: int = 200         # FITC inducing inputs
     xy_range: float = 0.06        # relative x, y sampled uniformly in +-xy_range (m)
-    # Finger spread of the grasps (rad): 90 degrees (fingers 1 and 2 at right angles, the thumb
-    # opposite) gives force closure 2-5x as often as 0 on the mugs and the pitcher (a 1,500-grasp
-    # sample within +-3 cm: pitcher 22% vs 4%) and about as often on the cube.
-    spread: float = float(np.pi / 2)
+    # Finger spread of the grasps (rad), or None (the default): chosen per object from
+    # AUTO_SPREADS by a pilot sample, as the spread with the most grasps that are both stable
+    # (epsilon) and held in the physical lift test (see choose_spread). The two criteria pull
+    # apart: on the built-in mug2 a 90-degree spread (fingers 1 and 2 facing each other, the thumb
+    # pushing between them) gives stable epsilon 3x as often as 30 degrees, but those grasps are
+    # never held when lifted (0/25), while 17/25 of the stable 30-degree ones are.
+    spread: Optional[float] = None
+    n_pilot: int = 300            # pilot grasps per candidate spread (spread=None)
+    n_pilot_lifts: int = 16       # lift tests per candidate spread (on its stable pilot grasps)
     # Epsilon above which a grasp counts as stable: force closure with a margin (about the
     # 10th percentile of positive epsilons on the built-in objects).
     eps_stable: float = 0.01
@@ -60,6 +68,10 @@ class ModelSettings:
             raise ValueError(f"n_inducing: must be >= 1, got {self.n_inducing}")
         if not (self.xy_range > 0 and np.isfinite(self.xy_range)):
             raise ValueError(f"xy_range: must be positive, got {self.xy_range}")
+        if self.spread is not None and not (np.isfinite(self.spread) and 0.0 <= self.spread <= np.pi):
+            raise ValueError(f"spread: must be None (choose per object) or in [0, pi], got {self.spread}")
+        if self.n_pilot < 10 or self.n_pilot_lifts < 1:
+            raise ValueError("n_pilot: need at least 10 grasps and n_pilot_lifts at least 1")
 
 
 def relative_top_grasps(grasps, object_poses) -> np.ndarray:
@@ -125,6 +137,11 @@ class GraspModels:
     def log_stability_probability(self, rel) -> np.ndarray:
         a, b = self.info.get("calibration", (1.702, 0.0))
         return -np.logaddexp(0.0, -(a * self._stability_z(rel) + b))
+
+    @property
+    def spread(self) -> float:
+        """The finger spread (rad) of every grasp these models describe."""
+        return float(self.info.get("spread", self.settings.spread if self.settings.spread is not None else np.pi / 2))
 
     @property
     def n_joints(self) -> int:
@@ -247,7 +264,31 @@ def fit_calibration(z, stable) -> tuple:
     return float(res.x[0]), float(res.x[1])
 
 
-def simulate_training_data(world: World, settings: ModelSettings, seed_offset: int = 0, n: Optional[int] = None):
+def choose_spread(world: World, settings: ModelSettings, say=lambda m: None) -> tuple:
+    """The pilot behind ModelSettings.spread = None: for each spread in AUTO_SPREADS, simulate
+    n_pilot random relative top grasps, lift-test up to n_pilot_lifts of the stable ones, and score
+    stable fraction x lifted fraction. Returns (best spread, {degrees: (stable, lifted, tested)});
+    with no grasp lifted at any spread, the spread with the most stable grasps."""
+    rng = np.random.default_rng([settings.seed, 7])
+    r = settings.xy_range
+    rel = np.column_stack([rng.uniform(-r, r, settings.n_pilot), rng.uniform(-r, r, settings.n_pilot),
+                           rng.uniform(-np.pi, np.pi, settings.n_pilot)])
+    table, scores = {}, []
+    for sp in AUTO_SPREADS:
+        b = world.grasp_batch(rel, spread=sp, threads=0)
+        ok = (np.asarray(b["epsilon"]) > settings.eps_stable) & ~np.asarray(b["collision_at_start"], dtype=bool)
+        idx = np.flatnonzero(ok)[:settings.n_pilot_lifts]
+        lifted = int(np.sum(world.grasp_batch(rel[idx], spread=sp, lift=True, threads=0)["lifted"])) if len(idx) else 0
+        frac = float(np.mean(ok))
+        table[round(float(np.degrees(sp)))] = (frac, lifted, int(len(idx)))
+        scores.append((frac * (lifted / len(idx) if len(idx) else 0.0), frac))
+        say(f"  spread {np.degrees(sp):3.0f} deg: {100 * frac:.0f}% stable, {lifted}/{len(idx)} of those lifted")
+    best = max(range(len(scores)), key=lambda i: scores[i])
+    return AUTO_SPREADS[best], table
+
+
+def simulate_training_data(world: World, settings: ModelSettings, seed_offset: int = 0, n: Optional[int] = None,
+                           spread: Optional[float] = None):
     """Relative grasps (n, 3), joint angles (n, J) and epsilon (n,) from the simulator; grasps
     whose open hand started in collision are dropped."""
     rng = np.random.default_rng([settings.seed, seed_offset])
@@ -255,7 +296,8 @@ def simulate_training_data(world: World, settings: ModelSettings, seed_offset: i
     rel = np.column_stack([rng.uniform(-settings.xy_range, settings.xy_range, n),
                            rng.uniform(-settings.xy_range, settings.xy_range, n),
                            rng.uniform(-np.pi, np.pi, n)])
-    b = world.grasp_batch(rel, spread=settings.spread, threads=0)
+    spread = settings.spread if spread is None else spread
+    b = world.grasp_batch(rel, spread=spread, threads=0)
     ok = ~np.asarray(b["collision_at_start"], dtype=bool)
     return rel[ok], np.asarray(b["joint_angles"])[ok], np.asarray(b["epsilon"])[ok]
 
@@ -280,8 +322,12 @@ def build_models(obj: Union[str, ObjectModel], hand="barrett_bh8", settings: Opt
             info = json.loads(files[2].read_text())
             say(f"models for {obj.name}: loaded from cache ({key})")
             return GraspModels(_gp.load(files[0]), _gp.load(files[1]), settings, info["joint_index"], info)
-    say(f"models for {obj.name}: simulating {settings.n_samples} grasps")
-    rel, q, eps = simulate_training_data(world, settings)
+    spread, pilot = settings.spread, None
+    if spread is None:
+        say(f"models for {obj.name}: choosing the finger spread (pilot of {settings.n_pilot} grasps per spread)")
+        spread, pilot = choose_spread(world, settings, say)
+    say(f"models for {obj.name}: simulating {settings.n_samples} grasps at spread {np.degrees(spread):.0f} deg")
+    rel, q, eps = simulate_training_data(world, settings, spread=spread)
     if len(rel) < 10:
         raise ValueError(f"{obj.name}: only {len(rel)} collision-free grasps in the sampled range")
     joint_index = np.arange(1, q.shape[1])     # every phalanx joint (the spread is fixed)
@@ -291,16 +337,18 @@ def build_models(obj: Union[str, ObjectModel], hand="barrett_bh8", settings: Opt
               noise=1e-2)
     measurement = _gp.SparseGP(**kw).fit(X, q[:, joint_index])
     stability = _gp.SparseGP(**kw).fit(X, np.maximum(eps, 0.0))
-    models = GraspModels(measurement, stability, settings, joint_index, {})
+    models = GraspModels(measurement, stability, settings, joint_index, {"spread": float(spread)})
     calibration = (1.702, 0.0)
     if settings.n_calibration > 0:
         say(f"models for {obj.name}: calibrating P(S) on {settings.n_calibration} held-out grasps")
-        rel_c, _, eps_c = simulate_training_data(world, settings, seed_offset=1, n=settings.n_calibration)
+        rel_c, _, eps_c = simulate_training_data(world, settings, seed_offset=1, n=settings.n_calibration,
+                                                 spread=spread)
         if len(rel_c) >= 10:
             calibration = fit_calibration(models._stability_z(rel_c), eps_c > settings.eps_stable)
     info = {"key": key, "object": obj.name, "calibration": list(calibration), "hand": world.hand.name, "settings": asdict(settings),
             "samples": int(len(rel)), "force_closure_fraction": float(np.mean(eps > 0)),
-            "stable_fraction": float(np.mean(eps > settings.eps_stable)), "joint_index": joint_index.tolist()}
+            "stable_fraction": float(np.mean(eps > settings.eps_stable)), "joint_index": joint_index.tolist(),
+            "spread": float(spread), "spread_pilot": pilot}
     if files is not None:
         try:
             files[0].parent.mkdir(parents=True, exist_ok=True)

@@ -27,9 +27,10 @@ PLANNERS = {"stability": StabilityPlanner, "explore": ExplorationPlanner, "ml_po
 
 
 def default_cache_dir() -> Path:
-    """Where models are cached: $BAYESGRASP_CACHE, else ~/.cache/bayesgrasp/models."""
-    env = os.environ.get("BAYESGRASP_CACHE")
-    return Path(env) if env else Path.home() / ".cache" / "bayesgrasp" / "models"
+    """Where models are cached: $BAYESGRASP_CACHE/models, else ~/.cache/bayesgrasp/models."""
+    from ..physics import cache_root
+
+    return cache_root() / "models"
 
 
 _MODELS: dict = {}
@@ -101,12 +102,12 @@ def run_episode(obj: Union[str, ObjectModel], true_pose: Sequence[float], method
             snapshots.append((planner.belief.particles, planner.belief.weights))
         plan = planner.plan()
         rel = relative_top_grasps(plan.action, true_pose)[0, 0]
-        g = world.grasp_batch(rel[None, :], spread=models.settings.spread)
+        g = world.grasp_batch(rel[None, :], spread=models.spread)
         eps = float(g["epsilon"][0])
         stable = eps > eps_stable
         lifted = None
         if lift and stable:
-            lifted = bool(world.grasp_batch(rel[None, :], spread=models.settings.spread, lift=True)["lifted"][0])
+            lifted = bool(world.grasp_batch(rel[None, :], spread=models.spread, lift=True)["lifted"][0])
         q = np.asarray(g["joint_angles"][0], dtype=float)[models.joint_index]
         if measurement_noise > 0:
             q = q + rng.normal(0.0, measurement_noise, q.shape)
