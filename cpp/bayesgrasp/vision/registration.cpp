@@ -22,7 +22,10 @@
 #include <chrono>
 #include <cmath>
 #include <numeric>
+#include <optional>
 #include <random>
+#include <mutex>
+#include <shared_mutex>
 #include <stdexcept>
 
 namespace bayesgrasp::vision {
@@ -159,14 +162,27 @@ Iso3 kabsch(const Eigen::Matrix3Xd& src, const Eigen::Matrix3Xd& dst) {
   return T;
 }
 
-// Per-model registration state.
+// A model prepared for registration: everything that does not depend on the scene.
 struct ModelData {
   bool ok = false;
   std::string reason;
   CloudN::Ptr dense;  // all surface samples with exact normals
   pcl::KdTreeFLANN<pcl::PointNormal> dense_tree;
-  double spacing = 0.0;
-  Prepared prep;
+  Prepared prep;            // downsampled, normals, FPFH
+  Features mfeat;           // the features as matched (square roots for the Hellinger distance)
+  Eigen::VectorXf mf_norm;  // their squared norms
+  std::vector<Vec3> mpts, mnrm;  // downsampled points and normals
+  int nm = 0;
+  double time = 0.0;        // s spent preparing
+};
+
+// The scene's part of a registration.
+struct SceneData {
+  int ns = 0;
+  std::vector<Vec3> spts, snrm;
+  Features sfeat;
+  Eigen::VectorXf sf_norm;
+  double time = 0.0;
 };
 
 // Distances from each (transformed) scene point to the nearest dense model sample.
@@ -253,6 +269,292 @@ Iso3 icp(const ModelData& m, const std::vector<Vec3>& pts, Iso3 T, double max_di
   return T;
 }
 
+void validate(const RegistrationParams& P) {
+  if (!(P.voxel > 0) || !std::isfinite(P.voxel)) throw std::invalid_argument("voxel must be positive and finite");
+  for (double f : {P.normal_radius, P.feature_radius, P.inlier_distance, P.icp_distance, P.weight_sigma})
+    if (!(f > 0) || !std::isfinite(f)) throw std::invalid_argument("radius and distance factors must be positive");
+  if (P.ransac_iterations < 1 || P.restarts < 1 || P.hypotheses < 1 || P.candidates < 1 || P.coarse_points < 1 ||
+      P.icp_iterations < 0 || P.coarse_icp_iterations < 0 || P.feature_neighbours < 1)
+    throw std::invalid_argument("iteration, restart, hypothesis and neighbour counts must be positive");
+  if (!(P.ransac_confidence > 0 && P.ransac_confidence < 1)) throw std::invalid_argument("ransac_confidence must be in (0, 1)");
+  if (!(P.edge_similarity > 0 && P.edge_similarity < 1)) throw std::invalid_argument("edge_similarity must be in (0, 1)");
+  if (P.use_up_prior && !(P.up.norm() > 0)) throw std::invalid_argument("up must be a non-zero vector");
+}
+
+// Model preparation: dense k-d tree, downsampling, normals along the samples' normals, FPFH.
+void prepare_model(const SurfaceSamples& S, const RegistrationParams& P, ModelData& md) {
+  const auto t0 = Clock::now();
+  if (S.points.rows() == 0 || S.points.rows() != S.normals.rows()) {
+    md.reason = "model has no surface points";
+    return;
+  }
+  if (!S.points.allFinite() || !S.normals.allFinite()) {
+    md.reason = "model points or normals contain NaN or infinity";
+    return;
+  }
+  const double voxel = P.voxel;
+  md.dense = to_cloud(S.points, &S.normals);
+  md.dense_tree.setInputCloud(md.dense);
+  CloudN::Ptr mdown = downsample(md.dense, voxel);
+  md.prep = prepare(mdown, P.normal_radius * voxel, P.feature_radius * voxel, Orient::Reference, Vec3::Zero(), 1);
+  md.nm = static_cast<int>(md.prep.cloud->size());
+  if (md.nm < 3) {
+    md.reason = "model has too few points after downsampling (" + std::to_string(md.nm) + ")";
+    md.time = seconds_since(t0);
+    return;
+  }
+  md.mfeat = md.prep.features;
+  if (P.hellinger) md.mfeat = md.mfeat.cwiseMax(0.f).cwiseSqrt();
+  md.mf_norm = md.mfeat.rowwise().squaredNorm();
+  md.mpts.resize(md.nm);
+  md.mnrm.resize(md.nm);
+  for (int i = 0; i < md.nm; ++i) {
+    md.mpts[i] = (*md.prep.cloud)[i].getVector3fMap().cast<double>();
+    md.mnrm[i] = (*md.prep.cloud)[i].getNormalVector3fMap().cast<double>();
+  }
+  md.ok = true;
+  md.time = seconds_since(t0);
+}
+
+// Scene preparation: downsampling, normals towards the viewpoint (or away from the centroid), FPFH.
+SceneData prepare_scene(const CloudN::Ptr& raw, const RegistrationParams& P, const std::optional<Vec3>& viewpoint,
+                        int nthreads) {
+  const auto t0 = Clock::now();
+  const double voxel = P.voxel;
+  CloudN::Ptr sdown = downsample(raw, voxel);
+  const Prepared sprep = prepare(sdown, P.normal_radius * voxel, P.feature_radius * voxel,
+                                 viewpoint ? Orient::Viewpoint : Orient::AwayFromCentroid,
+                                 viewpoint ? *viewpoint : Vec3::Zero(), nthreads);
+  SceneData sd;
+  sd.ns = static_cast<int>(sprep.cloud->size());
+  sd.spts.resize(sd.ns);
+  sd.snrm.resize(sd.ns);
+  for (int i = 0; i < sd.ns; ++i) {
+    sd.spts[i] = (*sprep.cloud)[i].getVector3fMap().cast<double>();
+    sd.snrm[i] = (*sprep.cloud)[i].getNormalVector3fMap().cast<double>();
+  }
+  sd.sfeat = sprep.features;
+  if (P.hellinger) sd.sfeat = sd.sfeat.cwiseMax(0.f).cwiseSqrt();  // Hellinger: L2 between sqrt histograms
+  sd.sf_norm = sd.sfeat.rowwise().squaredNorm();
+  sd.time = seconds_since(t0);
+  return sd;
+}
+
+// Registers one prepared model against the prepared scene.
+void register_one(const ModelData& md, const SceneData& sd, const RegistrationParams& P, std::uint64_t seed,
+                  RegistrationResult& res) {
+  const int ns = sd.ns, nm = md.nm;
+  const std::vector<Vec3>& spts = sd.spts;
+  const std::vector<Vec3>& snrm = sd.snrm;
+  const Features& sfeat = sd.sfeat;
+  const Eigen::VectorXf& sf_norm = sd.sf_norm;
+  const double voxel = P.voxel, tau = P.inlier_distance * voxel;
+  const Vec3 up = P.up.norm() > 0 ? P.up.normalized() : Vec3::UnitZ();
+  const double cos_tilt = std::cos(P.max_tilt);
+  // Rotation taking the scene's up onto +z (the model's up), for the 4-DOF hypotheses.
+  const Mat3 R0 = Eigen::Quaterniond::FromTwoVectors(up, Vec3::UnitZ()).toRotationMatrix();
+  // ---- correspondences: each scene feature's k nearest model features (brute force, L2).
+  auto t0 = Clock::now();
+  const int k = std::min(P.feature_neighbours, nm);
+  const Features& mfeat = md.mfeat;
+  const Eigen::VectorXf& mf_norm = md.mf_norm;
+  std::vector<std::pair<int, int>> corr;
+  corr.reserve(static_cast<std::size_t>(ns) * k + nm);
+  {
+    // Forward: each scene feature's k nearest model features. Reverse (optional): each model
+    // feature's nearest scene feature, which keeps the matches spread over the model when many
+    // scene features share a few nearest model features ("hubs", e.g. on flat faces).
+    const int block = 256;
+    Eigen::MatrixXf D;
+    std::vector<int> order(nm);
+    std::vector<float> rbest(nm, std::numeric_limits<float>::infinity());
+    std::vector<int> rarg(nm, -1);
+    for (int s0 = 0; s0 < ns; s0 += block) {
+      const int bs = std::min(block, ns - s0);
+      D.noalias() = -2.0f * sfeat.middleRows(s0, bs) * mfeat.transpose();
+      for (int i = 0; i < bs; ++i) {
+        std::iota(order.begin(), order.end(), 0);
+        auto row = D.row(i);
+        std::partial_sort(order.begin(), order.begin() + k, order.end(), [&](int a, int b) {
+          const float da = row(a) + mf_norm(a), db = row(b) + mf_norm(b);
+          return da < db || (da == db && a < b);
+        });
+        for (int j = 0; j < k; ++j) corr.emplace_back(s0 + i, order[j]);
+        if (P.reverse_matches)
+          for (int j = 0; j < nm; ++j) {
+            const float dj = row(j) + sf_norm(s0 + i);
+            if (dj < rbest[j]) {
+              rbest[j] = dj;
+              rarg[j] = s0 + i;
+            }
+          }
+      }
+    }
+    if (P.reverse_matches)
+      for (int j = 0; j < nm; ++j)
+        if (rarg[j] >= 0) corr.emplace_back(rarg[j], j);
+  }
+  const int nc = static_cast<int>(corr.size());
+  const std::vector<Vec3>& mpts = md.mpts;
+
+  // ---- RANSAC over correspondences, several restarts; keep distinct good hypotheses.
+  const std::vector<Vec3>& mnrm = md.mnrm;
+  std::vector<Hypothesis> hyps;
+  const double tau2 = tau * tau;
+  const double min_edge = 2.0 * voxel;
+  const double sim = P.edge_similarity;
+  const double cos_normal = std::cos(P.max_normal_angle);
+  const bool four_dof = P.use_up_prior && P.upright;
+  const int sample_size = four_dof ? 2 : 3;
+  for (int rs = 0; rs < P.restarts; ++rs) {
+    std::mt19937_64 rng(mix(seed * 0x100000001B3ull + static_cast<std::uint64_t>(rs)));
+    std::uniform_int_distribution<int> pick(0, nc - 1);
+    std::vector<Hypothesis> top;  // best distinct hypotheses of this restart
+    int best = 0;
+    long needed = P.ransac_iterations;
+    int it = 0;
+    for (; it < P.ransac_iterations && it < needed; ++it) {
+      int s_id[3], m_id[3];
+      for (int j = 0; j < sample_size; ++j) {
+        const int c = pick(rng);
+        s_id[j] = corr[c].first;
+        m_id[j] = corr[c].second;
+      }
+      if (s_id[0] == s_id[1] || (sample_size == 3 && (s_id[0] == s_id[2] || s_id[1] == s_id[2]))) continue;
+      Iso3 T = Iso3::Identity();
+      bool okay = true;
+      if (four_dof) {
+        // Yaw about the up axis and a translation from two correspondences (the model's +z is
+        // the scene's up): levelled scene points q = R0 p, then a rotation about z.
+        const Vec3 qa = R0 * spts[s_id[0]], qb = R0 * spts[s_id[1]];
+        const Vec3 dq = qb - qa, dm = mpts[m_id[1]] - mpts[m_id[0]];
+        const double lq = dq.head<2>().norm(), lm = dm.head<2>().norm();
+        if (lq < min_edge || lm < min_edge || std::min(lq, lm) < sim * std::max(lq, lm) ||
+            std::abs(dq.z() - dm.z()) > tau)
+          continue;
+        const double yaw = std::atan2(dm.y(), dm.x()) - std::atan2(dq.y(), dq.x());
+        T.linear() = Eigen::AngleAxisd(yaw, Vec3::UnitZ()).toRotationMatrix() * R0;
+        T.translation() = 0.5 * (mpts[m_id[0]] + mpts[m_id[1]]) - T.linear() * 0.5 * (spts[s_id[0]] + spts[s_id[1]]);
+      } else {
+        const int pairs[3][2] = {{0, 1}, {1, 2}, {0, 2}};
+        for (const auto& pr : pairs) {
+          const double ls = (spts[s_id[pr[0]]] - spts[s_id[pr[1]]]).norm();
+          const double lm = (mpts[m_id[pr[0]]] - mpts[m_id[pr[1]]]).norm();
+          if (ls < min_edge || lm < min_edge || std::min(ls, lm) < sim * std::max(ls, lm)) {
+            okay = false;
+            break;
+          }
+        }
+        if (!okay) continue;
+        Eigen::Matrix3Xd src(3, 3), dst(3, 3);
+        for (int j = 0; j < 3; ++j) {
+          src.col(j) = spts[s_id[j]];
+          dst.col(j) = mpts[m_id[j]];
+        }
+        T = kabsch(src, dst);
+        // model +z in the scene frame = R^T e_z (T maps scene -> model).
+        if (P.use_up_prior && T.linear().row(2).dot(up) < cos_tilt) continue;
+      }
+      // The sampled points must land near their matches with agreeing normals.
+      for (int j = 0; j < sample_size && okay; ++j)
+        okay = (T * spts[s_id[j]] - mpts[m_id[j]]).squaredNorm() < tau2 &&
+               (T.linear() * snrm[s_id[j]]).dot(mnrm[m_id[j]]) > cos_normal;
+      if (!okay) continue;
+      int inl = 0;
+      for (int j = 0; j < nc; ++j)
+        inl += (T * spts[corr[j].first] - mpts[corr[j].second]).squaredNorm() < tau2;
+      if (inl < sample_size) continue;
+      if (inl > best) {
+        best = inl;
+        const double w = std::min(0.999, static_cast<double>(best) / ns);
+        const double denom = std::log(1.0 - std::pow(w, sample_size));
+        if (denom < 0)
+          needed = std::max<long>(P.ransac_min_iterations,
+                                  static_cast<long>(std::ceil(std::log(1.0 - P.ransac_confidence) / denom)));
+      }
+      // Keep the `hypotheses` best distinct ones.
+      const double ttol = 4.0 * voxel, rtol = 20.0 * 3.14159265358979323846 / 180.0;
+      bool merged = false;
+      for (auto& h : top) {
+        if (similar(h.T, T, ttol, rtol)) {
+          if (inl > h.inliers) {
+            h.T = T;
+            h.inliers = inl;
+          }
+          merged = true;
+          break;
+        }
+      }
+      if (!merged) {
+        if (static_cast<int>(top.size()) < P.candidates) {
+          top.push_back({T, inl, 0.0});
+        } else {
+          auto worst = std::min_element(top.begin(), top.end(),
+                                        [](const Hypothesis& a, const Hypothesis& b) { return a.inliers < b.inliers; });
+          if (inl > worst->inliers) *worst = {T, inl, 0.0};
+        }
+      }
+    }
+    res.ransac_iterations += it;
+    for (const auto& h : top) hyps.push_back(h);
+  }
+  res.time_global = seconds_since(t0);
+  if (hyps.empty()) {
+    res.reason = "no transform hypothesis found (too few consistent feature matches)";
+    return;
+  }
+
+  // ---- refine the best distinct hypotheses by ICP and choose by fitting error + up penalty.
+  t0 = Clock::now();
+  // Candidates (distinct, by consensus) are ranked by their fitting error on a scene subsample;
+  // the best `hypotheses` get a coarse ICP.
+  std::vector<Vec3> sub;
+  const int stride = std::max(1, ns / P.coarse_points);
+  for (int i = 0; i < ns; i += stride) sub.push_back(spts[i]);
+  std::stable_sort(hyps.begin(), hyps.end(), [](const Hypothesis& a, const Hypothesis& b) { return a.inliers > b.inliers; });
+  std::vector<Hypothesis> distinct;
+  for (const auto& h : hyps) {
+    bool dup = false;
+    for (const auto& g : distinct) dup = dup || similar(g.T, h.T, 4.0 * voxel, 20.0 * 3.14159265358979323846 / 180.0);
+    if (!dup) distinct.push_back(h);
+  }
+  for (auto& h : distinct) h.cost = measure(md, sub, h.T, tau).delta;
+  std::stable_sort(distinct.begin(), distinct.end(), [](const Hypothesis& a, const Hypothesis& b) { return a.cost < b.cost; });
+  if (static_cast<int>(distinct.size()) > P.hypotheses) distinct.resize(P.hypotheses);
+  // Coarse: a short ICP on a subsample of the scene for every hypothesis; fine: the winner.
+  auto cost_of = [&](const Fit& f, const Iso3& T) {
+    const double up_cos = T.linear().row(2).dot(up);
+    return f.delta / tau + (P.use_up_prior ? P.up_weight * (1.0 - up_cos) / 2.0 : 0.0);
+  };
+  double best_cost = std::numeric_limits<double>::infinity();
+  Iso3 best_T = Iso3::Identity();
+  for (auto& h : distinct) {
+    const Iso3 T = icp(md, sub, h.T, P.icp_distance * voxel, P.coarse_icp_iterations, P.icp_tolerance);
+    const double cost = cost_of(measure(md, sub, T, tau), T);
+    if (cost < best_cost) {
+      best_cost = cost;
+      best_T = T;
+    }
+  }
+  const Iso3 T = icp(md, spts, best_T, P.icp_distance * voxel, P.icp_iterations, P.icp_tolerance);
+  const Fit f = measure(md, spts, T, tau);
+  const double sigma = P.weight_sigma * voxel;
+  res.transform = T.inverse().matrix();
+  res.fitness = f.fitness;
+  res.rmse = f.rmse;
+  res.delta = f.delta;
+  res.phi = std::exp(-f.delta * f.delta / (2 * sigma * sigma));
+  res.up_cos = T.linear().row(2).dot(up);
+  res.cost = cost_of(f, T);
+  res.time_icp = seconds_since(t0);
+  if (!res.transform.allFinite()) {
+    res.reason = "registration produced a non-finite transform";
+    res.transform.setIdentity();
+    return;
+  }
+  res.success = true;
+}
+
 }  // namespace
 
 // ---------------------------------------------------------------------------------------
@@ -330,292 +632,115 @@ double rotation_error(const Mat3& Ra, const Mat3& Rb, const Vec3& axis) {
   return std::acos(c);
 }
 
-std::vector<RegistrationResult> register_models(const Points& scene, const std::vector<ModelCloud>& models,
-                                                const RegistrationParams& P) {
-  if (!(P.voxel > 0) || !std::isfinite(P.voxel)) throw std::invalid_argument("voxel must be positive and finite");
-  for (double f : {P.normal_radius, P.feature_radius, P.inlier_distance, P.icp_distance, P.weight_sigma})
-    if (!(f > 0) || !std::isfinite(f)) throw std::invalid_argument("radius and distance factors must be positive");
-  if (P.ransac_iterations < 1 || P.restarts < 1 || P.hypotheses < 1 || P.candidates < 1 || P.coarse_points < 1 || P.icp_iterations < 0 || P.coarse_icp_iterations < 0 ||
-      P.feature_neighbours < 1)
-    throw std::invalid_argument("iteration, restart, hypothesis and neighbour counts must be positive");
-  if (!(P.ransac_confidence > 0 && P.ransac_confidence < 1)) throw std::invalid_argument("ransac_confidence must be in (0, 1)");
-  if (!(P.edge_similarity > 0 && P.edge_similarity < 1)) throw std::invalid_argument("edge_similarity must be in (0, 1)");
-  if (P.use_up_prior && !(P.up.norm() > 0)) throw std::invalid_argument("up must be a non-zero vector");
-  if (models.empty()) throw std::invalid_argument("no models given");
+// ---------------------------------------------------------------------------------------
+struct Registrar::Model : ModelData {};
+
+struct Registrar::Impl {
+  RegistrationParams P;
+  std::vector<std::unique_ptr<Model>> models;
+  mutable std::shared_mutex mutex;  // add_models (unique) against the readers (shared)
+};
+
+Registrar::Registrar(const RegistrationParams& params) : impl_(std::make_unique<Impl>()) {
+  validate(params);
+  impl_->P = params;
+}
+Registrar::~Registrar() = default;
+Registrar::Registrar(Registrar&&) noexcept = default;
+Registrar& Registrar::operator=(Registrar&&) noexcept = default;
+
+int Registrar::add_models(const std::vector<ModelCloud>& models) {
+  const int n = static_cast<int>(models.size());
+  std::vector<std::unique_ptr<Model>> prepared(n);
+  for (auto& m : prepared) m = std::make_unique<Model>();
+  const RegistrationParams& P = impl_->P;
+  const int nthreads = P.threads > 0 ? P.threads : omp_get_max_threads();
+#pragma omp parallel for schedule(dynamic, 1) num_threads(nthreads)
+  for (int i = 0; i < n; ++i) prepare_model(models[i].surface, P, *prepared[i]);
+  std::unique_lock<std::shared_mutex> lock(impl_->mutex);
+  const int first = static_cast<int>(impl_->models.size());
+  for (auto& m : prepared) impl_->models.push_back(std::move(m));
+  return first;
+}
+
+int Registrar::size() const {
+  std::shared_lock<std::shared_mutex> lock(impl_->mutex);
+  return static_cast<int>(impl_->models.size());
+}
+const RegistrationParams& Registrar::params() const { return impl_->P; }
+namespace {
+void check_index(int i, std::size_t n) {
+  if (i < 0 || static_cast<std::size_t>(i) >= n)
+    throw std::invalid_argument("model index " + std::to_string(i) + " out of range [0, " + std::to_string(n) + ")");
+}
+}  // namespace
+const Registrar::Model& Registrar::model(int i) const {
+  std::shared_lock<std::shared_mutex> lock(impl_->mutex);
+  check_index(i, impl_->models.size());
+  return *impl_->models[i];  // models are never removed, so the reference stays valid
+}
+bool Registrar::model_ok(int i) const { return model(i).ok; }
+const std::string& Registrar::model_reason(int i) const { return model(i).reason; }
+int Registrar::model_points(int i) const { return model(i).nm; }
+double Registrar::model_time(int i) const { return model(i).time; }
+
+std::vector<RegistrationResult> Registrar::register_scene(const Points& scene, std::uint64_t seed,
+                                                          const std::optional<Vec3>& viewpoint,
+                                                          const std::vector<int>& which) const {
+  const RegistrationParams& P = impl_->P;
+  std::shared_lock<std::shared_mutex> lock(impl_->mutex);
+  std::vector<int> idx = which;
+  if (idx.empty()) {
+    idx.resize(impl_->models.size());
+    std::iota(idx.begin(), idx.end(), 0);
+  }
+  if (idx.empty()) throw std::invalid_argument("no models given");
+  for (int i : idx) check_index(i, impl_->models.size());
+  if (viewpoint && !viewpoint->allFinite()) throw std::invalid_argument("viewpoint must be finite");
   CloudN::Ptr raw = to_cloud(scene, nullptr);
   if (raw->empty()) throw std::invalid_argument("scene cloud has no finite points");
 
-  const double voxel = P.voxel, tau = P.inlier_distance * voxel;
   const int nthreads = P.threads > 0 ? P.threads : omp_get_max_threads();
-  std::vector<RegistrationResult> results(models.size());
-
-  // Scene: downsample, normals towards the viewpoint (or away from the centroid), FPFH.
-  const auto t_scene = Clock::now();
-  CloudN::Ptr sdown = downsample(raw, voxel);
-  Prepared sprep = prepare(sdown, P.normal_radius * voxel, P.feature_radius * voxel,
-                           P.has_viewpoint ? Orient::Viewpoint : Orient::AwayFromCentroid, P.viewpoint, nthreads);
-  const double scene_time = seconds_since(t_scene);
-  const int ns = static_cast<int>(sprep.cloud->size());
-  std::vector<Vec3> spts(ns);
-  for (int i = 0; i < ns; ++i) spts[i] = (*sprep.cloud)[i].getVector3fMap().cast<double>();
-  if (ns < P.min_scene_points) {
+  std::vector<RegistrationResult> results(idx.size());
+  const SceneData sd = prepare_scene(raw, P, viewpoint, nthreads);
+  if (sd.ns < P.min_scene_points) {
     for (auto& r : results) {
-      r.reason = "scene has " + std::to_string(ns) + " points with normals after downsampling at voxel " +
-                 std::to_string(voxel) + " m; at least " + std::to_string(P.min_scene_points) + " are needed";
-      r.scene_points = ns;
+      r.reason = "scene has " + std::to_string(sd.ns) + " points with normals after downsampling at voxel " +
+                 std::to_string(P.voxel) + " m; at least " + std::to_string(P.min_scene_points) + " are needed";
+      r.scene_points = sd.ns;
     }
     return results;
   }
-  // Squared norms of the scene features, for the distance matrix.
-  Features sfeat = sprep.features;
-  if (P.hellinger) sfeat = sfeat.cwiseMax(0.f).cwiseSqrt();  // Hellinger: L2 between sqrt histograms
-  const Eigen::VectorXf sf_norm = sfeat.rowwise().squaredNorm();
-
-  std::vector<Vec3> snrm(ns);
-  for (int i = 0; i < ns; ++i) snrm[i] = (*sprep.cloud)[i].getNormalVector3fMap().cast<double>();
-  const Vec3 up = P.up.norm() > 0 ? P.up.normalized() : Vec3::UnitZ();
-  const double cos_tilt = std::cos(P.max_tilt);
-  // Rotation taking the scene's up onto +z (the model's up), for the 4-DOF hypotheses.
-  const Mat3 R0 = Eigen::Quaterniond::FromTwoVectors(up, Vec3::UnitZ()).toRotationMatrix();
-
 #pragma omp parallel for schedule(dynamic, 1) num_threads(nthreads)
-  for (int mi = 0; mi < static_cast<int>(models.size()); ++mi) {
-    RegistrationResult& res = results[mi];
-    res.scene_points = ns;
-    res.time_features = scene_time;
-    const SurfaceSamples& S = models[mi].surface;
-    if (S.points.rows() == 0 || S.points.rows() != S.normals.rows()) {
-      res.reason = "model has no surface points";
+  for (int k = 0; k < static_cast<int>(idx.size()); ++k) {
+    RegistrationResult& res = results[k];
+    const ModelData& md = *impl_->models[idx[k]];
+    res.scene_points = sd.ns;
+    res.time_features = sd.time;
+    res.model_points = md.nm;
+    if (!md.ok) {
+      res.reason = md.reason;
       continue;
     }
-    if (!S.points.allFinite() || !S.normals.allFinite()) {
-      res.reason = "model points or normals contain NaN or infinity";
-      continue;
-    }
-    // ---- model features
-    auto t0 = Clock::now();
-    ModelData md;
-    md.dense = to_cloud(S.points, &S.normals);
-    md.dense_tree.setInputCloud(md.dense);
-    CloudN::Ptr mdown = downsample(md.dense, voxel);
-    md.prep = prepare(mdown, P.normal_radius * voxel, P.feature_radius * voxel, Orient::Reference, Vec3::Zero(), 1);
-    const int nm = static_cast<int>(md.prep.cloud->size());
-    res.model_points = nm;
-    res.time_features += seconds_since(t0);
-    if (nm < 3) {
-      res.reason = "model has too few points after downsampling (" + std::to_string(nm) + ")";
-      continue;
-    }
-
-    // ---- correspondences: each scene feature's k nearest model features (brute force, L2).
-    t0 = Clock::now();
-    const int k = std::min(P.feature_neighbours, nm);
-    Features mfeat = md.prep.features;
-    if (P.hellinger) mfeat = mfeat.cwiseMax(0.f).cwiseSqrt();
-    const Eigen::VectorXf mf_norm = mfeat.rowwise().squaredNorm();
-    std::vector<std::pair<int, int>> corr;
-    corr.reserve(static_cast<std::size_t>(ns) * k + nm);
-    {
-      // Forward: each scene feature's k nearest model features. Reverse (optional): each model
-      // feature's nearest scene feature, which keeps the matches spread over the model when many
-      // scene features share a few nearest model features ("hubs", e.g. on flat faces).
-      const int block = 256;
-      Eigen::MatrixXf D;
-      std::vector<int> order(nm);
-      std::vector<float> rbest(nm, std::numeric_limits<float>::infinity());
-      std::vector<int> rarg(nm, -1);
-      for (int s0 = 0; s0 < ns; s0 += block) {
-        const int bs = std::min(block, ns - s0);
-        D.noalias() = -2.0f * sfeat.middleRows(s0, bs) * mfeat.transpose();
-        for (int i = 0; i < bs; ++i) {
-          std::iota(order.begin(), order.end(), 0);
-          auto row = D.row(i);
-          std::partial_sort(order.begin(), order.begin() + k, order.end(), [&](int a, int b) {
-            const float da = row(a) + mf_norm(a), db = row(b) + mf_norm(b);
-            return da < db || (da == db && a < b);
-          });
-          for (int j = 0; j < k; ++j) corr.emplace_back(s0 + i, order[j]);
-          if (P.reverse_matches)
-            for (int j = 0; j < nm; ++j) {
-              const float dj = row(j) + sf_norm(s0 + i);
-              if (dj < rbest[j]) {
-                rbest[j] = dj;
-                rarg[j] = s0 + i;
-              }
-            }
-        }
-      }
-      if (P.reverse_matches)
-        for (int j = 0; j < nm; ++j)
-          if (rarg[j] >= 0) corr.emplace_back(rarg[j], j);
-    }
-    const int nc = static_cast<int>(corr.size());
-    std::vector<Vec3> mpts(nm);
-    for (int i = 0; i < nm; ++i) mpts[i] = (*md.prep.cloud)[i].getVector3fMap().cast<double>();
-
-    // ---- RANSAC over correspondences, several restarts; keep distinct good hypotheses.
-    std::vector<Vec3> mnrm(nm);
-    for (int i = 0; i < nm; ++i) mnrm[i] = (*md.prep.cloud)[i].getNormalVector3fMap().cast<double>();
-    std::vector<Hypothesis> hyps;
-    const double tau2 = tau * tau;
-    const double min_edge = 2.0 * voxel;
-    const double sim = P.edge_similarity;
-    const double cos_normal = std::cos(P.max_normal_angle);
-    const bool four_dof = P.use_up_prior && P.upright;
-    const int sample_size = four_dof ? 2 : 3;
-    for (int rs = 0; rs < P.restarts; ++rs) {
-      std::mt19937_64 rng(mix(P.seed * 0x100000001B3ull + static_cast<std::uint64_t>(rs)));
-      std::uniform_int_distribution<int> pick(0, nc - 1);
-      std::vector<Hypothesis> top;  // best distinct hypotheses of this restart
-      int best = 0;
-      long needed = P.ransac_iterations;
-      int it = 0;
-      for (; it < P.ransac_iterations && it < needed; ++it) {
-        int s_id[3], m_id[3];
-        for (int j = 0; j < sample_size; ++j) {
-          const int c = pick(rng);
-          s_id[j] = corr[c].first;
-          m_id[j] = corr[c].second;
-        }
-        if (s_id[0] == s_id[1] || (sample_size == 3 && (s_id[0] == s_id[2] || s_id[1] == s_id[2]))) continue;
-        Iso3 T = Iso3::Identity();
-        bool okay = true;
-        if (four_dof) {
-          // Yaw about the up axis and a translation from two correspondences (the model's +z is
-          // the scene's up): levelled scene points q = R0 p, then a rotation about z.
-          const Vec3 qa = R0 * spts[s_id[0]], qb = R0 * spts[s_id[1]];
-          const Vec3 dq = qb - qa, dm = mpts[m_id[1]] - mpts[m_id[0]];
-          const double lq = dq.head<2>().norm(), lm = dm.head<2>().norm();
-          if (lq < min_edge || lm < min_edge || std::min(lq, lm) < sim * std::max(lq, lm) ||
-              std::abs(dq.z() - dm.z()) > tau)
-            continue;
-          const double yaw = std::atan2(dm.y(), dm.x()) - std::atan2(dq.y(), dq.x());
-          T.linear() = Eigen::AngleAxisd(yaw, Vec3::UnitZ()).toRotationMatrix() * R0;
-          T.translation() = 0.5 * (mpts[m_id[0]] + mpts[m_id[1]]) - T.linear() * 0.5 * (spts[s_id[0]] + spts[s_id[1]]);
-        } else {
-          const int pairs[3][2] = {{0, 1}, {1, 2}, {0, 2}};
-          for (const auto& pr : pairs) {
-            const double ls = (spts[s_id[pr[0]]] - spts[s_id[pr[1]]]).norm();
-            const double lm = (mpts[m_id[pr[0]]] - mpts[m_id[pr[1]]]).norm();
-            if (ls < min_edge || lm < min_edge || std::min(ls, lm) < sim * std::max(ls, lm)) {
-              okay = false;
-              break;
-            }
-          }
-          if (!okay) continue;
-          Eigen::Matrix3Xd src(3, 3), dst(3, 3);
-          for (int j = 0; j < 3; ++j) {
-            src.col(j) = spts[s_id[j]];
-            dst.col(j) = mpts[m_id[j]];
-          }
-          T = kabsch(src, dst);
-          // model +z in the scene frame = R^T e_z (T maps scene -> model).
-          if (P.use_up_prior && T.linear().row(2).dot(up) < cos_tilt) continue;
-        }
-        // The sampled points must land near their matches with agreeing normals.
-        for (int j = 0; j < sample_size && okay; ++j)
-          okay = (T * spts[s_id[j]] - mpts[m_id[j]]).squaredNorm() < tau2 &&
-                 (T.linear() * snrm[s_id[j]]).dot(mnrm[m_id[j]]) > cos_normal;
-        if (!okay) continue;
-        int inl = 0;
-        for (int j = 0; j < nc; ++j)
-          inl += (T * spts[corr[j].first] - mpts[corr[j].second]).squaredNorm() < tau2;
-        if (inl < sample_size) continue;
-        if (inl > best) {
-          best = inl;
-          const double w = std::min(0.999, static_cast<double>(best) / ns);
-          const double denom = std::log(1.0 - std::pow(w, sample_size));
-          if (denom < 0)
-            needed = std::max<long>(P.ransac_min_iterations,
-                                    static_cast<long>(std::ceil(std::log(1.0 - P.ransac_confidence) / denom)));
-        }
-        // Keep the `hypotheses` best distinct ones.
-        const double ttol = 4.0 * voxel, rtol = 20.0 * 3.14159265358979323846 / 180.0;
-        bool merged = false;
-        for (auto& h : top) {
-          if (similar(h.T, T, ttol, rtol)) {
-            if (inl > h.inliers) {
-              h.T = T;
-              h.inliers = inl;
-            }
-            merged = true;
-            break;
-          }
-        }
-        if (!merged) {
-          if (static_cast<int>(top.size()) < P.candidates) {
-            top.push_back({T, inl, 0.0});
-          } else {
-            auto worst = std::min_element(top.begin(), top.end(),
-                                          [](const Hypothesis& a, const Hypothesis& b) { return a.inliers < b.inliers; });
-            if (inl > worst->inliers) *worst = {T, inl, 0.0};
-          }
-        }
-      }
-      res.ransac_iterations += it;
-      for (const auto& h : top) hyps.push_back(h);
-    }
-    res.time_global = seconds_since(t0);
-    if (hyps.empty()) {
-      res.reason = "no transform hypothesis found (too few consistent feature matches)";
-      continue;
-    }
-
-    // ---- refine the best distinct hypotheses by ICP and choose by fitting error + up penalty.
-    t0 = Clock::now();
-    // Candidates (distinct, by consensus) are ranked by their fitting error on a scene subsample;
-    // the best `hypotheses` get a coarse ICP.
-    std::vector<Vec3> sub;
-    const int stride = std::max(1, ns / P.coarse_points);
-    for (int i = 0; i < ns; i += stride) sub.push_back(spts[i]);
-    std::stable_sort(hyps.begin(), hyps.end(), [](const Hypothesis& a, const Hypothesis& b) { return a.inliers > b.inliers; });
-    std::vector<Hypothesis> distinct;
-    for (const auto& h : hyps) {
-      bool dup = false;
-      for (const auto& g : distinct) dup = dup || similar(g.T, h.T, 4.0 * voxel, 20.0 * 3.14159265358979323846 / 180.0);
-      if (!dup) distinct.push_back(h);
-    }
-    for (auto& h : distinct) h.cost = measure(md, sub, h.T, tau).delta;
-    std::stable_sort(distinct.begin(), distinct.end(), [](const Hypothesis& a, const Hypothesis& b) { return a.cost < b.cost; });
-    if (static_cast<int>(distinct.size()) > P.hypotheses) distinct.resize(P.hypotheses);
-    // Coarse: a short ICP on a subsample of the scene for every hypothesis; fine: the winner.
-    auto cost_of = [&](const Fit& f, const Iso3& T) {
-      const double up_cos = T.linear().row(2).dot(up);
-      return f.delta / tau + (P.use_up_prior ? P.up_weight * (1.0 - up_cos) / 2.0 : 0.0);
-    };
-    double best_cost = std::numeric_limits<double>::infinity();
-    Iso3 best_T = Iso3::Identity();
-    for (auto& h : distinct) {
-      const Iso3 T = icp(md, sub, h.T, P.icp_distance * voxel, P.coarse_icp_iterations, P.icp_tolerance);
-      const double cost = cost_of(measure(md, sub, T, tau), T);
-      if (cost < best_cost) {
-        best_cost = cost;
-        best_T = T;
-      }
-    }
-    const Iso3 T = icp(md, spts, best_T, P.icp_distance * voxel, P.icp_iterations, P.icp_tolerance);
-    const Fit f = measure(md, spts, T, tau);
-    const double sigma = P.weight_sigma * voxel;
-    res.transform = T.inverse().matrix();
-    res.fitness = f.fitness;
-    res.rmse = f.rmse;
-    res.delta = f.delta;
-    res.phi = std::exp(-f.delta * f.delta / (2 * sigma * sigma));
-    res.up_cos = T.linear().row(2).dot(up);
-    res.cost = cost_of(f, T);
-    res.time_icp = seconds_since(t0);
-    if (!res.transform.allFinite()) {
-      res.reason = "registration produced a non-finite transform";
-      res.transform.setIdentity();
-      continue;
-    }
-    res.success = true;
+    register_one(md, sd, P, seed, res);
   }
   double total = 0;
   for (const auto& r : results)
     if (r.success) total += r.phi;
   for (auto& r : results) r.weight = (r.success && total > 0) ? r.phi / total : 0.0;
   return results;
+}
+
+std::vector<RegistrationResult> register_models(const Points& scene, const std::vector<ModelCloud>& models,
+                                                const RegistrationParams& P) {
+  Registrar reg(P);
+  if (models.empty()) throw std::invalid_argument("no models given");
+  if (!scene.array().isFinite().rowwise().all().any()) throw std::invalid_argument("scene cloud has no finite points");
+  reg.add_models(models);
+  std::vector<RegistrationResult> res =
+      reg.register_scene(scene, P.seed, P.has_viewpoint ? std::optional<Vec3>(P.viewpoint) : std::nullopt);
+  for (int i = 0; i < reg.size(); ++i) res[i].time_features += reg.model_time(i);
+  return res;
 }
 
 }  // namespace bayesgrasp::vision
