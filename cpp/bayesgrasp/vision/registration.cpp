@@ -162,12 +162,113 @@ Iso3 kabsch(const Eigen::Matrix3Xd& src, const Eigen::Matrix3Xd& dst) {
   return T;
 }
 
+// Exact nearest neighbour within a fixed radius among fixed points: a uniform grid with cells of
+// at least the radius over the points' bounding box, points sorted by cell (counting sort); a
+// query scans the 3 x 3 x 3 cells around its own, nearest cells first, skipping cells whose box is
+// farther than the best distance so far. Much cheaper than a k-d tree for the short-range queries
+// of the fit measures and ICP, whose distances are all cut off at the inlier / ICP distance.
+class RadiusGrid {
+ public:
+  void build(const CloudN& cloud, double radius) {
+    r2_ = radius * radius;
+    Eigen::Vector3d lo = Eigen::Vector3d::Constant(std::numeric_limits<double>::infinity()), hi = -lo;
+    for (const auto& p : cloud) {
+      lo = lo.cwiseMin(p.getVector3fMap().cast<double>());
+      hi = hi.cwiseMax(p.getVector3fMap().cast<double>());
+    }
+    // Cell size: the radius, larger if the grid would have more than kMaxCells cells.
+    constexpr double kMaxCells = 4.0e6;
+    const Eigen::Vector3d ext = (hi - lo).cwiseMax(radius);
+    h_ = std::max(radius, std::cbrt(ext.prod() / kMaxCells));
+    origin_ = lo;
+    for (int a = 0; a < 3; ++a) n_[a] = static_cast<int>(std::floor(ext[a] / h_)) + 1;
+    const std::size_t cells = static_cast<std::size_t>(n_[0]) * n_[1] * n_[2];
+    start_.assign(cells + 1, 0);
+    std::vector<std::size_t> key(cloud.size());
+    for (std::size_t i = 0; i < cloud.size(); ++i) {
+      key[i] = cell_of(cloud[i].getVector3fMap().cast<double>());
+      ++start_[key[i] + 1];
+    }
+    for (std::size_t c = 0; c < cells; ++c) start_[c + 1] += start_[c];
+    std::vector<int> fill(start_.begin(), start_.end() - 1);
+    xyz_.resize(3 * cloud.size());
+    ids_.resize(cloud.size());
+    for (std::size_t i = 0; i < cloud.size(); ++i) {
+      const int j = fill[key[i]]++;
+      ids_[j] = static_cast<int>(i);
+      xyz_[3 * j] = cloud[i].x;
+      xyz_[3 * j + 1] = cloud[i].y;
+      xyz_[3 * j + 2] = cloud[i].z;
+    }
+  }
+
+  // Index of the nearest point within the radius of q (ties: the first in cell order), -1 if none.
+  int nearest(const Vec3& q) const {
+    int c[3];
+    Vec3 f;  // q's position inside its cell, in [0, 1) per axis when inside the grid
+    for (int a = 0; a < 3; ++a) {
+      const double u = (q[a] - origin_[a]) / h_;
+      const double fl = std::floor(u);
+      if (!(fl >= -1 && fl <= n_[a])) return -1;  // farther than one cell outside the grid (or NaN)
+      c[a] = static_cast<int>(fl);
+      f[a] = u - fl;
+    }
+    float best = static_cast<float>(r2_);
+    int arg = -1;
+    const float qx = static_cast<float>(q.x()), qy = static_cast<float>(q.y()), qz = static_cast<float>(q.z());
+    // Own cell first, then the others ordered by how far their box is.
+    static constexpr int kOrder[27][3] = {
+        {0, 0, 0},   {-1, 0, 0},  {1, 0, 0},   {0, -1, 0},  {0, 1, 0},   {0, 0, -1},  {0, 0, 1},
+        {-1, -1, 0}, {-1, 1, 0},  {1, -1, 0},  {1, 1, 0},   {-1, 0, -1}, {-1, 0, 1},  {1, 0, -1},
+        {1, 0, 1},   {0, -1, -1}, {0, -1, 1},  {0, 1, -1},  {0, 1, 1},   {-1, -1, -1}, {-1, -1, 1},
+        {-1, 1, -1}, {-1, 1, 1},  {1, -1, -1}, {1, -1, 1},  {1, 1, -1},  {1, 1, 1}};
+    for (const auto& o : kOrder) {
+      double box2 = 0;  // squared distance from q to the neighbour cell's box
+      bool inside = true;
+      for (int a = 0; a < 3; ++a) {
+        const int ca = c[a] + o[a];
+        if (ca < 0 || ca >= n_[a]) {
+          inside = false;
+          break;
+        }
+        const double g = o[a] < 0 ? f[a] * h_ : o[a] > 0 ? (1.0 - f[a]) * h_ : 0.0;
+        box2 += g * g;
+      }
+      if (!inside || box2 >= best) continue;
+      const std::size_t cell = (static_cast<std::size_t>(c[2] + o[2]) * n_[1] + (c[1] + o[1])) * n_[0] + (c[0] + o[0]);
+      for (int j = start_[cell], e = start_[cell + 1]; j < e; ++j) {
+        const float dx = xyz_[3 * j] - qx, dy = xyz_[3 * j + 1] - qy, dz = xyz_[3 * j + 2] - qz;
+        const float d2 = dx * dx + dy * dy + dz * dz;
+        if (d2 < best) {
+          best = d2;
+          arg = ids_[j];
+        }
+      }
+    }
+    return arg;
+  }
+
+ private:
+  std::size_t cell_of(const Vec3& p) const {
+    int c[3];
+    for (int a = 0; a < 3; ++a)
+      c[a] = std::clamp(static_cast<int>(std::floor((p[a] - origin_[a]) / h_)), 0, n_[a] - 1);
+    return (static_cast<std::size_t>(c[2]) * n_[1] + c[1]) * n_[0] + c[0];
+  }
+  double h_ = 1.0, r2_ = 0.0;
+  Vec3 origin_ = Vec3::Zero();
+  int n_[3] = {1, 1, 1};
+  std::vector<int> start_;  // points of cell c: [start_[c], start_[c+1]) in xyz_ / ids_
+  std::vector<float> xyz_;
+  std::vector<int> ids_;
+};
+
 // A model prepared for registration: everything that does not depend on the scene.
 struct ModelData {
   bool ok = false;
   std::string reason;
   CloudN::Ptr dense;  // all surface samples with exact normals
-  pcl::KdTreeFLANN<pcl::PointNormal> dense_tree;
+  RadiusGrid dense_grid;  // over the dense samples, radius max(inlier, ICP distance)
   Prepared prep;            // downsampled, normals, FPFH
   Features mfeat;           // the features as matched (square roots for the Hellinger distance)
   Eigen::VectorXf mf_norm;  // their squared norms
@@ -185,26 +286,21 @@ struct SceneData {
   double time = 0.0;
 };
 
-// Distances from each (transformed) scene point to the nearest dense model sample.
+// Distances from each (transformed) scene point to the nearest dense model sample within the
+// grid's radius (infinity beyond; the fit measures and ICP cut distances off below it).
 void nearest(const ModelData& m, const std::vector<Vec3>& pts, const Iso3& T, std::vector<double>& d,
              std::vector<int>& idx) {
   d.resize(pts.size());
   idx.resize(pts.size());
-  pcl::Indices k(1);
-  std::vector<float> kd(1);
   for (std::size_t i = 0; i < pts.size(); ++i) {
     const Vec3 q = T * pts[i];
-    pcl::PointNormal p;
-    p.x = static_cast<float>(q.x());
-    p.y = static_cast<float>(q.y());
-    p.z = static_cast<float>(q.z());
-    if (m.dense_tree.nearestKSearch(p, 1, k, kd) > 0) {
-      const auto& s = (*m.dense)[k[0]];
+    const int k = m.dense_grid.nearest(q);
+    idx[i] = k;
+    if (k >= 0) {
+      const auto& s = (*m.dense)[k];
       d[i] = (q - Vec3(s.x, s.y, s.z)).norm();
-      idx[i] = k[0];
     } else {
       d[i] = std::numeric_limits<double>::infinity();
-      idx[i] = -1;
     }
   }
 }
@@ -294,7 +390,7 @@ void prepare_model(const SurfaceSamples& S, const RegistrationParams& P, ModelDa
   }
   const double voxel = P.voxel;
   md.dense = to_cloud(S.points, &S.normals);
-  md.dense_tree.setInputCloud(md.dense);
+  md.dense_grid.build(*md.dense, std::max(P.inlier_distance, P.icp_distance) * voxel);
   CloudN::Ptr mdown = downsample(md.dense, voxel);
   md.prep = prepare(mdown, P.normal_radius * voxel, P.feature_radius * voxel, Orient::Reference, Vec3::Zero(), 1);
   md.nm = static_cast<int>(md.prep.cloud->size());
