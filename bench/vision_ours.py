@@ -3,7 +3,8 @@ thread. With --registrar 1 (the default) the models are prepared once in a
 bayesgrasp._core.vision.Registrar before the timed calls (downsampled cloud, normals, FPFH, k-d
 trees), as bench/vision_open3d.py --model-cache 1 does for Open3D, and each timed call does only the
 per-view work; --registrar 0 times one-shot register_models calls that prepare the model inside.
-Usage: python bench/vision_ours.py [--up-prior 0|1] [--registrar 0|1]
+--pcl-features 1 uses PCL's normal and FPFH estimators instead of ours (same definitions).
+Usage: python bench/vision_ours.py [--up-prior 0|1] [--registrar 0|1] [--pcl-features 0|1]
 Writes bench/results/vision_ours[_noprior][_oneshot].json (or --out)."""
 import argparse
 import json
@@ -23,6 +24,7 @@ def main():
     ap.add_argument("--views", default="bench/results/vision_views.npz")
     ap.add_argument("--up-prior", type=int, default=1)
     ap.add_argument("--registrar", type=int, default=1)
+    ap.add_argument("--pcl-features", type=int, default=0, help="PCL's normals + FPFH instead of ours")
     ap.add_argument("--limit", type=int, default=0)
     ap.add_argument("--out", default="")
     a = ap.parse_args()
@@ -32,7 +34,8 @@ def main():
     V = _core.vision
     samples = [(m["points"], m["normals"]) for m in models]
     t0 = time.perf_counter()
-    reg = V.Registrar(samples, voxel=voxel, up_prior=bool(a.up_prior), threads=1) if a.registrar else None
+    reg = V.Registrar(samples, voxel=voxel, up_prior=bool(a.up_prior), threads=1,
+                                pcl_features=bool(a.pcl_features)) if a.registrar else None
     t_prepare = time.perf_counter() - t0
     rows = []
     for i, v in enumerate(views):
@@ -42,13 +45,13 @@ def main():
             r = reg.register(v["points"], seed=i, viewpoint=v["eye"], models=[v["model"]])[0]
         else:
             r = V.register_models(v["points"], [samples[v["model"]]], voxel=voxel, seed=i, viewpoint=v["eye"],
-                                  up_prior=bool(a.up_prior), threads=1)[0]
+                                  up_prior=bool(a.up_prior), threads=1, pcl_features=bool(a.pcl_features))[0]
         dt = time.perf_counter() - t0
         rot, tr = errors(np.asarray(r["transform"]), v["T_true"], m["axis"])
         rows.append(dict(view=i, model=m["name"], time=dt, rot_deg=rot, trans_m=tr,
                          success=bool(r["success"]) and rot < 10 and tr < 0.01, fitness=r["fitness"],
                          time_features=r["time_features"], time_global=r["time_global"], time_icp=r["time_icp"]))
-    name = "ours (PCL FPFH + seeded RANSAC " + ("4-DOF, up prior" if a.up_prior else "6-DOF, no prior") + " + ICP" \
+    name = "ours (" + ("PCL" if a.pcl_features else "own") + " FPFH + seeded RANSAC " + ("4-DOF, up prior" if a.up_prior else "6-DOF, no prior") + " + ICP" \
         + (", models prepared once)" if a.registrar else ", one-shot)")
     s = summarise(name, rows)
     if reg is not None:

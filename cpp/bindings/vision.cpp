@@ -93,7 +93,7 @@ RegistrationParams params_arg(double voxel, bool up_prior, bool upright, const D
                               int restarts, int ransac_iterations, int hypotheses, int icp_iterations,
                               int feature_neighbours, double normal_radius, double feature_radius,
                               double inlier_distance, double icp_distance, double weight_sigma, int min_scene_points,
-                              int threads, bool reverse_matches, bool hellinger) {
+                              int threads, bool reverse_matches, bool hellinger, bool pcl_features) {
   RegistrationParams p;
   p.voxel = positive(voxel, "voxel");
   p.use_up_prior = up_prior;
@@ -121,6 +121,7 @@ RegistrationParams params_arg(double voxel, bool up_prior, bool upright, const D
   p.threads = threads;
   p.reverse_matches = reverse_matches;
   p.hellinger = hellinger;
+  p.pcl_features = pcl_features;
   return p;
 }
 
@@ -329,12 +330,12 @@ void bind_vision(py::module_& m) {
          const DArray& up, double max_tilt_deg, py::object viewpoint, int restarts, int ransac_iterations,
          int hypotheses, int icp_iterations, int feature_neighbours, double normal_radius, double feature_radius,
          double inlier_distance, double icp_distance, double weight_sigma, int min_scene_points, int threads,
-         bool reverse_matches, bool hellinger) {
+         bool reverse_matches, bool hellinger, bool pcl_features) {
         const Points S = scene_arg(scene);
         RegistrationParams p = params_arg(voxel, up_prior, upright, up, max_tilt_deg, restarts, ransac_iterations,
                                           hypotheses, icp_iterations, feature_neighbours, normal_radius,
                                           feature_radius, inlier_distance, icp_distance, weight_sigma,
-                                          min_scene_points, threads, reverse_matches, hellinger);
+                                          min_scene_points, threads, reverse_matches, hellinger, pcl_features);
         p.seed = seed;
         const std::optional<Vec3> vp = viewpoint_arg(viewpoint);
         p.has_viewpoint = vp.has_value();
@@ -356,6 +357,7 @@ void bind_vision(py::module_& m) {
       py::arg("normal_radius") = 2.0, py::arg("feature_radius") = 5.0, py::arg("inlier_distance") = 1.5,
       py::arg("icp_distance") = 1.5, py::arg("weight_sigma") = 0.5, py::arg("min_scene_points") = 30,
       py::arg("threads") = 0, py::arg("reverse_matches") = true, py::arg("hellinger") = true,
+      py::arg("pcl_features") = false,
       "Registers a partial cloud (N, 3; NaN rows dropped) against models [(points (M,3), outward normals "
       "(M,3)), ...] (surface samples; see model_from_mesh). Radii and distances are multiples of `voxel`. "
       "One shot: the models are prepared (downsampled, normals, FPFH) inside the call; use Registrar to "
@@ -372,12 +374,12 @@ void bind_vision(py::module_& m) {
                        double max_tilt_deg, int restarts, int ransac_iterations, int hypotheses, int icp_iterations,
                        int feature_neighbours, double normal_radius, double feature_radius, double inlier_distance,
                        double icp_distance, double weight_sigma, int min_scene_points, int threads,
-                       bool reverse_matches, bool hellinger) {
+                       bool reverse_matches, bool hellinger, bool pcl_features) {
              const RegistrationParams p = params_arg(voxel, up_prior, upright, up, max_tilt_deg, restarts,
                                                      ransac_iterations, hypotheses, icp_iterations,
                                                      feature_neighbours, normal_radius, feature_radius,
                                                      inlier_distance, icp_distance, weight_sigma, min_scene_points,
-                                                     threads, reverse_matches, hellinger);
+                                                     threads, reverse_matches, hellinger, pcl_features);
              const std::vector<ModelCloud> ms = models_arg(models, true);
              auto r = std::make_unique<Registrar>(p);
              {
@@ -392,7 +394,7 @@ void bind_vision(py::module_& m) {
            py::arg("feature_neighbours") = 2, py::arg("normal_radius") = 2.0, py::arg("feature_radius") = 5.0,
            py::arg("inlier_distance") = 1.5, py::arg("icp_distance") = 1.5, py::arg("weight_sigma") = 0.5,
            py::arg("min_scene_points") = 30, py::arg("threads") = 0, py::arg("reverse_matches") = true,
-           py::arg("hellinger") = true,
+           py::arg("hellinger") = true, py::arg("pcl_features") = false,
            "Prepares the models [(points (M,3), outward normals (M,3)), ...] (may be empty; see add_models) "
            "with the parameters of register_models.")
       .def(

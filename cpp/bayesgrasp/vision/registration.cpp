@@ -87,81 +87,6 @@ CloudN::Ptr downsample(const CloudN::Ptr& in, double voxel) {
   return out;
 }
 
-// Normals by PCA over a radius; oriented towards `viewpoint` (scene) or along the averaged
-// reference normals carried by the points (model). Points without a normal are removed.
-// Then FPFH over `feature_radius`.
-enum class Orient { Viewpoint, Reference, AwayFromCentroid };
-Prepared prepare(const CloudN::Ptr& down, double normal_radius, double feature_radius, Orient orient,
-                 const Vec3& viewpoint, int threads) {
-  CloudN::Ptr withn(new CloudN);
-  pcl::NormalEstimationOMP<pcl::PointNormal, pcl::PointNormal> ne(threads);
-  ne.setInputCloud(down);
-  ne.setRadiusSearch(normal_radius);
-  ne.setViewPoint(static_cast<float>(viewpoint.x()), static_cast<float>(viewpoint.y()),
-                  static_cast<float>(viewpoint.z()));
-  CloudN est;
-  ne.compute(est);
-  withn->reserve(down->size());
-  Eigen::Vector3f centroid = Eigen::Vector3f::Zero();
-  for (const auto& p : *down) centroid += p.getVector3fMap();
-  if (!down->empty()) centroid /= static_cast<float>(down->size());
-  for (std::size_t i = 0; i < down->size(); ++i) {
-    pcl::PointNormal p = (*down)[i];
-    Eigen::Vector3f n(est[i].normal_x, est[i].normal_y, est[i].normal_z);
-    if (!n.allFinite() || n.norm() < 0.5f) continue;
-    if (orient == Orient::Reference) {
-      const Eigen::Vector3f ref(p.normal_x, p.normal_y, p.normal_z);
-      if (n.dot(ref) < 0) n = -n;
-    } else if (orient == Orient::AwayFromCentroid) {
-      if (n.dot(p.getVector3fMap() - centroid) < 0) n = -n;
-    }
-    p.normal_x = n.x();
-    p.normal_y = n.y();
-    p.normal_z = n.z();
-    p.curvature = est[i].curvature;
-    withn->push_back(p);
-  }
-  withn->width = static_cast<std::uint32_t>(withn->size());
-  withn->height = 1;
-  Prepared out;
-  out.cloud = withn;
-  if (withn->empty()) return out;
-  pcl::FPFHEstimationOMP<pcl::PointNormal, pcl::PointNormal, pcl::FPFHSignature33> fe(threads);
-  fe.setInputCloud(withn);
-  fe.setInputNormals(withn);
-  fe.setRadiusSearch(feature_radius);
-  pcl::PointCloud<pcl::FPFHSignature33> f;
-  fe.compute(f);
-  out.features.resize(static_cast<Eigen::Index>(f.size()), 33);
-  for (std::size_t i = 0; i < f.size(); ++i)
-    for (int j = 0; j < 33; ++j) out.features(static_cast<Eigen::Index>(i), j) = f[i].histogram[j];
-  return out;
-}
-
-struct Hypothesis {
-  Iso3 T = Iso3::Identity();  // scene -> model
-  int inliers = 0;
-  double cost = 0.0;
-};
-
-bool similar(const Iso3& a, const Iso3& b, double trans_tol, double rot_tol) {
-  const double ang = Eigen::AngleAxisd(a.linear().transpose() * b.linear()).angle();
-  return ang < rot_tol && (a.translation() - b.translation()).norm() < trans_tol;
-}
-
-// Rigid transform (no scale) taking src points onto dst points in the least-squares sense.
-Iso3 kabsch(const Eigen::Matrix3Xd& src, const Eigen::Matrix3Xd& dst) {
-  const Vec3 cs = src.rowwise().mean(), cd = dst.rowwise().mean();
-  const Mat3 Hm = (src.colwise() - cs) * (dst.colwise() - cd).transpose();
-  Eigen::JacobiSVD<Mat3> svd(Hm, Eigen::ComputeFullU | Eigen::ComputeFullV);
-  Mat3 D = Mat3::Identity();
-  if ((svd.matrixV() * svd.matrixU().transpose()).determinant() < 0) D(2, 2) = -1;
-  Iso3 T = Iso3::Identity();
-  T.linear() = svd.matrixV() * D * svd.matrixU().transpose();
-  T.translation() = cd - T.linear() * cs;
-  return T;
-}
-
 // Exact nearest neighbour within a fixed radius among fixed points: a uniform grid with cells of
 // at least the radius over the points' bounding box, points sorted by cell (counting sort); a
 // query scans the 3 x 3 x 3 cells around its own, nearest cells first, skipping cells whose box is
@@ -200,6 +125,28 @@ class RadiusGrid {
       xyz_[3 * j + 1] = cloud[i].y;
       xyz_[3 * j + 2] = cloud[i].z;
     }
+  }
+
+  // Indices of all points within the radius of q (distance <= radius), in cell order.
+  void within(const Vec3& q, std::vector<int>& out) const {
+    out.clear();
+    int c[3];
+    for (int a = 0; a < 3; ++a) {
+      const double fl = std::floor((q[a] - origin_[a]) / h_);
+      if (!(fl >= -1 && fl <= n_[a])) return;
+      c[a] = static_cast<int>(fl);
+    }
+    const float qx = static_cast<float>(q.x()), qy = static_cast<float>(q.y()), qz = static_cast<float>(q.z());
+    const float r2 = static_cast<float>(r2_);
+    for (int z = std::max(0, c[2] - 1); z <= std::min(n_[2] - 1, c[2] + 1); ++z)
+      for (int y = std::max(0, c[1] - 1); y <= std::min(n_[1] - 1, c[1] + 1); ++y)
+        for (int x = std::max(0, c[0] - 1); x <= std::min(n_[0] - 1, c[0] + 1); ++x) {
+          const std::size_t cell = (static_cast<std::size_t>(z) * n_[1] + y) * n_[0] + x;
+          for (int j = start_[cell], e = start_[cell + 1]; j < e; ++j) {
+            const float dx = xyz_[3 * j] - qx, dy = xyz_[3 * j + 1] - qy, dz = xyz_[3 * j + 2] - qz;
+            if (dx * dx + dy * dy + dz * dz <= r2) out.push_back(ids_[j]);
+          }
+        }
   }
 
   // Index of the nearest point within the radius of q (ties: the first in cell order), -1 if none.
@@ -262,6 +209,272 @@ class RadiusGrid {
   std::vector<float> xyz_;
   std::vector<int> ids_;
 };
+
+// Normals by PCA over a radius; oriented towards `viewpoint` (scene) or along the averaged
+// reference normals carried by the points (model). Points without a normal are removed.
+// Then FPFH over `feature_radius`.
+enum class Orient { Viewpoint, Reference, AwayFromCentroid };
+Prepared prepare_pcl(const CloudN::Ptr& down, double normal_radius, double feature_radius, Orient orient,
+                 const Vec3& viewpoint, int threads) {
+  CloudN::Ptr withn(new CloudN);
+  pcl::NormalEstimationOMP<pcl::PointNormal, pcl::PointNormal> ne(threads);
+  ne.setInputCloud(down);
+  ne.setRadiusSearch(normal_radius);
+  ne.setViewPoint(static_cast<float>(viewpoint.x()), static_cast<float>(viewpoint.y()),
+                  static_cast<float>(viewpoint.z()));
+  CloudN est;
+  ne.compute(est);
+  withn->reserve(down->size());
+  Eigen::Vector3f centroid = Eigen::Vector3f::Zero();
+  for (const auto& p : *down) centroid += p.getVector3fMap();
+  if (!down->empty()) centroid /= static_cast<float>(down->size());
+  for (std::size_t i = 0; i < down->size(); ++i) {
+    pcl::PointNormal p = (*down)[i];
+    Eigen::Vector3f n(est[i].normal_x, est[i].normal_y, est[i].normal_z);
+    if (!n.allFinite() || n.norm() < 0.5f) continue;
+    if (orient == Orient::Reference) {
+      const Eigen::Vector3f ref(p.normal_x, p.normal_y, p.normal_z);
+      if (n.dot(ref) < 0) n = -n;
+    } else if (orient == Orient::AwayFromCentroid) {
+      if (n.dot(p.getVector3fMap() - centroid) < 0) n = -n;
+    }
+    p.normal_x = n.x();
+    p.normal_y = n.y();
+    p.normal_z = n.z();
+    p.curvature = est[i].curvature;
+    withn->push_back(p);
+  }
+  withn->width = static_cast<std::uint32_t>(withn->size());
+  withn->height = 1;
+  Prepared out;
+  out.cloud = withn;
+  if (withn->empty()) return out;
+  pcl::FPFHEstimationOMP<pcl::PointNormal, pcl::PointNormal, pcl::FPFHSignature33> fe(threads);
+  fe.setInputCloud(withn);
+  fe.setInputNormals(withn);
+  fe.setRadiusSearch(feature_radius);
+  pcl::PointCloud<pcl::FPFHSignature33> f;
+  fe.compute(f);
+  out.features.resize(static_cast<Eigen::Index>(f.size()), 33);
+  for (std::size_t i = 0; i < f.size(); ++i)
+    for (int j = 0; j < 33; ++j) out.features(static_cast<Eigen::Index>(i), j) = f[i].histogram[j];
+  return out;
+}
+
+
+// Darboux-frame pair features of two oriented points (Rusu et al., "Fast Point Feature Histograms
+// (FPFH) for 3D registration", ICRA 2009): the source is the point whose normal makes the smaller
+// angle with the line joining them (|cos| larger; ties: the first argument), u = its normal,
+// v = u x (pt - ps) / |pt - ps| normalised, w = u x v; f1 = atan2(w.nt, u.nt) in [-pi, pi],
+// f2 = v.nt and f3 = u.(pt - ps)/|pt - ps| in [-1, 1]. Symmetric: pair(a, b) = pair(b, a) apart
+// from ties, so the caller orders its arguments. Returns false for coincident points.
+bool pair_features(const Eigen::Vector3f& pa, const Eigen::Vector3f& na, const Eigen::Vector3f& pb,
+                   const Eigen::Vector3f& nb, float& f1, float& f2, float& f3) {
+  Eigen::Vector3f dp = pb - pa;
+  const float d = dp.norm();
+  if (!(d > 0)) return false;
+  dp /= d;
+  const float ca = na.dot(dp), cb = nb.dot(dp);
+  const Eigen::Vector3f *ns = &na, *nt = &nb;
+  if (std::abs(ca) < std::abs(cb)) {  // b is the source; the line then points from b to a
+    ns = &nb;
+    nt = &na;
+    dp = -dp;
+    f3 = -cb;
+  } else {
+    f3 = ca;
+  }
+  Eigen::Vector3f v = ns->cross(dp);
+  const float vn = v.norm();
+  if (!(vn > 0)) return false;
+  v /= vn;
+  const Eigen::Vector3f w = ns->cross(v);
+  f2 = v.dot(*nt);
+  f1 = std::atan2(w.dot(*nt), ns->dot(*nt));
+  return true;
+}
+
+// Normals by PCA over `normal_radius` (at least 3 points; smallest-eigenvalue eigenvector of the
+// neighbourhood covariance) oriented as `orient` says; points without a normal are removed. Then
+// FPFH over `feature_radius`, 3 x 11 bins: SPFH(p) = histograms of (f1, f2, f3) over p's
+// neighbours, each summing to 100; FPFH(p) = sum over the neighbours q != p of SPFH(q) / |p - q|^2,
+// each sub-histogram normalised to sum 100 (PCL's weighting, which leaves out p's own SPFH).
+// Neighbours come from one fixed-radius grid search per point, shared by normals and features;
+// each pair's features are computed once (single thread) or once per end (threads > 1, parallel
+// over points): the results are the same.
+Prepared prepare(const CloudN::Ptr& down, double normal_radius, double feature_radius, Orient orient,
+                 const Vec3& viewpoint, int threads) {
+  const int n0 = static_cast<int>(down->size());
+  Prepared out;
+  out.cloud.reset(new CloudN);
+  if (n0 == 0) return out;
+  const double R = std::max(normal_radius, feature_radius);
+  RadiusGrid grid;
+  grid.build(*down, R);
+  std::vector<std::vector<int>> nbr(n0);
+  const float rn2 = static_cast<float>(normal_radius * normal_radius);
+  const float rf2 = static_cast<float>(feature_radius * feature_radius);
+  std::vector<Eigen::Vector3f> normal(n0);
+  std::vector<char> valid(n0, 0);
+  std::vector<float> curvature(n0, 0.f);
+  Eigen::Vector3f centroid = Eigen::Vector3f::Zero();
+  for (const auto& p : *down) centroid += p.getVector3fMap();
+  centroid /= static_cast<float>(n0);
+  const Eigen::Vector3f vp = viewpoint.cast<float>();
+#pragma omp parallel for schedule(static) num_threads(threads)
+  for (int i = 0; i < n0; ++i) {
+    const Eigen::Vector3f pi = (*down)[i].getVector3fMap();
+    grid.within(pi.cast<double>(), nbr[i]);
+    Eigen::Vector3d mean = Eigen::Vector3d::Zero();
+    int m = 0;
+    for (int j : nbr[i]) {
+      const Eigen::Vector3f pj = (*down)[j].getVector3fMap();
+      if ((pj - pi).squaredNorm() <= rn2) {
+        mean += pj.cast<double>();
+        ++m;
+      }
+    }
+    if (m < 3) continue;
+    mean /= m;
+    Eigen::Matrix3d C = Eigen::Matrix3d::Zero();
+    for (int j : nbr[i]) {
+      const Eigen::Vector3f pj = (*down)[j].getVector3fMap();
+      if ((pj - pi).squaredNorm() <= rn2) {
+        const Eigen::Vector3d e = pj.cast<double>() - mean;
+        C.noalias() += e * e.transpose();
+      }
+    }
+    Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> es;
+    es.computeDirect(C);
+    Eigen::Vector3f n = es.eigenvectors().col(0).cast<float>();  // eigenvalues ascending
+    if (!n.allFinite() || n.norm() < 0.5f) continue;
+    n.normalize();
+    const auto& p = (*down)[i];
+    if (orient == Orient::Reference) {
+      if (n.dot(Eigen::Vector3f(p.normal_x, p.normal_y, p.normal_z)) < 0) n = -n;
+    } else if (orient == Orient::AwayFromCentroid) {
+      if (n.dot(pi - centroid) < 0) n = -n;
+    } else if (n.dot(vp - pi) < 0) {
+      n = -n;
+    }
+    const double tr = es.eigenvalues().sum();
+    curvature[i] = tr > 0 ? static_cast<float>(es.eigenvalues()(0) / tr) : 0.f;
+    normal[i] = n;
+    valid[i] = 1;
+  }
+  // Keep the points with normals, renumbered.
+  std::vector<int> id(n0, -1);
+  for (int i = 0; i < n0; ++i) {
+    if (!valid[i]) continue;
+    id[i] = static_cast<int>(out.cloud->size());
+    pcl::PointNormal p = (*down)[i];
+    p.normal_x = normal[i].x();
+    p.normal_y = normal[i].y();
+    p.normal_z = normal[i].z();
+    p.curvature = curvature[i];
+    out.cloud->push_back(p);
+  }
+  out.cloud->width = static_cast<std::uint32_t>(out.cloud->size());
+  out.cloud->height = 1;
+  const int n = static_cast<int>(out.cloud->size());
+  if (n == 0) return out;
+  // Feature neighbours among the kept points (self excluded), and their squared distances.
+  std::vector<std::vector<int>> fn(n);
+  std::vector<std::vector<float>> fd(n);
+  std::vector<Eigen::Vector3f> P(n), N(n);
+  for (int i = 0; i < n; ++i) {
+    P[i] = (*out.cloud)[i].getVector3fMap();
+    N[i] = (*out.cloud)[i].getNormalVector3fMap();
+  }
+  for (int i0 = 0; i0 < n0; ++i0) {
+    const int i = id[i0];
+    if (i < 0) continue;
+    for (int j0 : nbr[i0]) {
+      const int j = id[j0];
+      if (j < 0 || j == i) continue;
+      const float d2 = (P[j] - P[i]).squaredNorm();
+      if (d2 <= rf2) {
+        fn[i].push_back(j);
+        fd[i].push_back(d2);
+      }
+    }
+  }
+  // SPFH bin counts.
+  constexpr int B = 11;
+  constexpr float kTwoPi = 6.28318530717958647692f;
+  Eigen::Matrix<int, Eigen::Dynamic, 3 * B, Eigen::RowMajor> count =
+      Eigen::Matrix<int, Eigen::Dynamic, 3 * B, Eigen::RowMajor>::Zero(n, 3 * B);
+  auto bins = [&](int a, int b, int* h) {  // a < b
+    float f1, f2, f3;
+    if (!pair_features(P[a], N[a], P[b], N[b], f1, f2, f3)) return false;
+    h[0] = std::clamp(static_cast<int>(std::floor(B * ((f1 + kTwoPi / 2) / kTwoPi))), 0, B - 1);
+    h[1] = B + std::clamp(static_cast<int>(std::floor(B * ((f2 + 1.f) * 0.5f))), 0, B - 1);
+    h[2] = 2 * B + std::clamp(static_cast<int>(std::floor(B * ((f3 + 1.f) * 0.5f))), 0, B - 1);
+    return true;
+  };
+  if (threads <= 1) {
+    for (int i = 0; i < n; ++i)
+      for (int j : fn[i]) {
+        if (j < i) continue;  // each pair once
+        int h[3];
+        if (!bins(i, j, h)) continue;
+        for (int k = 0; k < 3; ++k) {
+          ++count(i, h[k]);
+          ++count(j, h[k]);
+        }
+      }
+  } else {
+#pragma omp parallel for schedule(static) num_threads(threads)
+    for (int i = 0; i < n; ++i)
+      for (int j : fn[i]) {
+        int h[3];
+        if (!bins(std::min(i, j), std::max(i, j), h)) continue;
+        for (int k = 0; k < 3; ++k) ++count(i, h[k]);
+      }
+  }
+  Eigen::Matrix<float, Eigen::Dynamic, 3 * B, Eigen::RowMajor> spfh(n, 3 * B);
+  for (int i = 0; i < n; ++i) {
+    const float inc = fn[i].empty() ? 0.f : 100.f / static_cast<float>(fn[i].size());
+    spfh.row(i) = count.row(i).cast<float>() * inc;
+  }
+  out.features.setZero(n, 33);
+#pragma omp parallel for schedule(static) num_threads(threads)
+  for (int i = 0; i < n; ++i) {
+    Eigen::Matrix<float, 1, 3 * B> acc = Eigen::Matrix<float, 1, 3 * B>::Zero();
+    for (std::size_t k = 0; k < fn[i].size(); ++k)
+      if (fd[i][k] > 0) acc += spfh.row(fn[i][k]) / fd[i][k];
+    for (int s = 0; s < 3; ++s) {
+      const float sum = acc.segment<B>(s * B).sum();
+      if (sum > 0) acc.segment<B>(s * B) *= 100.f / sum;
+    }
+    out.features.row(i) = acc;
+  }
+  return out;
+}
+
+struct Hypothesis {
+  Iso3 T = Iso3::Identity();  // scene -> model
+  int inliers = 0;
+  double cost = 0.0;
+};
+
+bool similar(const Iso3& a, const Iso3& b, double trans_tol, double rot_tol) {
+  const double ang = Eigen::AngleAxisd(a.linear().transpose() * b.linear()).angle();
+  return ang < rot_tol && (a.translation() - b.translation()).norm() < trans_tol;
+}
+
+// Rigid transform (no scale) taking src points onto dst points in the least-squares sense.
+Iso3 kabsch(const Eigen::Matrix3Xd& src, const Eigen::Matrix3Xd& dst) {
+  const Vec3 cs = src.rowwise().mean(), cd = dst.rowwise().mean();
+  const Mat3 Hm = (src.colwise() - cs) * (dst.colwise() - cd).transpose();
+  Eigen::JacobiSVD<Mat3> svd(Hm, Eigen::ComputeFullU | Eigen::ComputeFullV);
+  Mat3 D = Mat3::Identity();
+  if ((svd.matrixV() * svd.matrixU().transpose()).determinant() < 0) D(2, 2) = -1;
+  Iso3 T = Iso3::Identity();
+  T.linear() = svd.matrixV() * D * svd.matrixU().transpose();
+  T.translation() = cd - T.linear() * cs;
+  return T;
+}
 
 // A model prepared for registration: everything that does not depend on the scene.
 struct ModelData {
@@ -392,7 +605,7 @@ void prepare_model(const SurfaceSamples& S, const RegistrationParams& P, ModelDa
   md.dense = to_cloud(S.points, &S.normals);
   md.dense_grid.build(*md.dense, std::max(P.inlier_distance, P.icp_distance) * voxel);
   CloudN::Ptr mdown = downsample(md.dense, voxel);
-  md.prep = prepare(mdown, P.normal_radius * voxel, P.feature_radius * voxel, Orient::Reference, Vec3::Zero(), 1);
+  md.prep = (P.pcl_features ? prepare_pcl : prepare)(mdown, P.normal_radius * voxel, P.feature_radius * voxel, Orient::Reference, Vec3::Zero(), 1);
   md.nm = static_cast<int>(md.prep.cloud->size());
   if (md.nm < 3) {
     md.reason = "model has too few points after downsampling (" + std::to_string(md.nm) + ")";
@@ -418,7 +631,7 @@ SceneData prepare_scene(const CloudN::Ptr& raw, const RegistrationParams& P, con
   const auto t0 = Clock::now();
   const double voxel = P.voxel;
   CloudN::Ptr sdown = downsample(raw, voxel);
-  const Prepared sprep = prepare(sdown, P.normal_radius * voxel, P.feature_radius * voxel,
+  const Prepared sprep = (P.pcl_features ? prepare_pcl : prepare)(sdown, P.normal_radius * voxel, P.feature_radius * voxel,
                                  viewpoint ? Orient::Viewpoint : Orient::AwayFromCentroid,
                                  viewpoint ? *viewpoint : Vec3::Zero(), nthreads);
   SceneData sd;
