@@ -675,28 +675,37 @@ void register_one(const ModelData& md, const SceneData& sd, const RegistrationPa
     // scene features share a few nearest model features ("hubs", e.g. on flat faces).
     const int block = 256;
     Eigen::MatrixXf D;
-    std::vector<int> order(nm);
+    std::vector<int> top_i(k);
+    std::vector<float> top_d(k);
     std::vector<float> rbest(nm, std::numeric_limits<float>::infinity());
     std::vector<int> rarg(nm, -1);
     for (int s0 = 0; s0 < ns; s0 += block) {
       const int bs = std::min(block, ns - s0);
-      D.noalias() = -2.0f * sfeat.middleRows(s0, bs) * mfeat.transpose();
+      // Column i: -2 <model features, scene feature s0 + i>, contiguous for the scans below.
+      D.noalias() = -2.0f * mfeat * sfeat.middleRows(s0, bs).transpose();
       for (int i = 0; i < bs; ++i) {
-        std::iota(order.begin(), order.end(), 0);
-        auto row = D.row(i);
-        std::partial_sort(order.begin(), order.begin() + k, order.end(), [&](int a, int b) {
-          const float da = row(a) + mf_norm(a), db = row(b) + mf_norm(b);
-          return da < db || (da == db && a < b);
-        });
-        for (int j = 0; j < k; ++j) corr.emplace_back(s0 + i, order[j]);
-        if (P.reverse_matches)
-          for (int j = 0; j < nm; ++j) {
-            const float dj = row(j) + sf_norm(s0 + i);
-            if (dj < rbest[j]) {
-              rbest[j] = dj;
-              rarg[j] = s0 + i;
+        const float* col = D.col(i).data();
+        const float sn = sf_norm(s0 + i);
+        // k nearest by one scan, kept sorted (ties: the lower index first).
+        int cnt = 0;
+        for (int j = 0; j < nm; ++j) {
+          const float dj = col[j] + mf_norm(j);
+          if (cnt < k || dj < top_d[cnt - 1]) {
+            int pos = cnt < k ? cnt++ : k - 1;
+            while (pos > 0 && top_d[pos - 1] > dj) {
+              top_d[pos] = top_d[pos - 1];
+              top_i[pos] = top_i[pos - 1];
+              --pos;
             }
+            top_d[pos] = dj;
+            top_i[pos] = j;
           }
+          if (P.reverse_matches && col[j] + sn < rbest[j]) {
+            rbest[j] = col[j] + sn;
+            rarg[j] = s0 + i;
+          }
+        }
+        for (int j = 0; j < cnt; ++j) corr.emplace_back(s0 + i, top_i[j]);
       }
     }
     if (P.reverse_matches)
