@@ -3,8 +3,9 @@ a partial cloud against object models (thesis §4.2, Publication V).
 
 The heavy lifting is in C++ (:mod:`bayesgrasp._core.vision`): a BVH ray caster with a
 structured-light noise model, PCL's plane RANSAC and Euclidean clustering, and a registration
-pipeline of voxel downsampling, normals and FPFH features (PCL), a seeded RANSAC over feature
+pipeline of voxel downsampling (PCL), normals and FPFH features, a seeded RANSAC over feature
 correspondences, point-to-plane ICP, and a hypothesis choice that penalises upside-down fits.
+To register many clouds against the same models, prepare the models once in a :class:`Registrar`.
 
 >>> from bayesgrasp.vision import Camera, segment_table, register
 >>> cam = Camera.looking_at(eye=(0.5, -0.5, 0.5), target=(0, 0, 0.05))
@@ -12,6 +13,8 @@ correspondences, point-to-plane ICP, and a hypothesis choice that penalises upsi
 >>> seg = segment_table(cloud)                                 # clusters, largest first
 >>> results = register(seg.cluster_points[0], [model_a, model_b], viewpoint=cam.eye)
 >>> results[0].transform, results[0].fitness, results[0].weight
+>>> reg = Registrar([model_a, model_b])                        # models prepared once
+>>> results = reg.register(seg.cluster_points[0], viewpoint=cam.eye)
 
 Conventions: metres; world frame z up with the table top at z = 0; camera frame x right, y down,
 z forward; depth images hold the camera-frame z (NaN where nothing is measured).
@@ -352,7 +355,8 @@ def register(cloud, models: Sequence, voxel: float = 0.005, seed: int = 0, viewp
         up_prior, up, upright: see the module docstring.
         params: restarts, ransac_iterations, hypotheses, icp_iterations, feature_neighbours,
             normal_radius, feature_radius, inlier_distance, icp_distance (multiples of voxel),
-            weight_sigma (x voxel), max_tilt_deg, min_scene_points, threads.
+            weight_sigma (x voxel), max_tilt_deg, min_scene_points, threads, pcl_features (PCL's
+            normal and FPFH estimators instead of ours: same definitions, slower).
 
     Returns one :class:`RegistrationResult` per model, in order (``time_features`` includes the
     model's preparation). A model with no surface, or a cloud with too few points for the features,

@@ -1,8 +1,14 @@
-// Registration against object models. PCL provides voxel downsampling, normals, FPFH and the
-// k-d trees; the RANSAC over feature correspondences and the point-to-plane ICP are ours so that
-// they are seeded (PCL's SampleConsensusPrerejective draws from the global rand(), which is
-// neither seedable per call nor deterministic under OpenMP) and so that the hypothesis choice can
-// use the up prior.
+// Registration against object models. PCL provides the voxel downsampling (and, with
+// pcl_features, its normal and FPFH estimators). Our normals and FPFH follow the same definitions
+// but share one fixed-radius grid search between them and compute each point pair's features
+// once, about 3x faster than PCL's estimators, which searched a k-d tree twice per point and
+// computed every pair from both ends. The dense-model nearest neighbours of the fit measures and
+// ICP come from a fixed-radius grid as well (their distances are cut off at the inlier/ICP
+// distance), several times cheaper per query than the FLANN k-d tree. The RANSAC over feature
+// correspondences and the point-to-plane ICP are ours so that they are seeded (PCL's
+// SampleConsensusPrerejective draws from the global rand(), which is neither seedable per call
+// nor deterministic under OpenMP) and so that the hypothesis choice can use the up prior.
+// Everything about a model that does not depend on the scene is prepared once in a Registrar.
 // All PCL templates are instantiated here, in our own flags, instead of using the instances
 // precompiled into Debian's libpcl_*.so: with -march=native Eigen's heap alignment (and so its
 // aligned_malloc/free) differs from the library's SSE2 build, and memory allocated on one side and
@@ -14,7 +20,6 @@
 #include <pcl/features/fpfh_omp.h>
 #include <pcl/features/normal_3d_omp.h>
 #include <pcl/filters/voxel_grid.h>
-#include <pcl/kdtree/kdtree_flann.h>
 #include <pcl/point_cloud.h>
 #include <pcl/point_types.h>
 

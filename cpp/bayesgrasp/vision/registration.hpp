@@ -1,7 +1,8 @@
-// Registration of a partial scene cloud against N object models: voxel downsampling, normals,
-// FPFH features (PCL), a seeded feature-correspondence RANSAC with edge-length pre-rejection and
+// Registration of a partial scene cloud against N object models: voxel downsampling (PCL),
+// normals and FPFH features (ours, or PCL's with pcl_features), a seeded feature-correspondence RANSAC with edge-length pre-rejection and
 // an optional up-axis prior, several restarts and hypotheses, point-to-plane ICP refinement,
-// and a hypothesis choice by fitting error plus an upside-down penalty.
+// and a hypothesis choice by fitting error plus an upside-down penalty. A Registrar prepares the
+// models once and registers any number of scenes against them; register_models is one-shot.
 // PCL is used in registration.cpp only; this header is plain Eigen.
 //
 // Every radius and threshold is a multiple of one voxel size (defaults for household objects of
