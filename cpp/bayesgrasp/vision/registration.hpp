@@ -1,8 +1,9 @@
 // Registration of a partial scene cloud against N object models: voxel downsampling (PCL),
-// normals and FPFH features (ours, or PCL's with pcl_features), a seeded feature-correspondence RANSAC with edge-length pre-rejection and
-// an optional up-axis prior, several restarts and hypotheses, point-to-plane ICP refinement,
-// and a hypothesis choice by fitting error plus an upside-down penalty. A Registrar prepares the
-// models once and registers any number of scenes against them; register_models is one-shot.
+// normals and FPFH features (ours, or PCL's with pcl_features), a seeded feature-correspondence
+// RANSAC with edge-length pre-rejection and an optional up-axis prior, several restarts and
+// hypotheses, point-to-plane ICP refinement, and a hypothesis choice by fitting error plus an
+// upside-down penalty. A Registrar prepares the models once and registers any number of scenes
+// against them; register_models is one-shot.
 // PCL is used in registration.cpp only; this header is plain Eigen.
 //
 // Every radius and threshold is a multiple of one voxel size (defaults for household objects of
@@ -113,7 +114,7 @@ ModelCloud model_from_mesh(const TriMesh& mesh, const RegistrationParams& params
 
 /// Models prepared once, scenes registered against them any number of times.
 ///
-/// Preparing a model (its dense samples' k-d tree, voxel downsampling, normals, FPFH features and
+/// Preparing a model (a neighbour grid over its dense samples, voxel downsampling, normals, FPFH features and
 /// their transformed copies for matching) is the costliest part of a one-shot registration and
 /// does not depend on the scene, so a Registrar does it once per model in add_models() and
 /// register_scene() does only the per-scene work: the scene's features, the feature matching,
