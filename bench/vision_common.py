@@ -3,7 +3,8 @@ import numpy as np
 
 
 def load_views(path):
-    d = np.load(path)
+    with np.load(path) as z:
+        d = {k: z[k] for k in z.files}  # each array read (and decompressed) once
     views = []
     for i in range(len(d["offsets"]) - 1):
         views.append(dict(points=d["points"][d["offsets"][i]:d["offsets"][i + 1]], eye=d["eye"][i],

@@ -6,6 +6,8 @@
 #include <pybind11/pybind11.h>
 #include <pybind11/stl.h>
 
+#include <optional>
+
 #include "bayesgrasp/vision/camera.hpp"
 #include "bayesgrasp/vision/registration.hpp"
 #include "bayesgrasp/vision/segmentation.hpp"
@@ -85,6 +87,77 @@ py::dict result_dict(const RegistrationResult& r) {
   d["time_global"] = r.time_global;
   d["time_icp"] = r.time_icp;
   return d;
+}
+
+RegistrationParams params_arg(double voxel, bool up_prior, bool upright, const DArray& up, double max_tilt_deg,
+                              int restarts, int ransac_iterations, int hypotheses, int icp_iterations,
+                              int feature_neighbours, double normal_radius, double feature_radius,
+                              double inlier_distance, double icp_distance, double weight_sigma, int min_scene_points,
+                              int threads, bool reverse_matches, bool hellinger, bool pcl_features) {
+  RegistrationParams p;
+  p.voxel = positive(voxel, "voxel");
+  p.use_up_prior = up_prior;
+  p.upright = upright;
+  p.up = vector(up, "up", 3);
+  if (!(p.up.norm() > 0)) throw py::value_error("up: must be non-zero");
+  p.max_tilt = positive(max_tilt_deg, "max_tilt_deg") * 3.14159265358979323846 / 180.0;
+  auto pos_int = [](int v, const char* name) {
+    if (v < 1) throw py::value_error(std::string(name) + ": must be positive");
+    return v;
+  };
+  p.restarts = pos_int(restarts, "restarts");
+  p.ransac_iterations = pos_int(ransac_iterations, "ransac_iterations");
+  p.hypotheses = pos_int(hypotheses, "hypotheses");
+  if (icp_iterations < 0) throw py::value_error("icp_iterations: must be non-negative");
+  p.icp_iterations = icp_iterations;
+  p.feature_neighbours = pos_int(feature_neighbours, "feature_neighbours");
+  p.normal_radius = positive(normal_radius, "normal_radius");
+  p.feature_radius = positive(feature_radius, "feature_radius");
+  p.inlier_distance = positive(inlier_distance, "inlier_distance");
+  p.icp_distance = positive(icp_distance, "icp_distance");
+  p.weight_sigma = positive(weight_sigma, "weight_sigma");
+  p.min_scene_points = pos_int(min_scene_points, "min_scene_points");
+  if (threads < 0) throw py::value_error("threads: must be non-negative");
+  p.threads = threads;
+  p.reverse_matches = reverse_matches;
+  p.hellinger = hellinger;
+  p.pcl_features = pcl_features;
+  return p;
+}
+
+std::vector<ModelCloud> models_arg(const py::list& models, bool allow_empty = false) {
+  std::vector<ModelCloud> ms;
+  for (std::size_t i = 0; i < models.size(); ++i) {
+    const std::string name = "models[" + std::to_string(i) + "]";
+    py::tuple t;
+    try {
+      t = models[i].cast<py::tuple>();
+    } catch (const py::cast_error&) {
+      throw py::value_error(name + ": expected a (points, normals) tuple");
+    }
+    if (t.size() != 2) throw py::value_error(name + ": expected a (points, normals) tuple");
+    ModelCloud mc;
+    mc.surface.points = points_arg(t[0].cast<DArray>(), (name + " points").c_str(), false);
+    mc.surface.normals = points_arg(t[1].cast<DArray>(), (name + " normals").c_str(), false);
+    if (mc.surface.points.rows() != mc.surface.normals.rows())
+      throw py::value_error(name + ": points and normals differ in length");
+    ms.push_back(std::move(mc));
+  }
+  if (ms.empty() && !allow_empty) throw py::value_error("models: is empty");
+  return ms;
+}
+
+Points scene_arg(const DArray& cloud) {
+  Points S = points_arg(cloud, "cloud", true);
+  bool any_finite = false;
+  for (Eigen::Index i = 0; i < S.rows() && !any_finite; ++i) any_finite = S.row(i).allFinite();
+  if (!any_finite) throw py::value_error("cloud: has no finite points");
+  return S;
+}
+
+std::optional<Vec3> viewpoint_arg(const py::object& viewpoint) {
+  if (viewpoint.is_none()) return std::nullopt;
+  return Vec3(vector(viewpoint.cast<DArray>(), "viewpoint", 3));
 }
 
 }  // namespace
@@ -256,61 +329,18 @@ void bind_vision(py::module_& m) {
       [](const DArray& scene, const py::list& models, double voxel, std::uint64_t seed, bool up_prior, bool upright,
          const DArray& up, double max_tilt_deg, py::object viewpoint, int restarts, int ransac_iterations,
          int hypotheses, int icp_iterations, int feature_neighbours, double normal_radius, double feature_radius,
-         double inlier_distance, double icp_distance, double weight_sigma, int min_scene_points, int threads, bool reverse_matches, bool hellinger) {
-        Points S = points_arg(scene, "cloud", true);
-        RegistrationParams p;
-        p.voxel = positive(voxel, "voxel");
+         double inlier_distance, double icp_distance, double weight_sigma, int min_scene_points, int threads,
+         bool reverse_matches, bool hellinger, bool pcl_features) {
+        const Points S = scene_arg(scene);
+        RegistrationParams p = params_arg(voxel, up_prior, upright, up, max_tilt_deg, restarts, ransac_iterations,
+                                          hypotheses, icp_iterations, feature_neighbours, normal_radius,
+                                          feature_radius, inlier_distance, icp_distance, weight_sigma,
+                                          min_scene_points, threads, reverse_matches, hellinger, pcl_features);
         p.seed = seed;
-        p.use_up_prior = up_prior;
-        p.upright = upright;
-        p.up = vector(up, "up", 3);
-        if (!(p.up.norm() > 0)) throw py::value_error("up: must be non-zero");
-        p.max_tilt = positive(max_tilt_deg, "max_tilt_deg") * 3.14159265358979323846 / 180.0;
-        if (!viewpoint.is_none()) {
-          p.has_viewpoint = true;
-          p.viewpoint = vector(viewpoint.cast<DArray>(), "viewpoint", 3);
-        }
-        auto pos_int = [](int v, const char* name) {
-          if (v < 1) throw py::value_error(std::string(name) + ": must be positive");
-          return v;
-        };
-        p.restarts = pos_int(restarts, "restarts");
-        p.ransac_iterations = pos_int(ransac_iterations, "ransac_iterations");
-        p.hypotheses = pos_int(hypotheses, "hypotheses");
-        if (icp_iterations < 0) throw py::value_error("icp_iterations: must be non-negative");
-        p.icp_iterations = icp_iterations;
-        p.feature_neighbours = pos_int(feature_neighbours, "feature_neighbours");
-        p.normal_radius = positive(normal_radius, "normal_radius");
-        p.feature_radius = positive(feature_radius, "feature_radius");
-        p.inlier_distance = positive(inlier_distance, "inlier_distance");
-        p.icp_distance = positive(icp_distance, "icp_distance");
-        p.weight_sigma = positive(weight_sigma, "weight_sigma");
-        p.min_scene_points = pos_int(min_scene_points, "min_scene_points");
-        if (threads < 0) throw py::value_error("threads: must be non-negative");
-        p.threads = threads;
-        p.reverse_matches = reverse_matches;
-        p.hellinger = hellinger;
-        std::vector<ModelCloud> ms;
-        for (std::size_t i = 0; i < models.size(); ++i) {
-          const std::string name = "models[" + std::to_string(i) + "]";
-          py::tuple t;
-          try {
-            t = models[i].cast<py::tuple>();
-          } catch (const py::cast_error&) {
-            throw py::value_error(name + ": expected a (points, normals) tuple");
-          }
-          if (t.size() != 2) throw py::value_error(name + ": expected a (points, normals) tuple");
-          ModelCloud mc;
-          mc.surface.points = points_arg(t[0].cast<DArray>(), (name + " points").c_str(), false);
-          mc.surface.normals = points_arg(t[1].cast<DArray>(), (name + " normals").c_str(), false);
-          if (mc.surface.points.rows() != mc.surface.normals.rows())
-            throw py::value_error(name + ": points and normals differ in length");
-          ms.push_back(std::move(mc));
-        }
-        if (ms.empty()) throw py::value_error("models: is empty");
-        bool any_finite = false;
-        for (Eigen::Index i = 0; i < S.rows() && !any_finite; ++i) any_finite = S.row(i).allFinite();
-        if (!any_finite) throw py::value_error("cloud: has no finite points");
+        const std::optional<Vec3> vp = viewpoint_arg(viewpoint);
+        p.has_viewpoint = vp.has_value();
+        if (vp) p.viewpoint = *vp;
+        const std::vector<ModelCloud> ms = models_arg(models);
         std::vector<RegistrationResult> res;
         {
           py::gil_scoped_release release;
@@ -327,11 +357,100 @@ void bind_vision(py::module_& m) {
       py::arg("normal_radius") = 2.0, py::arg("feature_radius") = 5.0, py::arg("inlier_distance") = 1.5,
       py::arg("icp_distance") = 1.5, py::arg("weight_sigma") = 0.5, py::arg("min_scene_points") = 30,
       py::arg("threads") = 0, py::arg("reverse_matches") = true, py::arg("hellinger") = true,
+      py::arg("pcl_features") = false,
       "Registers a partial cloud (N, 3; NaN rows dropped) against models [(points (M,3), outward normals "
       "(M,3)), ...] (surface samples; see model_from_mesh). Radii and distances are multiples of `voxel`. "
-      "Returns one dict per model: success, reason, transform (4x4 model->scene), fitness, rmse, delta, "
-      "phi = exp(-delta^2 / (2 (weight_sigma voxel)^2)), weight (phi normalised over successful models), "
-      "up_cos, cost, scene_points, model_points, ransac_iterations, time_features/global/icp (s).");
+      "One shot: the models are prepared (downsampled, normals, FPFH) inside the call; use Registrar to "
+      "prepare them once for many clouds. Returns one dict per model: success, reason, transform (4x4 "
+      "model->scene), fitness, rmse, delta, phi = exp(-delta^2 / (2 (weight_sigma voxel)^2)), weight (phi "
+      "normalised over successful models), up_cos, cost, scene_points, model_points, ransac_iterations, "
+      "time_features/global/icp (s; time_features includes the model's preparation).");
+
+  py::class_<Registrar>(m, "Registrar",
+                        "Object models prepared once (dense k-d tree, downsampled cloud, normals, FPFH) and "
+                        "registered against any number of partial clouds. Same parameters, seed and viewpoint: "
+                        "the same result as register_models.")
+      .def(py::init([](const py::list& models, double voxel, bool up_prior, bool upright, const DArray& up,
+                       double max_tilt_deg, int restarts, int ransac_iterations, int hypotheses, int icp_iterations,
+                       int feature_neighbours, double normal_radius, double feature_radius, double inlier_distance,
+                       double icp_distance, double weight_sigma, int min_scene_points, int threads,
+                       bool reverse_matches, bool hellinger, bool pcl_features) {
+             const RegistrationParams p = params_arg(voxel, up_prior, upright, up, max_tilt_deg, restarts,
+                                                     ransac_iterations, hypotheses, icp_iterations,
+                                                     feature_neighbours, normal_radius, feature_radius,
+                                                     inlier_distance, icp_distance, weight_sigma, min_scene_points,
+                                                     threads, reverse_matches, hellinger, pcl_features);
+             const std::vector<ModelCloud> ms = models_arg(models, true);
+             auto r = std::make_unique<Registrar>(p);
+             {
+               py::gil_scoped_release release;
+               r->add_models(ms);
+             }
+             return r;
+           }),
+           py::arg("models"), py::arg("voxel") = 0.005, py::arg("up_prior") = true, py::arg("upright") = true,
+           py::arg("up") = Eigen::Vector3d::UnitZ(), py::arg("max_tilt_deg") = 60.0, py::arg("restarts") = 3,
+           py::arg("ransac_iterations") = 20000, py::arg("hypotheses") = 4, py::arg("icp_iterations") = 30,
+           py::arg("feature_neighbours") = 2, py::arg("normal_radius") = 2.0, py::arg("feature_radius") = 5.0,
+           py::arg("inlier_distance") = 1.5, py::arg("icp_distance") = 1.5, py::arg("weight_sigma") = 0.5,
+           py::arg("min_scene_points") = 30, py::arg("threads") = 0, py::arg("reverse_matches") = true,
+           py::arg("hellinger") = true, py::arg("pcl_features") = false,
+           "Prepares the models [(points (M,3), outward normals (M,3)), ...] (may be empty; see add_models) "
+           "with the parameters of register_models.")
+      .def(
+          "add_models",
+          [](Registrar& r, const py::list& models) {
+            const std::vector<ModelCloud> ms = models_arg(models);
+            py::gil_scoped_release release;
+            return r.add_models(ms);
+          },
+          py::arg("models"), "Prepares and appends models; returns the index of the first.")
+      .def(
+          "register",
+          [](const Registrar& r, const DArray& cloud, std::uint64_t seed, py::object viewpoint, py::object models) {
+            const Points S = scene_arg(cloud);
+            const std::optional<Vec3> vp = viewpoint_arg(viewpoint);
+            std::vector<int> idx;
+            if (!models.is_none()) {
+              try {
+                idx = models.cast<std::vector<int>>();
+              } catch (const py::cast_error&) {
+                throw py::value_error("models: expected a sequence of model indices");
+              }
+              if (idx.empty()) throw py::value_error("models: is empty");
+              for (int i : idx)
+                if (i < 0 || i >= r.size())
+                  throw py::value_error("models: index " + std::to_string(i) + " out of range [0, " +
+                                        std::to_string(r.size()) + ")");
+            }
+            if (r.size() == 0) throw py::value_error("models: the registrar has no models");
+            std::vector<RegistrationResult> res;
+            {
+              py::gil_scoped_release release;
+              res = r.register_scene(S, seed, vp, idx);
+            }
+            py::list out;
+            for (const auto& x : res) out.append(result_dict(x));
+            return out;
+          },
+          py::arg("cloud"), py::arg("seed") = 0, py::arg("viewpoint") = py::none(), py::arg("models") = py::none(),
+          "Registers a partial cloud (N, 3; NaN rows dropped) against the prepared models (`models`: indices, "
+          "None for all). Returns one dict per model as register_models does (time_features: the cloud's "
+          "features only); weights are normalised over the models of the call.")
+      .def("__len__", &Registrar::size)
+      .def_property_readonly("voxel", [](const Registrar& r) { return r.params().voxel; })
+      .def(
+          "model_info",
+          [](const Registrar& r, int i) {
+            if (i < 0 || i >= r.size()) throw py::value_error("i: model index out of range");
+            py::dict d;
+            d["ok"] = r.model_ok(i);
+            d["reason"] = r.model_reason(i);
+            d["model_points"] = r.model_points(i);
+            d["time"] = r.model_time(i);
+            return d;
+          },
+          py::arg("i"), "{'ok', 'reason', 'model_points' (after downsampling), 'time' (s to prepare)} of model i.");
 
   m.def(
       "model_from_mesh",

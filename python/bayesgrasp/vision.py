@@ -3,8 +3,9 @@ a partial cloud against object models (thesis §4.2, Publication V).
 
 The heavy lifting is in C++ (:mod:`bayesgrasp._core.vision`): a BVH ray caster with a
 structured-light noise model, PCL's plane RANSAC and Euclidean clustering, and a registration
-pipeline of voxel downsampling, normals and FPFH features (PCL), a seeded RANSAC over feature
+pipeline of voxel downsampling (PCL), normals and FPFH features, a seeded RANSAC over feature
 correspondences, point-to-plane ICP, and a hypothesis choice that penalises upside-down fits.
+To register many clouds against the same models, prepare the models once in a :class:`Registrar`.
 
 >>> from bayesgrasp.vision import Camera, segment_table, register
 >>> cam = Camera.looking_at(eye=(0.5, -0.5, 0.5), target=(0, 0, 0.05))
@@ -12,6 +13,8 @@ correspondences, point-to-plane ICP, and a hypothesis choice that penalises upsi
 >>> seg = segment_table(cloud)                                 # clusters, largest first
 >>> results = register(seg.cluster_points[0], [model_a, model_b], viewpoint=cam.eye)
 >>> results[0].transform, results[0].fitness, results[0].weight
+>>> reg = Registrar([model_a, model_b])                        # models prepared once
+>>> results = reg.register(seg.cluster_points[0], viewpoint=cam.eye)
 
 Conventions: metres; world frame z up with the table top at z = 0; camera frame x right, y down,
 z forward; depth images hold the camera-frame z (NaN where nothing is measured).
@@ -37,7 +40,7 @@ from typing import Any, List, Optional, Sequence, Tuple, Union
 import numpy as np
 
 __all__ = [
-    "Camera", "SegmentationResult", "RegistrationResult", "segment_table", "register",
+    "Camera", "SegmentationResult", "RegistrationResult", "Registrar", "segment_table", "register",
     "model_samples", "rotation_error", "register_command", "as_cloud", "as_mesh",
 ]
 
@@ -232,10 +235,115 @@ def model_samples(model, voxel: float = 0.005, seed: int = 0, samples: int = 0) 
     return np.asarray(P), np.asarray(N)
 
 
+def _check_cloud(cloud) -> np.ndarray:
+    P = as_cloud(cloud)
+    if len(P) == 0:
+        raise ValueError("cloud: is empty")
+    if not np.isfinite(P).all(axis=1).any():
+        raise ValueError("cloud: has no finite points")
+    return P
+
+
+def _result(r: dict, model, reason: Optional[str] = None, extra_feature_time: float = 0.0) -> RegistrationResult:
+    return RegistrationResult(
+        success=bool(r["success"]), reason=r["reason"] if reason is None else reason,
+        transform=np.asarray(r["transform"]), fitness=float(r["fitness"]), rmse=float(r["rmse"]),
+        delta=float(r["delta"]), phi=float(r["phi"]), weight=float(r["weight"]), up_cos=float(r["up_cos"]),
+        scene_points=int(r["scene_points"]), model_points=int(r["model_points"]),
+        time_features=float(r["time_features"]) + extra_feature_time, time_global=float(r["time_global"]),
+        time_icp=float(r["time_icp"]), model=model)
+
+
+class Registrar:
+    """Object models prepared once, partial clouds registered against them many times.
+
+    Preparing a model (downsampling, normals, FPFH features, k-d trees) does not depend on the
+    cloud, so it is done here once per model; :meth:`register` does only the per-cloud work. With
+    the same parameters, seed and viewpoint, ``Registrar(models).register(cloud)`` gives exactly the
+    transforms, fits and weights of ``register(cloud, models)``.
+
+    >>> reg = Registrar([mug_a, mug_b, mug_c], names=["a", "b", "c"])
+    >>> for cloud, eye in views:
+    ...     results = reg.register(cloud, viewpoint=eye)        # all models
+    ...     best = reg.register(cloud, viewpoint=eye, models=["b"])[0]
+
+    Args:
+        models: meshes or surface samples (see :func:`model_samples`).
+        voxel, up_prior, up, upright, model_seed, params: as for :func:`register` (fixed for the
+            registrar's life; ``params`` without ``seed`` and ``viewpoint``, which are per call).
+        names: a name per model (else the index), used in the results and by ``models=`` of
+            :meth:`register`.
+    """
+
+    def __init__(self, models: Sequence, voxel: float = 0.005, up_prior: bool = True, up=(0.0, 0.0, 1.0),
+                 upright: bool = True, model_seed: int = 0, names: Optional[Sequence] = None, **params):
+        if not isinstance(voxel, (int, float)) or not (voxel > 0) or not math.isfinite(voxel):
+            raise ValueError(f"voxel: must be positive and finite, got {voxel}")
+        for k in ("seed", "viewpoint"):
+            if k in params:
+                raise ValueError(f"{k}: is given per call, to Registrar.register")
+        models = list(models)
+        if not models:
+            raise ValueError("models: is empty")
+        if names is not None:
+            names = list(names)
+            if len(names) != len(models):
+                raise ValueError(f"names: expected {len(models)} names, got {len(names)}")
+        self.names = names if names is not None else list(range(len(models)))
+        samples, self._failed = [], {}
+        for i, m in enumerate(models):
+            try:
+                samples.append(model_samples(m, voxel=voxel, seed=model_seed + i))
+            except ValueError as e:
+                if "no surface" not in str(e) and "no area" not in str(e):
+                    raise ValueError(f"models[{i}]: {e}") from None
+                self._failed[i] = f"model has no surface ({e})"
+                samples.append((np.zeros((0, 3)), np.zeros((0, 3))))
+        self.voxel = float(voxel)
+        self._core = _core().Registrar(samples, voxel=float(voxel), up_prior=bool(up_prior), upright=bool(upright),
+                                       up=np.asarray(up, float), **params)
+
+    def __len__(self) -> int:
+        return len(self._core)
+
+    def preparation_time(self, i: int) -> float:
+        """Seconds spent preparing model ``i`` (downsampling, normals, FPFH, k-d trees)."""
+        return float(self._core.model_info(int(i))["time"])
+
+    def _indices(self, models) -> List[int]:
+        if models is None:
+            return list(range(len(self.names)))
+        if isinstance(models, (str, int, np.integer)):
+            models = [models]
+        out = []
+        for m in models:
+            if m in self.names:  # a name (the first model of that name)
+                out.append(self.names.index(m))
+            elif isinstance(m, (int, np.integer)) and not isinstance(m, bool) and 0 <= int(m) < len(self.names):
+                out.append(int(m))
+            else:
+                raise ValueError(f"models: unknown model {m!r} (names: {self.names})")
+        if not out:
+            raise ValueError("models: is empty")
+        return out
+
+    def register(self, cloud, seed: int = 0, viewpoint=None, models=None) -> List[RegistrationResult]:
+        """Registers a partial cloud against the prepared models (``models``: names or indices,
+        None for all), in parallel. ``seed``: RANSAC seed; ``viewpoint``: the camera centre in the
+        cloud's frame. Returns one :class:`RegistrationResult` per model asked for, with weights
+        normalised over those; ``time_features`` is the cloud's feature time only."""
+        P = _check_cloud(cloud)
+        idx = self._indices(models)
+        vp = None if viewpoint is None else np.asarray(viewpoint, float)
+        raw = self._core.register(P, seed=int(seed), viewpoint=vp, models=idx)
+        return [_result(r, self.names[i], self._failed.get(i)) for i, r in zip(idx, raw)]
+
+
 def register(cloud, models: Sequence, voxel: float = 0.005, seed: int = 0, viewpoint=None, up_prior: bool = True,
              up=(0.0, 0.0, 1.0), upright: bool = True, model_seed: int = 0, names: Optional[Sequence] = None,
              **params) -> List[RegistrationResult]:
-    """Registers a partial cloud against every model in one parallel call.
+    """Registers a partial cloud against every model in one parallel call (a one-shot
+    :class:`Registrar`; to register many clouds against the same models, make one Registrar).
 
     Args:
         cloud: (N, 3) / organised (H, W, 3) array or Open3D cloud; NaN rows are dropped.
@@ -247,46 +355,21 @@ def register(cloud, models: Sequence, voxel: float = 0.005, seed: int = 0, viewp
         up_prior, up, upright: see the module docstring.
         params: restarts, ransac_iterations, hypotheses, icp_iterations, feature_neighbours,
             normal_radius, feature_radius, inlier_distance, icp_distance (multiples of voxel),
-            weight_sigma (x voxel), max_tilt_deg, min_scene_points, threads.
+            weight_sigma (x voxel), max_tilt_deg, min_scene_points, threads, pcl_features (PCL's
+            normal and FPFH estimators instead of ours: same definitions, slower).
 
-    Returns one :class:`RegistrationResult` per model, in order. A model with no surface, or a
-    cloud with too few points for the features, gives ``success=False`` with a ``reason`` (the
-    transform is then the identity). ValueError for an empty or all-NaN cloud, no models, or bad
-    parameters.
+    Returns one :class:`RegistrationResult` per model, in order (``time_features`` includes the
+    model's preparation). A model with no surface, or a cloud with too few points for the features,
+    gives ``success=False`` with a ``reason`` (the transform is then the identity). ValueError for an
+    empty or all-NaN cloud, no models, or bad parameters.
     """
-    P = as_cloud(cloud)
-    if len(P) == 0:
-        raise ValueError("cloud: is empty")
-    if not np.isfinite(P).all(axis=1).any():
-        raise ValueError("cloud: has no finite points")
-    if not isinstance(voxel, (int, float)) or not (voxel > 0) or not math.isfinite(voxel):
-        raise ValueError(f"voxel: must be positive and finite, got {voxel}")
-    models = list(models)
-    if not models:
-        raise ValueError("models: is empty")
-    samples, failed = [], {}
-    for i, m in enumerate(models):
-        try:
-            samples.append(model_samples(m, voxel=voxel, seed=model_seed + i))
-        except ValueError as e:
-            if "no surface" not in str(e) and "no area" not in str(e):
-                raise ValueError(f"models[{i}]: {e}") from None
-            failed[i] = f"model has no surface ({e})"
-            samples.append((np.zeros((0, 3)), np.zeros((0, 3))))
-    vp = None if viewpoint is None else np.asarray(viewpoint, float)
-    raw = _core().register_models(P, samples, voxel=float(voxel), seed=int(seed), up_prior=bool(up_prior),
-                                  upright=bool(upright), up=np.asarray(up, float), viewpoint=vp, **params)
-    out = []
-    for i, r in enumerate(raw):
-        reason = failed.get(i, r["reason"])
-        out.append(RegistrationResult(
-            success=bool(r["success"]), reason=reason, transform=np.asarray(r["transform"]),
-            fitness=float(r["fitness"]), rmse=float(r["rmse"]), delta=float(r["delta"]), phi=float(r["phi"]),
-            weight=float(r["weight"]), up_cos=float(r["up_cos"]), scene_points=int(r["scene_points"]),
-            model_points=int(r["model_points"]), time_features=float(r["time_features"]),
-            time_global=float(r["time_global"]), time_icp=float(r["time_icp"]),
-            model=(names[i] if names is not None else i)))
-    return out
+    P = _check_cloud(cloud)
+    reg = Registrar(models, voxel=voxel, up_prior=up_prior, up=up, upright=upright, model_seed=model_seed,
+                    names=names, **params)
+    res = reg.register(P, seed=seed, viewpoint=viewpoint)
+    for i, r in enumerate(res):
+        r.time_features += reg.preparation_time(i)
+    return res
 
 
 def rotation_error(Ra, Rb, axis=None) -> float:

@@ -374,3 +374,138 @@ TEST(VisionRegistration, BadInputs) {
   bad.voxel = -1;
   EXPECT_THROW(register_models(scene, {m}, bad), std::invalid_argument);
 }
+
+TEST(VisionRegistrar, ReusedAcrossScenesEqualsOneShot) {
+  const TriMesh L = l_block();
+  const TriMesh B = box(0.05, 0.05, 0.2);
+  RegistrationParams p;
+  const std::vector<ModelCloud> models = {model_from_mesh(B, p, 1), model_from_mesh(L, p, 2)};
+  Registrar reg(p);
+  EXPECT_EQ(reg.add_models(models), 0);
+  ASSERT_EQ(reg.size(), 2);
+  EXPECT_TRUE(reg.model_ok(0) && reg.model_ok(1));
+  EXPECT_GT(reg.model_points(1), 100);
+  struct Case {
+    double x, y, yaw;
+    Vec3 eye;
+    std::uint64_t seed;
+  };
+  for (const Case& c : {Case{0.02, -0.03, 0.4, Vec3(0.5, -0.5, 0.5), 2}, Case{-0.05, 0.04, 2.2, Vec3(-0.4, -0.5, 0.6), 7},
+                        Case{0.0, 0.0, -1.0, Vec3(0.2, 0.6, 0.5), 3}}) {
+    const Iso3 T = planar_pose(c.x, c.y, c.yaw);
+    const Points scene = view(L, T, c.eye, T * Vec3(0.05, 0.04, 0.03), true, c.seed);
+    RegistrationParams q = p;
+    q.seed = c.seed;
+    q.has_viewpoint = true;
+    q.viewpoint = c.eye;
+    const auto one = register_models(scene, models, q);
+    const auto all = reg.register_scene(scene, c.seed, c.eye);
+    const auto only_l = reg.register_scene(scene, c.seed, c.eye, {1});
+    ASSERT_EQ(all.size(), 2u);
+    ASSERT_EQ(only_l.size(), 1u);
+    for (int i = 0; i < 2; ++i) {
+      EXPECT_EQ(all[i].success, one[i].success);
+      EXPECT_TRUE(all[i].transform == one[i].transform) << "model " << i << " yaw " << c.yaw;
+      EXPECT_EQ(all[i].fitness, one[i].fitness);
+      EXPECT_EQ(all[i].delta, one[i].delta);
+      EXPECT_EQ(all[i].weight, one[i].weight);
+      EXPECT_EQ(all[i].ransac_iterations, one[i].ransac_iterations);
+      // Only the scene's features are timed per call; the one-shot call adds the model's.
+      EXPECT_GT(one[i].time_features, all[i].time_features - 1e-3);
+    }
+    // One model alone: the same fit, its weight normalised over itself.
+    EXPECT_TRUE(only_l[0].transform == all[1].transform);
+    EXPECT_EQ(only_l[0].delta, all[1].delta);
+    EXPECT_NEAR(only_l[0].weight, 1.0, 1e-12);
+    ASSERT_TRUE(all[1].success) << all[1].reason;
+    const Iso3 E(all[1].transform);
+    EXPECT_LT(rotation_error(E.linear(), T.linear()) * 180 / kPi, 5.0) << "yaw " << c.yaw;
+    EXPECT_LT((E.translation() - T.translation()).norm(), 0.005) << "yaw " << c.yaw;
+  }
+}
+
+TEST(VisionRegistrar, OwnFeaturesMatchPclsInQuality) {
+  // Our normals + FPFH and PCL's (pcl_features) follow the same definitions: both recover the
+  // block's pose.
+  const TriMesh L = l_block();
+  RegistrationParams p;
+  p.restarts = 6;
+  const ModelCloud m = model_from_mesh(L, p, 11);
+  const Iso3 T = planar_pose(0.05, 0.02, 0.7);
+  const Vec3 eye(0.4, -0.6, 0.55);
+  const Points scene = view(L, T, eye, T * Vec3(0.05, 0.04, 0.03), true, 3);
+  for (bool pcl : {false, true}) {
+    RegistrationParams q = p;
+    q.pcl_features = pcl;
+    Registrar reg(q);
+    reg.add_models({m});
+    const auto r = reg.register_scene(scene, 5, eye);
+    ASSERT_TRUE(r[0].success) << r[0].reason;
+    const Iso3 E(r[0].transform);
+    EXPECT_LT(rotation_error(E.linear(), T.linear()) * 180 / kPi, 5.0) << "pcl " << pcl;
+    EXPECT_LT((E.translation() - T.translation()).norm(), 0.005) << "pcl " << pcl;
+  }
+}
+
+TEST(VisionRegistrar, BadInputs) {
+  RegistrationParams p;
+  RegistrationParams bad = p;
+  bad.voxel = 0;
+  EXPECT_THROW(Registrar{bad}, std::invalid_argument);
+  Registrar reg(p);
+  const Points scene = view(box(0.1, 0.1, 0.1), Iso3::Identity(), Vec3(0.4, -0.4, 0.4), Vec3(0, 0, 0.05), false, 0);
+  EXPECT_THROW(reg.register_scene(scene, 0), std::invalid_argument);  // no models yet
+  Points nanpts = Points::Constant(10, 3, std::numeric_limits<double>::quiet_NaN());
+  Points halfnan = model_from_mesh(box(0.1, 0.1, 0.1), p, 0).surface.points;
+  halfnan(3, 1) = std::numeric_limits<double>::quiet_NaN();
+  ModelCloud nanmodel{{halfnan, model_from_mesh(box(0.1, 0.1, 0.1), p, 0).surface.normals}};
+  EXPECT_EQ(reg.add_models({model_from_mesh(box(0.1, 0.1, 0.1), p, 0), ModelCloud{}, nanmodel}), 0);
+  EXPECT_EQ(reg.add_models({model_from_mesh(box(0.1, 0.1, 0.1), p, 4)}), 3);
+  EXPECT_TRUE(reg.model_ok(0));
+  EXPECT_FALSE(reg.model_ok(1));
+  EXPECT_NE(reg.model_reason(1).find("no surface"), std::string::npos);
+  EXPECT_FALSE(reg.model_ok(2));
+  EXPECT_NE(reg.model_reason(2).find("NaN"), std::string::npos);
+  EXPECT_THROW(reg.model_ok(4), std::invalid_argument);
+  EXPECT_THROW(reg.register_scene(scene, 0, std::nullopt, {0, 4}), std::invalid_argument);
+  EXPECT_THROW(reg.register_scene(scene, 0, std::nullopt, {-1}), std::invalid_argument);
+  EXPECT_THROW(reg.register_scene(Points(0, 3), 0), std::invalid_argument);
+  EXPECT_THROW(reg.register_scene(nanpts, 0), std::invalid_argument);
+  EXPECT_THROW(reg.register_scene(scene, 0, Vec3(0, std::numeric_limits<double>::infinity(), 0)),
+               std::invalid_argument);
+  const auto r = reg.register_scene(scene, 0, Vec3(0.4, -0.4, 0.4));
+  ASSERT_EQ(r.size(), 4u);
+  EXPECT_TRUE(r[0].success) << r[0].reason;
+  EXPECT_FALSE(r[1].success);
+  EXPECT_NE(r[1].reason.find("no surface"), std::string::npos);
+  EXPECT_TRUE(r[1].transform.isIdentity());
+  EXPECT_EQ(r[1].weight, 0.0);
+  EXPECT_FALSE(r[2].success);
+  EXPECT_TRUE(r[3].success);
+  EXPECT_NEAR(r[0].weight + r[3].weight, 1.0, 1e-12);
+  // Too few scene points: every model fails with the reason.
+  const auto few = reg.register_scene(Points::Random(10, 3) * 0.05, 0);
+  for (const auto& x : few) EXPECT_NE(x.reason.find("at least"), std::string::npos);
+}
+
+TEST(VisionRegistrar, ThreadCountDoesNotChangeTheResult) {
+  // The features are computed pair-once on one thread and once per pair end on several; the
+  // RANSAC is seeded per model: the same result either way.
+  const TriMesh L = l_block();
+  const Iso3 T = planar_pose(0.01, 0.02, -0.6);
+  const Vec3 eye(0.5, 0.4, 0.5);
+  const Points scene = view(L, T, eye, T * Vec3(0.05, 0.04, 0.03), true, 4);
+  std::vector<std::vector<RegistrationResult>> out;
+  for (int threads : {1, 2}) {
+    RegistrationParams p;
+    p.threads = threads;
+    Registrar reg(p);
+    reg.add_models({model_from_mesh(L, p, 2), model_from_mesh(box(0.05, 0.05, 0.2), p, 1)});
+    out.push_back(reg.register_scene(scene, 9, eye));
+  }
+  for (int i = 0; i < 2; ++i) {
+    EXPECT_TRUE(out[0][i].transform == out[1][i].transform) << "model " << i;
+    EXPECT_EQ(out[0][i].delta, out[1][i].delta);
+    EXPECT_EQ(out[0][i].model_points, out[1][i].model_points);
+  }
+}

@@ -198,3 +198,73 @@ def test_register_command_json_and_png(tmp_path, capsys):
     assert png.exists() and png.stat().st_size > 1000
     with pytest.raises(ValueError, match="pose"):
         vision.register_command("cube", "1,2", ["cube"])
+
+
+def test_registrar_reused_across_clouds_equals_one_shot():
+    L, cyl = l_block(), cylinder(0.04, 0.12)
+    reg = vision.Registrar([cyl, L], names=["cyl", "L"], restarts=6)  # flat faces: search longer
+    assert len(reg) == 2 and reg.preparation_time(1) > 0
+    for k, (yaw, eye, seed) in enumerate([(0.3, (0.5, -0.4, 0.5), 7), (2.0, (-0.4, -0.5, 0.6), 3)]):
+        T = planar(0.01 * k, -0.02, yaw)
+        V, F = moved(L, T)
+        cam = Camera.looking_at(eye=eye, target=V.mean(axis=0))
+        cloud = cam.capture([(V, F)], seed=seed)
+        once = register(cloud, [cyl, L], viewpoint=cam.eye, seed=seed, names=["cyl", "L"], restarts=6)
+        again = reg.register(cloud, viewpoint=cam.eye, seed=seed)
+        assert [r.model for r in again] == ["cyl", "L"]
+        for a, b in zip(once, again):
+            assert a.success == b.success
+            np.testing.assert_array_equal(a.transform, b.transform)
+            assert a.delta == b.delta and a.weight == b.weight
+            assert a.time_features >= b.time_features - 1e-3  # one shot includes the model's preparation
+        only = reg.register(cloud, viewpoint=cam.eye, seed=seed, models=["L"])
+        assert len(only) == 1 and only[0].model == "L" and only[0].weight == pytest.approx(1.0)
+        np.testing.assert_array_equal(only[0].transform, again[1].transform)
+        assert math.degrees(rotation_error(again[1].transform[:3, :3], T[:3, :3])) < 5
+        assert np.linalg.norm(again[1].transform[:3, 3] - T[:3, 3]) < 0.005
+    # By index too.
+    assert reg.register(cloud, viewpoint=cam.eye, seed=seed, models=[1])[0].model == "L"
+
+
+def test_registrar_bad_inputs():
+    L = l_block()
+    with pytest.raises(ValueError, match="models"):
+        vision.Registrar([])
+    with pytest.raises(ValueError, match="voxel"):
+        vision.Registrar([L], voxel=0)
+    with pytest.raises(ValueError, match="seed"):
+        vision.Registrar([L], seed=3)
+    with pytest.raises(ValueError, match="names"):
+        vision.Registrar([L], names=["a", "b"])
+    flat = (np.array([[0, 0, 0], [1, 0, 0], [2, 0, 0.0]]), np.array([[0, 1, 2]]))
+    reg = vision.Registrar([flat, L], names=["flat", "L"])
+    cam = Camera.looking_at(eye=(0.4, -0.4, 0.4), target=(0.05, 0.05, 0.03))
+    cloud = cam.capture([L], seed=1)
+    r = reg.register(cloud, viewpoint=cam.eye)
+    assert not r[0].success and "no surface" in r[0].reason and r[0].weight == 0
+    assert r[1].success
+    with pytest.raises(ValueError, match="models"):
+        reg.register(cloud, models=["mug"])
+    with pytest.raises(ValueError, match="models"):
+        reg.register(cloud, models=[5])
+    with pytest.raises(ValueError, match="models"):
+        reg.register(cloud, models=[])
+    with pytest.raises(ValueError, match="cloud"):
+        reg.register(np.zeros((0, 3)))
+    with pytest.raises(ValueError, match="cloud"):
+        reg.register(np.full((20, 3), np.nan))
+    with pytest.raises(ValueError, match="viewpoint"):
+        reg.register(cloud, viewpoint=(0, 0))
+    with pytest.raises(ValueError, match="viewpoint"):
+        reg.register(cloud, viewpoint=(0, np.nan, 1))
+    core = reg._core
+    with pytest.raises(ValueError, match="models"):
+        core.register(cloud, models=[7])
+    with pytest.raises(ValueError, match="cloud"):
+        core.register(np.zeros((5, 2)))
+    with pytest.raises(ValueError, match=r"models\[0\]"):
+        core.add_models([(np.zeros((3, 3)), np.zeros((4, 3)))])
+    with pytest.raises(ValueError, match="i"):
+        core.model_info(9)
+    assert core.add_models([(np.zeros((0, 3)), np.zeros((0, 3)))]) == 2
+    assert not core.model_info(2)["ok"] and "no surface" in core.model_info(2)["reason"]
