@@ -142,7 +142,7 @@ def entropy_gain_run(obj: str, run_index: int, cache=None, models=None, base_see
     pose = true_pose("entropy_gain", obj, run_index, base_seed)
     models = models or get_models(obj, cache_dir=cache)
     rng = np.random.default_rng(run_seed(base_seed, "entropy_gain", obj, run_index))
-    s = PlannerSettings()
+    s = PlannerSettings(explore_stability_weight=0.0)  # Eq. 3.2 alone
     est = pose + rng.uniform(-np.asarray(s.half_width), np.asarray(s.half_width))
     planner = make_planner("explore", models, est, s, seed=int(rng.integers(2**31)))
     world = World.single(obj, pose=pose)

@@ -44,6 +44,13 @@ class PlannerSettings:
     entropy_samples: int = 50          # measurement samples per candidate action
     explore_pso_particles: int = 16
     explore_pso_iter: int = 12
+    # The exploration search minimises E[H] - explore_stability_weight * P(S) (nats per unit of
+    # belief-weighted stability): 0 is the thesis's pure entropy minimisation; a positive weight
+    # prefers, among about equally informative grasps, the ones that may also hold. On the 150
+    # problems of `experiment baselines` (lift off), success by attempt 1-4 was 0.16 / 0.71 / 0.92 /
+    # 0.95 with 0, 0.27 / 0.76 / 0.95 / 0.99 with 2 (stability only: 0.29 / 0.75 / 0.93 / 0.99), and
+    # the final KDE entropy -7.46 vs -7.02 nats (stability only -6.82).
+    explore_stability_weight: float = 2.0
     # Belief update.
     metropolis_steps: int = 10
     metropolis_step: Sequence[float] = (0.003, 0.003, np.radians(3.0))
@@ -66,6 +73,8 @@ class PlannerSettings:
         for name in ("pso_particles", "pso_iter", "entropy_samples", "explore_pso_particles", "explore_pso_iter"):
             if getattr(self, name) < 1:
                 raise ValueError(f"{name}: must be at least 1, got {getattr(self, name)}")
+        if not (np.isfinite(self.explore_stability_weight) and self.explore_stability_weight >= 0):
+            raise ValueError(f"explore_stability_weight: must be >= 0, got {self.explore_stability_weight}")
         if self.metropolis_steps < 0:
             raise ValueError(f"metropolis_steps: must be >= 0, got {self.metropolis_steps}")
 
