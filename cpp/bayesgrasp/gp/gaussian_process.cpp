@@ -80,6 +80,57 @@ inline vd vbroadcast(double x) {
   return v;
 }
 
+// exp(x) for a vector of x <= 0, to ~1 ulp (x < -700, where exp(x) < 1e-304, gives 0): x =
+// (16 n' + j) ln2/16 + r with |r| <= ln2/32, exp(x) = 2^n' 2^(j/16) e^r, e^r by its Taylor
+// polynomial of degree 7 (truncation below 2e-18), 2^(j/16) from a 16-entry table.
+struct Exp2Table {
+  alignas(64) double t[16];
+  Exp2Table() {
+    for (int j = 0; j < 16; ++j) t[j] = std::exp2(j / 16.0);
+  }
+};
+const Exp2Table kExp2Table;
+typedef long long vi __attribute__((vector_size(kW * sizeof(double))));
+
+inline vd exp_nonpositive(vd x) {
+  constexpr double k16_ln2 = 23.083120654223414;            // 16 / ln 2
+  constexpr double ln2_16_hi = 6.93147180369123816490e-01 / 16;  // ln2 / 16 = hi + lo, hi with
+  constexpr double ln2_16_lo = 1.90821492927058770002e-10 / 16;  // trailing zero bits (n hi exact)
+  constexpr double shifter = 6755399441055744.0;             // 1.5 * 2^52
+  const vi tiny = x < vbroadcast(-700.0);
+  x = tiny ? vbroadcast(-700.0) : x;
+  const vd t = x * vbroadcast(k16_ln2) + vbroadcast(shifter);
+  const vd nd = t - vbroadcast(shifter);
+  const vd r = (x - nd * vbroadcast(ln2_16_hi)) - nd * vbroadcast(ln2_16_lo);
+  vd p = vbroadcast(1.0 / 5040.0);
+  p = p * r + vbroadcast(1.0 / 720.0);
+  p = p * r + vbroadcast(1.0 / 120.0);
+  p = p * r + vbroadcast(1.0 / 24.0);
+  p = p * r + vbroadcast(1.0 / 6.0);
+  p = p * r + vbroadcast(0.5);
+  p = p * r + vbroadcast(1.0);
+  p = p * r + vbroadcast(1.0);
+  vi n;
+  std::memcpy(&n, &t, sizeof(vi));
+  n -= 0x18000000000000LL;  // the shifter's mantissa bits: n = round(16 x / ln2)
+  const vi j = n & 15;
+  vd s;
+  if constexpr (kW == 8) {  // two-register permute (vpermt2pd) instead of a gather
+    vd t0, t1;
+    std::memcpy(&t0, kExp2Table.t, sizeof(vd));
+    std::memcpy(&t1, kExp2Table.t + 8, sizeof(vd));
+    s = __builtin_shuffle(t0, t1, j);
+  } else {
+    for (int l = 0; l < kW; ++l) s[l] = kExp2Table.t[j[l]];
+  }
+  vd y = p * s;
+  vi yb;
+  std::memcpy(&yb, &y, sizeof(vi));
+  yb += (n >> 4) << 52;  // times 2^floor(n / 16)
+  std::memcpy(&y, &yb, sizeof(vd));
+  return tiny ? vbroadcast(0.0) : y;
+}
+
 // Packed layout of an upper-triangular M x M factor G: tile t covers rows i0 = t*kMR ..
 // i0+kMR-1 (rows >= M are zero padding) and columns k = i0 .. M-1; entry (ii, k) sits at
 // offset(t) + (k - i0) * kMR + ii. offset(t) = kMR * sum_{s<t} (M - s*kMR).
@@ -101,6 +152,7 @@ template <class Cache>
 void shape_group(const Cache& c, const Eigen::MatrixXd& X, Eigen::Index i0, int n, double* F) {
   const Eigen::Index M = c.basis.rows(), D = c.basis.cols();
   constexpr int kMaxD = 16;
+  const bool se = c.type == KernelType::SquaredExponential;
   if (D <= kMaxD) {
     alignas(64) double xs[kMaxD][kGroup];
     for (Eigen::Index d = 0; d < D; ++d)
@@ -116,8 +168,12 @@ void shape_group(const Cache& c, const Eigen::MatrixXd& X, Eigen::Index i0, int 
           r[v] += t * t;
         }
       }
-      for (int v = 0; v < kNV; ++v) vstore(f + v * kW, r[v]);
+      if (se)
+        for (int v = 0; v < kNV; ++v) vstore(f + v * kW, exp_nonpositive(vbroadcast(-0.5) * r[v]));
+      else
+        for (int v = 0; v < kNV; ++v) vstore(f + v * kW, r[v]);
     }
+    if (se) return;
   } else {
     for (Eigen::Index k = 0; k < M; ++k)
       for (int j = 0; j < kGroup; ++j) {
@@ -131,8 +187,8 @@ void shape_group(const Cache& c, const Eigen::MatrixXd& X, Eigen::Index i0, int 
       }
   }
   Eigen::Map<Eigen::ArrayXd> a(F, M * kGroup);
-  if (c.type == KernelType::SquaredExponential) {
-    a = (-0.5 * a).exp();
+  if (se) {
+    for (Eigen::Index i = 0; i < M * kGroup; i += kW) vstore(F + i, exp_nonpositive(vbroadcast(-0.5) * vload(F + i)));
   } else {
     const Eigen::ArrayXd s = (5.0 * a).sqrt();
     a = (1.0 + s + s.square() * (1.0 / 3.0)) * (-s).exp();
