@@ -328,3 +328,98 @@ TEST(GPErrors, BadInputIsRejected) {
   EXPECT_THROW(gp.predict_mean(Eigen::MatrixXd::Zero(3, 3)), std::invalid_argument);
   EXPECT_THROW(gp.log_predictive_density(X, Eigen::MatrixXd::Zero(20, 2)), std::invalid_argument);
 }
+
+namespace {
+// The same fitted model predicting through the blockwise Eigen path (no packed factor).
+struct BlockwiseSparseGP : SparseGP {
+  explicit BlockwiseSparseGP(const SparseGP& g) : SparseGP(g) { cache_.G_packed.clear(); }
+};
+}  // namespace
+
+TEST(GPFitc, FusedPredictionEqualsDenseFormulaAndBlockwisePath) {
+  // FITC predictive distribution from its textbook form (Snelson & Ghahramani 2006):
+  //   Lambda = diag(Knn - Qnn) + noise,  Sigma = (Kmm + Kmn Lambda^-1 Knm)^-1,
+  //   mean = Ksm Sigma Kmn Lambda^-1 y,  var = kss - Ksm (Kmm^-1 - Sigma) Kms.
+  // Shapes chosen to hit the kernel's edge cases: M not a multiple of the register tile,
+  // batches of 1, 23, 24, 25, 301 inputs (not multiples of the input group), D = 3 and D = 17
+  // (the scalar distance fallback), both kernels, two outputs.
+  for (const int D : {3, 17})
+    for (KernelType t : {KernelType::SquaredExponential, KernelType::Matern52}) {
+      Eigen::MatrixXd X, Y, Z, Zy;
+      make_data(120, D, 2, 31 + D, X, Y);
+      make_data(37, D, 1, 41 + D, Z, Zy);
+      GPOptions o = fixed_options(t);
+      o.lengthscale = Eigen::VectorXd::Constant(1, D == 3 ? 0.8 : 3.0);
+      o.inducing = Z;
+      SparseGP gp(o);
+      gp.fit(X, Y);
+      // Reference in long double (explicit inverses of an ill-conditioned Kmm lose ~8 digits in
+      // double), with the jitter the fit used.
+      using MatL = Eigen::Matrix<long double, Eigen::Dynamic, Eigen::Dynamic>;
+      const Kernel k(t, Eigen::VectorXd::Constant(D, D == 3 ? 0.8 : 3.0), 1.3);
+      MatL Kmm = k(Z).cast<long double>();
+      Kmm.diagonal().array() += static_cast<long double>(gp.fit_info().jitter_used * 1.3);
+      const MatL Kmn = k(Z, X).cast<long double>();
+      const MatL Kmm_inv = Kmm.inverse();
+      const Eigen::Array<long double, Eigen::Dynamic, 1> lam =
+          1.3L - (Kmn.transpose() * Kmm_inv * Kmn).diagonal().array() + 0.05L;
+      const MatL KmnL = Kmn * lam.inverse().matrix().asDiagonal();
+      const MatL Sigma = (Kmm + KmnL * Kmn.transpose()).inverse();
+      const BlockwiseSparseGP blockwise(gp);
+      for (const int ns : {1, 23, 24, 25, 301}) {
+        Eigen::MatrixXd Xs, Ys;
+        make_data(ns, D, 2, 50 + ns, Xs, Ys);
+        const MatL Ksm = k(Xs, Z).cast<long double>();
+        const Eigen::MatrixXd mean = (Ksm * Sigma * KmnL * Y.cast<long double>()).cast<double>();
+        const Eigen::VectorXd var =
+            (1.3L - (Ksm * (Kmm_inv - Sigma) * Ksm.transpose()).diagonal().array()).matrix().cast<double>();
+        Eigen::MatrixXd m, v, mb, vb;
+        gp.predict(Xs, m, v);
+        blockwise.predict(Xs, mb, vb);
+        ASSERT_EQ(m.rows(), ns);
+        for (int p = 0; p < 2; ++p) EXPECT_LT((v.col(p) - var).cwiseAbs().maxCoeff(), 1e-8) << ns;
+        EXPECT_LT((m - mean).cwiseAbs().maxCoeff(), 1e-7) << ns;
+        // fused vs blockwise: the same algebra in another summation order
+        EXPECT_LT((v - vb).cwiseAbs().maxCoeff(), 1e-12 * 1.3) << ns;
+        EXPECT_LT((m - mb).cwiseAbs().maxCoeff(), 1e-10) << ns;
+        EXPECT_LT((gp.predict_mean(Xs) - m).cwiseAbs().maxCoeff(), 1e-10);
+        // with noise: var + noise
+        Eigen::MatrixXd mn, vn;
+        gp.predict(Xs, mn, vn, true);
+        EXPECT_LT(((vn - v).array() - 0.05).abs().maxCoeff(), 1e-12);
+      }
+    }
+}
+
+TEST(GPFitc, FusedVarianceNearZeroIsClampedNeverNaN) {
+  // Inducing = training inputs (duplicated), zero noise: the predictive variance at the training
+  // inputs is ~0 (rounding may push 1 - |G f|^2 below zero); it must come back >= 0 and finite,
+  // agree with the exact GP and with the blockwise path.
+  Eigen::MatrixXd X, Y;
+  make_data(40, 3, 1, 77, X, Y);
+  Eigen::MatrixXd Xd(80, 3), Yd(80, 1);
+  Xd << X, X;
+  Yd << Y, Y;
+  GPOptions o = fixed_options();
+  o.noise = 0.0;
+  o.inducing = X;
+  SparseGP gp(o);
+  gp.fit(Xd, Yd);
+  Eigen::MatrixXd m, v, mb, vb;
+  gp.predict(Xd, m, v);
+  ASSERT_TRUE(v.allFinite());
+  ASSERT_TRUE(m.allFinite());
+  EXPECT_GE(v.minCoeff(), 0.0);
+  EXPECT_LT(v.maxCoeff(), 1e-5 * 1.3);
+  BlockwiseSparseGP(gp).predict(Xd, mb, vb);
+  EXPECT_LT((v - vb).cwiseAbs().maxCoeff(), 1e-12 * 1.3);
+  EXPECT_TRUE(gp.log_predictive_density(Xd, Yd).allFinite());
+  // exact GP with the same zero noise (it adds jitter): same near-zero variances
+  o.inducing.resize(0, 0);
+  ExactGP ex(o);
+  ex.fit(X, Y);
+  Eigen::MatrixXd me, ve;
+  ex.predict(X, me, ve);
+  EXPECT_LT((ve - v.topRows(40)).cwiseAbs().maxCoeff(), 1e-5 * 1.3);
+  EXPECT_LT((me - m.topRows(40)).cwiseAbs().maxCoeff(), 1e-4);
+}

@@ -51,6 +51,35 @@ def test_sparse_equals_exact_when_inducing_inputs_are_training_inputs():
     np.testing.assert_allclose(sp.log_predictive_density(Xs, Ys), ex.log_predictive_density(Xs, Ys), atol=1e-5)
 
 
+def _se(A, B, ls, var):
+    d = (A[:, None, :] - B[None, :, :]) / ls
+    return var * np.exp(-0.5 * (d ** 2).sum(-1))
+
+
+@pytest.mark.parametrize("ns", [1, 23, 24, 25, 97])
+def test_sparse_variance_equals_dense_fitc_formula(ns):
+    # var = kss - k*^T (Kmm^-1 - Sigma) k*, Sigma = (Kmm + Kmn Lambda^-1 Knm)^-1 (Snelson &
+    # Ghahramani 2006), in numpy, against the fused C++ kernel at batch sizes around its group.
+    X, y = data(150, 3, seed=4)
+    Z, _ = data(29, 3, seed=5)
+    ls, var, noise = np.array([0.9, 1.2, 1.6]), 1.4, 0.02
+    sp = SparseGP(inducing=Z, lengthscale=ls, variance=var, noise=noise, **FIXED).fit(X, y)
+    jit = sp.fit_info_["jitter_used"]
+    Kmm = _se(Z, Z, ls, var) + jit * var * np.eye(29)
+    Kmn = _se(Z, X, ls, var)
+    Ki = np.linalg.inv(Kmm)
+    lam = var - np.einsum("mi,mk,ki->i", Kmn, Ki, Kmn) + noise
+    Sigma = np.linalg.inv(Kmm + (Kmn / lam) @ Kmn.T)
+    Xs, _ = data(ns, 3, seed=6)
+    Ksm = _se(Xs, Z, ls, var)
+    mean = Ksm @ Sigma @ (Kmn / lam) @ y
+    v = var - np.einsum("im,mk,ik->i", Ksm, Ki - Sigma, Ksm)
+    m, s = sp.predict(Xs, return_std=True)
+    assert m.shape == (ns,) and np.all(np.isfinite(s))
+    np.testing.assert_allclose(m, mean, atol=1e-6)
+    np.testing.assert_allclose(s ** 2, np.maximum(v, 0.0), atol=1e-7)
+
+
 @pytest.mark.parametrize("cls,extra", [(ExactGP, {}), (SparseGP, dict(n_inducing=10, optimize_inducing=True))])
 @pytest.mark.parametrize("kernel", ["se", "matern52"])
 def test_gradient_matches_finite_differences(cls, extra, kernel):

@@ -140,8 +140,15 @@ class GaussianProcess {
                                  // 3: G is lower triangular and the factor is G^-1 (solve)
     Eigen::RowVectorXd var_f0;   // (P,) prior variance per output in raw units
     Eigen::RowVectorXd noise;    // (P,) noise variance per output in raw units
+    // G (shape 2, upper triangular) packed in register tiles for the fused mean + variance
+    // kernel (see pack_factor()); empty = the blockwise Eigen path.
+    std::vector<double> G_packed;
   };
 
+  /// Packs an upper-triangular cache_.G (G_shape 2) for the fused prediction kernel: the
+  /// per-input quadratic form |G f|^2 then costs M^2 flops in registers, computed on batches of
+  /// inputs right after their kernel vectors, with no (N x M) intermediate.
+  void pack_factor();
   void check_fitted(const char* what) const;
   void check_inputs(const Eigen::MatrixXd& X, const char* name) const;
   /// Standardises X, Y into Xn_, Yn_ and sets the normalisation; validates.

@@ -249,6 +249,7 @@ void SparseGP::build_cache() {
   Eigen::HouseholderQR<Eigen::MatrixXd> qr(Gt.transpose());
   cache_.G = qr.matrixQR().triangularView<Eigen::Upper>();
   cache_.G_shape = 2;
+  pack_factor();
   cache_.var_f0 = (y_scale_.array().square() * var).matrix().transpose();
   cache_.noise = (y_scale_.array().square() * noise_).matrix().transpose();
   (void)M;
