@@ -236,6 +236,15 @@ struct GraspSimulator::Impl {
     Vec3 point = Vec3::Zero(), link_point = Vec3::Zero();
     int tri = -1;
   };
+  /// Outward contact normal: the direction from the object's nearest point to the link's when
+  /// they are apart (at an edge or a rim the nearest triangle's face normal can be that of the
+  /// wrong face: a palm resting on a cylinder's top face reported the side wall's horizontal
+  /// normal at the rim), else the face normal.
+  Vec3 contact_normal(const Exact& e) const {
+    const Vec3 gap = e.link_point - e.point;
+    if (e.d > 0.0 && gap.norm() > 1e-7) return gap.normalized();
+    return normals[e.tri];
+  }
   /// FCL distance from one shape to the object; `offset` (the capsule radius of a segment
   /// shape) is subtracted, and the link-side nearest point moved onto the capsule's surface.
   /// With a finite `cap`, only distances below it are searched for; kInf if there are none.
@@ -649,7 +658,7 @@ struct GraspSimulator::Impl {
         if (e.d < tol && e.tri >= 0) {
           Contact k;
           k.point = e.point;
-          k.normal = normals[e.tri];
+          k.normal = contact_normal(e);
           k.link = l;
           k.penetration = std::max(0.0, -e.d);
           r.contacts.push_back(k);

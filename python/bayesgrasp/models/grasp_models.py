@@ -32,7 +32,7 @@ from .. import gp as _gp
 from ..objects import ObjectModel, load_object
 from ..world import World
 
-CACHE_VERSION = 3
+CACHE_VERSION = 4  # bump when the simulator or the models change what a key means
 
 #: Candidate finger spreads (rad) when ModelSettings.spread is None.
 AUTO_SPREADS = tuple(float(np.radians(d)) for d in (0.0, 30.0, 45.0, 60.0, 90.0))
