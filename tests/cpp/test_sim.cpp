@@ -397,3 +397,22 @@ TEST(Sim, QueryPruningKeepsTheResult) {
   }
   EXPECT_LT(qa, qb);
 }
+
+// A palm resting on a cylinder's top face pushes along +z: its contact normal is the top face's,
+// also when the nearest points lie on the rim (where the side wall's triangles meet the top).
+TEST(Sim, PalmOnTopFaceHasAVerticalNormal) {
+  const HandModel hand = HandModel::from_file(kBarrett);
+  const TriMesh cyl = cylinder(0.035, 0.0, 0.2, 64);
+  const GraspSimulator sim(hand, cyl);
+  int palm_contacts = 0;
+  for (double yaw : {0.0, 0.4, 1.1}) {
+    const GraspResult g = sim.top_grasp(0.0, 0.0, yaw, 60 * kDeg);
+    for (const Contact& c : g.contacts) {
+      if (c.on_table || c.link != 0) continue;
+      ++palm_contacts;
+      EXPECT_NEAR(c.point.z(), 0.2, 3e-4);
+      EXPECT_GT(c.normal.z(), 0.999) << "yaw " << yaw;
+    }
+  }
+  EXPECT_GT(palm_contacts, 0);
+}
