@@ -27,6 +27,7 @@ from typing import List, Optional, Sequence, Union
 import numpy as np
 
 from bayesgrasp import _core
+from bayesgrasp.cache import cache_root
 
 __all__ = ["BARRETT_HAND", "LiftOptions", "LiftTester", "convex_decomposition", "decomposition_cache_dir",
            "is_concave", "lift_test", "lift_test_batch", "make_options"]
@@ -56,11 +57,6 @@ def decomposition_cache_dir() -> Path:
     ``~/.cache/bayesgrasp``) / ``convex_decomposition``."""
     return cache_root() / "convex_decomposition"
 
-
-def cache_root() -> Path:
-    """bayesgrasp's cache: ``$BAYESGRASP_CACHE``, else ``~/.cache/bayesgrasp`` (models in
-    ``models/``, convex decompositions in ``convex_decomposition/``)."""
-    return Path(os.environ.get("BAYESGRASP_CACHE") or os.path.join(os.path.expanduser("~"), ".cache", "bayesgrasp"))
 
 
 def convex_decomposition(vertices, faces, threshold: float = 0.05, seed: int = 0,

@@ -5,46 +5,16 @@
 #include <cmath>
 
 #include "bayesgrasp/physics/lift_test.hpp"
+#include "physics_fixtures.hpp"
 
 using namespace bayesgrasp;
+using namespace bayesgrasp::fixtures;
 
 namespace {
-
-HandModel barrett() {
-  return HandModel::from_file(std::string(BAYESGRASP_SOURCE_DIR) + "/python/bayesgrasp/data/hands/barrett_bh8.json");
-}
-
-// Axis-aligned box [lo, hi] as a closed, outward-wound triangle mesh.
-TriMesh box_mesh(const Vec3& lo, const Vec3& hi) {
-  TriMesh m;
-  m.V.resize(8, 3);
-  for (int i = 0; i < 8; ++i)
-    m.V.row(i) << ((i & 1) ? hi.x() : lo.x()), ((i & 2) ? hi.y() : lo.y()), ((i & 4) ? hi.z() : lo.z());
-  m.F.resize(12, 3);
-  m.F << 0, 2, 1, 1, 2, 3, 4, 5, 6, 5, 7, 6, 0, 1, 4, 1, 5, 4, 2, 6, 3, 3, 6, 7, 0, 4, 2, 2, 4, 6, 1, 3, 5, 3, 7, 5;
-  return m;
-}
 
 double point_box_distance(const Vec3& p, const Vec3& lo, const Vec3& hi) {
   const Vec3 q = p.cwiseMax(lo).cwiseMin(hi);
   return (p - q).norm();
-}
-
-// Distance from finger f's phalanx capsules (hand at T, joints q) to the box, by dense
-// sampling of the capsule axes (exact point-box distances, 400 samples per link).
-double finger_box_distance(const HandModel& hand, int f, const Iso3& T, const Eigen::VectorXd& q, const Vec3& lo,
-                           const Vec3& hi) {
-  const auto poses = hand.link_poses(T, q);
-  double best = 1e9;
-  for (const Phalanx& ph : hand.fingers()[f].phalanges)
-    for (const Shape& s : ph.shapes) {
-      if (s.type != Shape::Type::Capsule) continue;
-      for (int k = 0; k <= 400; ++k) {
-        const Vec3 p = poses[ph.link] * (s.p0 + (s.p1 - s.p0) * (k / 400.0));
-        best = std::min(best, point_box_distance(p, lo, hi) - s.radius);
-      }
-    }
-  return best;
 }
 
 // Closes the listed fingers (coupled law, no breakaway needed for a box) until each is
@@ -53,23 +23,11 @@ double finger_box_distance(const HandModel& hand, int f, const Iso3& T, const Ei
 Eigen::VectorXd touch_joints(const HandModel& hand, const Iso3& T, const Vec3& lo, const Vec3& hi,
                              const std::vector<int>& fingers) {
   Eigen::VectorXd t = Eigen::VectorXd::Zero(static_cast<Eigen::Index>(hand.fingers().size()));
+  auto dist = [&](const Vec3& p) { return point_box_distance(p, lo, hi); };
   for (int f : fingers) {
-    auto dist = [&](double tf) {
-      Eigen::VectorXd tt = t;
-      tt[f] = tf;
-      return finger_box_distance(hand, f, T, hand.coupled_joints(0.0, tt), lo, hi);
-    };
-    double a = 0.0, b = 0.0;
-    while (b < hand.fingers()[f].t_max() && dist(b) > 0) {
-      a = b;
-      b += 0.01;
-    }
-    for (int i = 0; i < 40; ++i) {
-      const double m = 0.5 * (a + b);
-      (dist(m) > 1e-4 ? a : b) = m;
-    }
-    t[f] = a;
-    EXPECT_NEAR(dist(a), 1e-4, 1e-5) << "finger " << f << " did not reach the box";
+    double end = 0.0;
+    t[f] = touch_actuator(hand, T, t, f, 0.0, dist, nullptr, &end);
+    EXPECT_NEAR(end, 1e-4, 1e-5) << "finger " << f << " did not reach the box";
   }
   return hand.coupled_joints(0.0, t);
 }
@@ -235,102 +193,16 @@ TEST(PhysicsLift, TetrahedraShapeAndAutoChoice) {
 
 namespace {
 
-// Closed cup with a floor: outer radius R, inner r, height h, floor thickness t, n segments
-// (outer wall, rim, inner wall, inner floor, bottom; 8n triangles).
-TriMesh cup_mesh(double R, double r, double h, double t, int n, const Vec3& c) {
-  TriMesh m;
-  m.V.resize(4 * n + 2, 3);
-  const double rad[4] = {R, R, r, r}, z[4] = {0, h, h, t};
-  for (int k = 0; k < 4; ++k)
-    for (int i = 0; i < n; ++i) {
-      const double a = 2 * M_PI * i / n;
-      m.V.row(k * n + i) << c.x() + rad[k] * std::cos(a), c.y() + rad[k] * std::sin(a), z[k];
-    }
-  const int cb = 4 * n, cf = 4 * n + 1;
-  m.V.row(cb) << c.x(), c.y(), 0;
-  m.V.row(cf) << c.x(), c.y(), t;
-  std::vector<Eigen::Vector3i> f;
-  auto quad = [&](int a, int b, int cc, int d) {
-    f.emplace_back(a, b, cc);
-    f.emplace_back(a, cc, d);
-  };
-  for (int i = 0; i < n; ++i) {
-    const int j = (i + 1) % n;
-    quad(0 * n + i, 0 * n + j, 1 * n + j, 1 * n + i);
-    quad(1 * n + i, 1 * n + j, 2 * n + j, 2 * n + i);
-    quad(2 * n + i, 2 * n + j, 3 * n + j, 3 * n + i);
-    f.emplace_back(cf, 3 * n + j, 3 * n + i);
-    f.emplace_back(cb, 0 * n + i, 0 * n + j);
-  }
-  m.F.resize(static_cast<Eigen::Index>(f.size()), 3);
-  for (size_t i = 0; i < f.size(); ++i) m.F.row(static_cast<Eigen::Index>(i)) = f[i].transpose();
-  return m;
-}
 
-// A convex decomposition of that cup derived by hand: the wall cut into n / per sectors
-// (each the hull of its outer and inner ring points, top and bottom; its inner face is a
-// chord, at most r (1 - cos(pi per / n)) into the cavity), and the floor (hull of the
-// outer bottom ring and the inner floor ring, inside the solid).
-std::vector<Eigen::MatrixX3d> cup_pieces(double R, double r, double h, double t, int n, int per, const Vec3& c) {
-  std::vector<Eigen::MatrixX3d> out;
-  auto ring_point = [&](double rad, int i, double z) {
-    const double a = 2 * M_PI * i / n;
-    return Eigen::RowVector3d(c.x() + rad * std::cos(a), c.y() + rad * std::sin(a), z);
-  };
-  for (int s = 0; s < n / per; ++s) {
-    Eigen::MatrixX3d P(4 * (per + 1), 3);
-    int k = 0;
-    for (int i = s * per; i <= (s + 1) * per; ++i)
-      for (double rad : {R, r})
-        for (double z : {0.0, h}) P.row(k++) = ring_point(rad, i % n, z);
-    out.push_back(P);
-  }
-  Eigen::MatrixX3d floor(2 * n, 3);
-  for (int i = 0; i < n; ++i) {
-    floor.row(i) = ring_point(R, i, 0.0);
-    floor.row(n + i) = ring_point(r, i, t);
-  }
-  out.push_back(floor);
-  return out;
-}
 
-// Signed distance (outside > 0) of a point to that cup's solid: in the (rho, z) half-plane
-// the solid is the union of the wall [r, R] x [0, h] and the floor [0, R] x [0, t].
-double cup_distance(const Vec3& p, double R, double r, double h, double t, const Vec3& c) {
-  const double rho = std::hypot(p.x() - c.x(), p.y() - c.y());
-  auto rect = [&](double r0, double r1, double z0, double z1) {
-    const double dx = std::max({r0 - rho, rho - r1, 0.0}), dz = std::max({z0 - p.z(), p.z() - z1, 0.0});
-    if (dx == 0 && dz == 0) return -std::min({rho - r0, r1 - rho, p.z() - z0, z1 - p.z()});
-    return std::hypot(dx, dz);
-  };
-  return std::min(rect(r, R, 0, h), rect(0, R, 0, t));
-}
 
-// Closes finger f from actuator value t0 until it is within 0.1 mm of the object (signed
-// distance `dist`; capsule axes sampled densely): scan in 0.01 rad steps, then bisect.
+// touch_actuator with the expectations: the finger starts clear of the object and reaches it.
 template <class Dist>
-double touch_actuator(const HandModel& hand, const Iso3& T, Eigen::VectorXd t, int f, double t0, Dist dist) {
-  auto d = [&](double tf) {
-    t[f] = tf;
-    const auto poses = hand.link_poses(T, hand.coupled_joints(0.0, t));
-    double best = 1e9;
-    for (const Phalanx& ph : hand.fingers()[f].phalanges)
-      for (const Shape& s : ph.shapes)
-        for (int k = 0; k <= 400; ++k)
-          best = std::min(best, dist(Vec3(poses[ph.link] * (s.p0 + (s.p1 - s.p0) * (k / 400.0)))) - s.radius);
-    return best;
-  };
-  EXPECT_GT(d(t0), 0.0) << "finger " << f << " starts in contact";
-  double a = t0, b = t0;
-  while (b < hand.fingers()[f].t_max() && d(b) > 0) {
-    a = b;
-    b += 0.01;
-  }
-  for (int i = 0; i < 40; ++i) {
-    const double m = 0.5 * (a + b);
-    (d(m) > 1e-4 ? a : b) = m;
-  }
-  EXPECT_LT(d(a), 2e-4) << "finger " << f << " did not reach the object";
+double touch_checked(const HandModel& hand, const Iso3& T, const Eigen::VectorXd& t, int f, double t0, Dist dist) {
+  double start = 0.0, end = 0.0;
+  const double a = fixtures::touch_actuator(hand, T, t, f, t0, dist, &start, &end);
+  EXPECT_GT(start, 0.0) << "finger " << f << " starts in contact";
+  EXPECT_LT(end, 2e-4) << "finger " << f << " did not reach the object";
   return a;
 }
 
@@ -351,9 +223,9 @@ struct PotScene {
   Eigen::VectorXd joints(bool pinch) const {
     Eigen::VectorXd a = Eigen::VectorXd::Zero(3);
     auto d = [this](const Vec3& p) { return dist(p); };
-    a[2] = touch_actuator(hand, pose, a, 2, M_PI / 3, d);
+    a[2] = touch_checked(hand, pose, a, 2, M_PI / 3, d);
     if (pinch)
-      for (int f : {0, 1}) a[f] = touch_actuator(hand, pose, a, f, 0.0, d);
+      for (int f : {0, 1}) a[f] = touch_checked(hand, pose, a, f, 0.0, d);
     return hand.coupled_joints(0.0, a);
   }
 };

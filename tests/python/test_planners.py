@@ -108,7 +108,8 @@ def test_success_rises_over_attempts_on_a_batch(cube):
         r = run_episode("cube", pose, method="stability", seed=i, models=cube, lift=False)
         first.append(r["attempts"][0]["stable"])
         by_four.append(r["success"])
-    assert np.mean(by_four) >= np.mean(first)
+    # (cumulative success cannot fall; it has to rise by a margin)
+    assert np.mean(by_four) >= np.mean(first) + 0.25
     assert np.mean(by_four) >= 0.75
 
 

@@ -22,20 +22,17 @@ True poses: x, y uniform in +-10 cm, yaw uniform; the same for every method at a
 """
 from __future__ import annotations
 
-import csv
-import json
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from functools import partial
 from pathlib import Path
-from typing import Callable, Dict, List, Optional, Sequence
+from typing import Dict, Optional, Sequence
 
 import numpy as np
 from scipy import stats
 
-from ..belief import relative_planar_pose
-from ..models import ModelSettings, relative_top_grasps
+from ..belief import relative_planar_pose, weight_entropy
+from ..models import relative_top_grasps
 from ..planners import PlannerSettings, get_models, make_planner, run_episode
-from ..planners.base import wrap_angle
 from ..world import World
 from .runner import ResultStore, run_experiment, run_seed
 
@@ -83,16 +80,24 @@ def episode_run(experiment: str, obj: str, run_index: int, seed: int, *, base: s
     return _strip(r)
 
 
+def _initial_planner(name: str, obj: str, run_index: int, base_seed: int, seed: int, cache_dir, models=None,
+                     settings: Optional[PlannerSettings] = None):
+    """A run's hidden true pose and an exploration planner on its initial belief (around a
+    noisy estimate of that pose): (pose, models, planner, rng, settings); rng (seeded by
+    ``seed``) has drawn the estimate and the planner's seed and serves the rest of the run."""
+    pose = true_pose(name, obj, run_index, base_seed)
+    models = models or get_models(obj, cache_dir=cache_dir)
+    rng = np.random.default_rng(seed)
+    s = settings or PlannerSettings()
+    est = pose + rng.uniform(-np.asarray(s.half_width), np.asarray(s.half_width))
+    return pose, models, make_planner("explore", models, est, s, seed=int(rng.integers(2**31))), rng, s
+
+
 def entropy_order_run(experiment: str, obj: str, run_index: int, seed: int, *, base_seed: int,
                       cache_dir: Optional[str], grid: int = 15) -> dict:
     """Predict the expected entropy of a grid of grasps from the initial belief, execute the best,
     the median and the worst, and compare the realised weight entropies after reweighting."""
-    pose = true_pose("entropy_order", obj, run_index, base_seed)
-    models = get_models(obj, cache_dir=cache_dir)
-    rng = np.random.default_rng(seed)
-    s = PlannerSettings()
-    est = pose + rng.uniform(-np.asarray(s.half_width), np.asarray(s.half_width))
-    planner = make_planner("explore", models, est, s, seed=int(rng.integers(2**31)))
+    pose, models, planner, _, _ = _initial_planner("entropy_order", obj, run_index, base_seed, seed, cache_dir)
     cands = _grid_actions(planner, grid, yaw=planner.belief.mean()[2])
     h, se = planner.expected_entropy(cands, n_samples=200, seed=1)
     order = np.argsort(h)
@@ -100,19 +105,10 @@ def entropy_order_run(experiment: str, obj: str, run_index: int, seed: int, *, b
     world = World.single(obj, pose=pose)
     out = {"true_pose": pose.tolist(), "predicted": {}, "realised": {}, "actions": {}, "grid": grid,
            "landscape": h.tolist(), "candidates": cands.tolist(), "particles": planner.belief.particles.tolist()}
-    P = planner.belief.particles
     for name, i in picks.items():
-        a = cands[i]
-        rel = relative_top_grasps(a, pose)[0, 0]
-        q = np.asarray(world.grasp_batch(rel[None, :], spread=models.spread)["joint_angles"][0])
-        q = q[models.joint_index]
-        ll = models.log_likelihood(relative_planar_pose(a[None, :], P), q)
-        lw = planner.belief.log_weights + ll
-        lw -= np.logaddexp.reduce(lw)
-        w = np.exp(lw)
         out["predicted"][name] = float(h[i])
-        out["realised"][name] = float(-np.sum(w[w > 0] * lw[w > 0]))
-        out["actions"][name] = a.tolist()
+        out["realised"][name], _ = _reweighted(planner, models, world, pose, cands[i])
+        out["actions"][name] = cands[i].tolist()
     pr = [out["predicted"][k] for k in ("best", "good", "worst")]
     re = [out["realised"][k] for k in ("best", "good", "worst")]
     out["order_kept"] = bool(np.all(np.argsort(re) == np.argsort(pr)))
@@ -123,36 +119,31 @@ def entropy_order_run(experiment: str, obj: str, run_index: int, seed: int, *, b
 
 def _reweighted(planner, models, world, pose, action):
     """Executes ``action`` at the true pose and reweights the planner's particles by the
-    measurement likelihood (no resampling): (log weights, weight entropy, posterior-mean error)."""
+    measurement likelihood (no resampling): (weight entropy, posterior-mean position error)."""
     rel = relative_top_grasps(action, pose)[0, 0]
     q = np.asarray(world.grasp_batch(rel[None, :], spread=models.spread)["joint_angles"][0])
     q = q[models.joint_index]
     P = planner.belief.particles
     lw = planner.belief.log_weights + models.log_likelihood(relative_planar_pose(np.asarray(action)[None, :], P), q)
-    lw = lw - np.logaddexp.reduce(lw)
-    w = np.exp(lw)
-    mu = w @ P[:, :2]
-    return lw, float(-np.sum(w[w > 0] * lw[w > 0])), float(np.hypot(*(mu - pose[:2])))
+    w = np.exp(lw - np.logaddexp.reduce(lw))
+    return weight_entropy(lw), float(np.hypot(*(w @ P[:, :2] - pose[:2])))
 
 
 def entropy_gain_run(obj: str, run_index: int, cache=None, models=None, base_seed: int = 0) -> dict:
     """From one initial belief: the planner's most informative grasp (Eq. 3.2) and a random grasp
     in the same search box, each executed at the true pose; realised posterior weight entropies
     and posterior-mean position errors (before: the prior's)."""
-    pose = true_pose("entropy_gain", obj, run_index, base_seed)
-    models = models or get_models(obj, cache_dir=cache)
-    rng = np.random.default_rng(run_seed(base_seed, "entropy_gain", obj, run_index))
-    s = PlannerSettings(explore_stability_weight=0.0)  # Eq. 3.2 alone
-    est = pose + rng.uniform(-np.asarray(s.half_width), np.asarray(s.half_width))
-    planner = make_planner("explore", models, est, s, seed=int(rng.integers(2**31)))
+    pose, models, planner, rng, _ = _initial_planner(
+        "entropy_gain", obj, run_index, base_seed, run_seed(base_seed, "entropy_gain", obj, run_index), cache,
+        models, PlannerSettings(explore_stability_weight=0.0))  # Eq. 3.2 alone
     world = World.single(obj, pose=pose)
     informative, _, _ = planner.minimise_entropy()
     low, high = planner.action_bounds()
     random_action = rng.uniform(low, high)
     w0 = planner.belief.weights
     err0 = float(np.hypot(*(w0 @ planner.belief.particles[:, :2] - pose[:2])))
-    _, h_i, e_i = _reweighted(planner, models, world, pose, informative)
-    _, h_r, e_r = _reweighted(planner, models, world, pose, random_action)
+    h_i, e_i = _reweighted(planner, models, world, pose, informative)
+    h_r, e_r = _reweighted(planner, models, world, pose, random_action)
     return {"true_pose": pose.tolist(), "error_before": err0, "entropy_before": float(np.log(len(w0))),
             "entropy_informative": h_i, "error_after_informative": e_i, "entropy_random": h_r,
             "error_after_random": e_r, "informative": informative.tolist(), "random": random_action.tolist()}
@@ -170,12 +161,7 @@ def landscapes_run(experiment: str, obj: str, run_index: int, seed: int, *, base
                    cache_dir: Optional[str], grid: int = 21) -> dict:
     """Weight vs kernel expected-entropy landscapes over (x, y) at the belief's mean yaw; for the
     cube also the 1-D (x only) uncertainty case with 1,000 and 10,000 measurement samples."""
-    pose = true_pose("landscapes", obj, run_index, base_seed)
-    models = get_models(obj, cache_dir=cache_dir)
-    rng = np.random.default_rng(seed)
-    s = PlannerSettings()
-    est = pose + rng.uniform(-np.asarray(s.half_width), np.asarray(s.half_width))
-    planner = make_planner("explore", models, est, s, seed=int(rng.integers(2**31)))
+    pose, models, planner, rng, s = _initial_planner("landscapes", obj, run_index, base_seed, seed, cache_dir)
     cands = _grid_actions(planner, grid, yaw=planner.belief.mean()[2])
     hw, _ = planner.expected_entropy(cands, n_samples=200, seed=3, method="weight")
     hk, _ = planner.expected_entropy(cands, n_samples=200, seed=3, method="kernel")

@@ -34,6 +34,9 @@ from ..world import World
 
 CACHE_VERSION = 4  # bump when the simulator or the models change what a key means
 
+#: Grid nodes of highest P(S) a ModelTable keeps (the planners' PSO seeds).
+N_BEST = 64
+
 #: Candidate finger spreads (rad) when ModelSettings.spread is None.
 AUTO_SPREADS = tuple(float(np.radians(d)) for d in (0.0, 30.0, 45.0, 60.0, 90.0))
 
@@ -167,8 +170,8 @@ class ModelTable:
     """:class:`GraspModels` on a grid (C++ ``RelativePoseGrid``): trilinear lookups at every
     (candidate grasp, particle) pair instead of GP predictions, for planning."""
 
-    def __init__(self, grid, n_joints: int, xy_range: float):
-        self.grid, self.n_joints, self.xy_range = grid, int(n_joints), float(xy_range)
+    def __init__(self, grid, n_joints: int, xy_range: float, best: np.ndarray):
+        self.grid, self.n_joints, self.xy_range, self.best = grid, int(n_joints), float(xy_range), best
 
     @classmethod
     def build(cls, models: "GraspModels", xy_step: float, yaw_step: float) -> "ModelTable":
@@ -191,23 +194,15 @@ class ModelTable:
         outside = np.full(1 + 2 * k, np.nan)
         outside[0] = 0.0
         grid = _core.belief.RelativePoseGrid(np.array([-r, -r]), np.array([r, r]), nx, nx, nyaw, values, outside)
-        table = cls(grid, k, r)
-        table.best_relative_grasps(64)  # the planners' PSO seeds, found once with the table
-        return table
+        # the planners' PSO seeds: the nodes of highest P(S), best first
+        top = np.argpartition(-values[:, 0], N_BEST - 1)[:N_BEST]
+        return cls(grid, k, r, rel[top[np.argsort(-values[top, 0])]])
 
     def best_relative_grasps(self, k: int = 64) -> np.ndarray:
-        """The k grid nodes with the highest P(S) (k, 3), best first (computed once per table)."""
-        cached = getattr(self, "_best", None)
-        if cached is None or len(cached) < k:
-            r = self.xy_range
-            nx, ny, nyaw, _ = self.grid.shape
-            xs, ys, yaws = np.linspace(-r, r, nx), np.linspace(-r, r, ny), -np.pi + 2 * np.pi * np.arange(nyaw) / nyaw
-            X, Y, T = np.meshgrid(xs, ys, yaws, indexing="ij")
-            rel = np.column_stack([X.ravel(), Y.ravel(), T.ravel()])
-            ps = self.stability(rel)
-            top = np.argpartition(-ps, k - 1)[:k]
-            cached = self._best = rel[top[np.argsort(-ps[top])]]
-        return cached[:k]
+        """The k grid nodes with the highest P(S) (k, 3), best first (found when the table is built)."""
+        if not 1 <= k <= len(self.best):
+            raise ValueError(f"k: between 1 and {len(self.best)}, got {k}")
+        return self.best[:k]
 
     def stability(self, rel) -> np.ndarray:
         """P(S) at relative grasps (P, 3)."""

@@ -11,6 +11,7 @@ from __future__ import annotations
 import numpy as np
 
 from .base import Observation, Plan, Planner
+from .stability import StabilityPlanner
 
 
 class MLPosePlanner(Planner):
@@ -23,13 +24,8 @@ class MLPosePlanner(Planner):
                     evaluations=n)
 
 
-class OpenLoopPlanner(Planner):
+class OpenLoopPlanner(StabilityPlanner):
     method = "open_loop"
-
-    def _plan(self) -> Plan:
-        b = self.belief
-        a, v, n = self.maximise_stability(b.particles, b.weights)
-        return Plan(action=a, kind="stability", predicted_stability=v, objective=v, evaluations=n)
 
     def _update(self, obs: Observation) -> None:
         """No belief update: the measurement is recorded and ignored."""

@@ -7,16 +7,16 @@ settings): the experiments call it run by run, in any process.
 """
 from __future__ import annotations
 
-import os
 from pathlib import Path
 from typing import Optional, Sequence, Union
 
 import numpy as np
 
+from ..cache import cache_root
 from ..models import GraspModels, ModelSettings, build_models, relative_top_grasps
 from ..objects import ObjectModel, load_object
 from ..world import World
-from .base import Planner, PlannerSettings, wrap_angle
+from .base import Planner, PlannerSettings
 from .baselines import MLPosePlanner, OpenLoopPlanner
 from .exploration import ExplorationPlanner
 from .stability import StabilityPlanner
@@ -28,8 +28,6 @@ PLANNERS = {"stability": StabilityPlanner, "explore": ExplorationPlanner, "ml_po
 
 def default_cache_dir() -> Path:
     """Where models are cached: $BAYESGRASP_CACHE/models, else ~/.cache/bayesgrasp/models."""
-    from ..physics import cache_root
-
     return cache_root() / "models"
 
 
