@@ -10,7 +10,7 @@ export CMAKE_BUILD_PARALLEL_LEVEL ?= $(JOBS)
 # Debian packages the build needs (checked one by one; only missing ones are installed).
 DEB_PACKAGES := build-essential cmake pkg-config python3-dev python3-venv \
   libeigen3-dev libfcl-dev libbullet-dev libqhull-dev nlohmann-json3-dev liblbfgspp-dev \
-  libpcl-dev libgtest-dev libbenchmark-dev
+  libpcl-dev libgtest-dev libbenchmark-dev libopenblas-openmp-dev
 
 SOURCES := $(shell find cpp python tests/cpp bench -type f \( -name '*.cpp' -o -name '*.hpp' -o -name '*.h' -o -name '*.py' -o -name '*.json' \) 2>/dev/null) \
            CMakeLists.txt pyproject.toml

@@ -5,6 +5,7 @@
 #include <Eigen/LU>
 
 #include <cmath>
+#include <limits>
 #include <random>
 
 #include "bayesgrasp/gp/gp.hpp"
@@ -168,6 +169,24 @@ TEST(GPGradient, FitcMatchesFiniteDifferencesIncludingInducingInputs) {
     SparseGP gp(o);
     gp.fit(X, Y);
     ASSERT_EQ(gp.parameters().size(), 3 + 2 + 2 + 12 * 3);
+    check_gradient(gp, gp.parameters(), 1e-5);
+  }
+}
+
+TEST(GPGradient, FitcMatchesFiniteDifferencesFixedInducingFarFromTheOrigin) {
+  // Fixed inducing inputs take the lengthscale-only gradient contraction (expanded around the
+  // inputs' centre); inputs offset by 50 lengthscales, no normalisation, one and three outputs.
+  for (const int P : {1, 3}) {
+    Eigen::MatrixXd X, Y;
+    make_data(90, 3, P, 8 + P, X, Y);
+    X.array() += 50.0;
+    GPOptions o = fixed_options();
+    o.mean = MeanType::Constant;
+    o.lengthscale = Eigen::Vector3d(0.7, 1.4, 1.0);
+    o.n_inducing = 15;
+    SparseGP gp(o);
+    gp.fit(X, Y);
+    ASSERT_EQ(gp.parameters().size(), 3 + 2 + P);
     check_gradient(gp, gp.parameters(), 1e-5);
   }
 }
@@ -422,4 +441,38 @@ TEST(GPFitc, FusedVarianceNearZeroIsClampedNeverNaN) {
   ex.predict(X, me, ve);
   EXPECT_LT((ve - v.topRows(40)).cwiseAbs().maxCoeff(), 1e-5 * 1.3);
   EXPECT_LT((me - m.topRows(40)).cwiseAbs().maxCoeff(), 1e-4);
+}
+
+TEST(GPPredict, SingleOutputMeanKernelMatchesStdExpToAFewUlp) {
+  // One training point, zero mean: mean(x) = alpha * variance * exp(-d^2 / 2), d the scaled
+  // distance to it; the single-output mean path sums its own vectorised exp. Sweep d over
+  // [0, 40] (exp down to 1e-348, i.e. through the subnormal range to 0) at 2,001 inputs (not
+  // a multiple of the input group) and compare with std::exp, relative to exp's conditioning.
+  for (const int D : {1, 3}) {
+    GPOptions o = fixed_options();
+    o.lengthscale = Eigen::VectorXd::Constant(1, 0.7);
+    ExactGP gp(o);
+    Eigen::MatrixXd X = Eigen::MatrixXd::Zero(1, D), Y(1, 1);
+    Y << 2.0;
+    gp.fit(X, Y);
+    const double alpha = 2.0 / (1.3 + 0.05);
+    const int n = 2001;
+    Eigen::MatrixXd Xs = Eigen::MatrixXd::Zero(n, D);
+    for (int i = 0; i < n; ++i) Xs(i, 0) = 0.7 * 40.0 * i / (n - 1);
+    const Eigen::MatrixXd m = gp.predict_mean(Xs);
+    double worst = 0.0;
+    for (int i = 0; i < n; ++i) {
+      const double d = Xs(i, 0) / 0.7;
+      const double ref = alpha * 1.3 * std::exp(-0.5 * d * d);
+      ASSERT_TRUE(std::isfinite(m(i, 0)));
+      // exp's condition number is |x|: the exponent itself carries ~1 ulp * |x| of rounding
+      if (ref > 1e-300) worst = std::max(worst, std::abs(m(i, 0) - ref) / ref / (1.0 + 0.5 * d * d));
+      else EXPECT_LT(std::abs(m(i, 0)), 1e-290) << d;
+    }
+    EXPECT_LT(worst, 8 * std::numeric_limits<double>::epsilon()) << "D=" << D;
+    // the fused mean + variance path builds its kernel vectors with the same exp
+    Eigen::MatrixXd mv, vv;
+    gp.predict(Xs, mv, vv);
+    EXPECT_LT((mv - m).cwiseAbs().maxCoeff(), 1e-15);
+  }
 }

@@ -1,5 +1,7 @@
 #include "bayesgrasp/gp/gaussian_process.hpp"
 
+#include "bayesgrasp/gp/vector_exp.hpp"
+
 #include <Eigen/Cholesky>
 #include <LBFGSB.h>
 
@@ -9,9 +11,11 @@
 #include <limits>
 #include <stdexcept>
 
+
 namespace bayesgrasp::gp {
 
 namespace {
+using namespace detail;  // vector_exp.hpp: vd, kW, vload, vstore, vbroadcast, exp_nonpositive
 
 constexpr double kLog2Pi = 1.8378770664093453;
 constexpr int kBlock = 128;          // inputs per prediction block
@@ -58,78 +62,14 @@ void apply_factor(const Cache& c, const Eigen::MatrixXd& F, Eigen::MatrixXd& H) 
 // input (multiply-adds over the upper triangle), the same arithmetic as Eigen's TRMM but with
 // the reduction fused and no (n x M) matrices beyond the L1/L2-sized buffer.
 #if defined(__AVX512F__)
-constexpr int kW = 8, kNV = 3, kMR = 8;   // 24 accumulators of 32 zmm registers (3x8 measured
-                                          // fastest of 4x6, 2x8, 3x7, 3x9, 2x12 on Zen 4)
+constexpr int kNV = 3, kMR = 8;   // 24 accumulators of 32 zmm registers (3x8 measured
+                                  // fastest of 4x6, 2x8, 3x7, 3x9, 2x12 on Zen 4)
 #elif defined(__AVX__)
-constexpr int kW = 4, kNV = 3, kMR = 4;   // 12 of 16 ymm
+constexpr int kNV = 3, kMR = 4;   // 12 of 16 ymm
 #else
-constexpr int kW = 2, kNV = 3, kMR = 4;   // 12 of 16 xmm
+constexpr int kNV = 3, kMR = 4;   // 12 of 16 xmm
 #endif
 constexpr int kGroup = kW * kNV;
-typedef double vd __attribute__((vector_size(kW * sizeof(double))));
-
-inline vd vload(const double* p) {
-  vd v;
-  std::memcpy(&v, p, sizeof(vd));
-  return v;
-}
-inline void vstore(double* p, const vd& v) { std::memcpy(p, &v, sizeof(vd)); }
-inline vd vbroadcast(double x) {
-  vd v;
-  for (int l = 0; l < kW; ++l) v[l] = x;
-  return v;
-}
-
-// exp(x) for a vector of x <= 0, to ~1 ulp (x < -700, where exp(x) < 1e-304, gives 0): x =
-// (16 n' + j) ln2/16 + r with |r| <= ln2/32, exp(x) = 2^n' 2^(j/16) e^r, e^r by its Taylor
-// polynomial of degree 7 (truncation below 2e-18), 2^(j/16) from a 16-entry table.
-struct Exp2Table {
-  alignas(64) double t[16];
-  Exp2Table() {
-    for (int j = 0; j < 16; ++j) t[j] = std::exp2(j / 16.0);
-  }
-};
-const Exp2Table kExp2Table;
-typedef long long vi __attribute__((vector_size(kW * sizeof(double))));
-
-inline vd exp_nonpositive(vd x) {
-  constexpr double k16_ln2 = 23.083120654223414;            // 16 / ln 2
-  constexpr double ln2_16_hi = 6.93147180369123816490e-01 / 16;  // ln2 / 16 = hi + lo, hi with
-  constexpr double ln2_16_lo = 1.90821492927058770002e-10 / 16;  // trailing zero bits (n hi exact)
-  constexpr double shifter = 6755399441055744.0;             // 1.5 * 2^52
-  const vi tiny = x < vbroadcast(-700.0);
-  x = tiny ? vbroadcast(-700.0) : x;
-  const vd t = x * vbroadcast(k16_ln2) + vbroadcast(shifter);
-  const vd nd = t - vbroadcast(shifter);
-  const vd r = (x - nd * vbroadcast(ln2_16_hi)) - nd * vbroadcast(ln2_16_lo);
-  vd p = vbroadcast(1.0 / 5040.0);
-  p = p * r + vbroadcast(1.0 / 720.0);
-  p = p * r + vbroadcast(1.0 / 120.0);
-  p = p * r + vbroadcast(1.0 / 24.0);
-  p = p * r + vbroadcast(1.0 / 6.0);
-  p = p * r + vbroadcast(0.5);
-  p = p * r + vbroadcast(1.0);
-  p = p * r + vbroadcast(1.0);
-  vi n;
-  std::memcpy(&n, &t, sizeof(vi));
-  n -= 0x18000000000000LL;  // the shifter's mantissa bits: n = round(16 x / ln2)
-  const vi j = n & 15;
-  vd s;
-  if constexpr (kW == 8) {  // two-register permute (vpermt2pd) instead of a gather
-    vd t0, t1;
-    std::memcpy(&t0, kExp2Table.t, sizeof(vd));
-    std::memcpy(&t1, kExp2Table.t + 8, sizeof(vd));
-    s = __builtin_shuffle(t0, t1, j);
-  } else {
-    for (int l = 0; l < kW; ++l) s[l] = kExp2Table.t[j[l]];
-  }
-  vd y = p * s;
-  vi yb;
-  std::memcpy(&yb, &y, sizeof(vi));
-  yb += (n >> 4) << 52;  // times 2^floor(n / 16)
-  std::memcpy(&y, &yb, sizeof(vd));
-  return tiny ? vbroadcast(0.0) : y;
-}
 
 // Packed layout of an upper-triangular M x M factor G: tile t covers rows i0 = t*kMR ..
 // i0+kMR-1 (rows >= M are zero padding) and columns k = i0 .. M-1; entry (ii, k) sits at
@@ -193,6 +133,39 @@ void shape_group(const Cache& c, const Eigen::MatrixXd& X, Eigen::Index i0, int 
     const Eigen::ArrayXd s = (5.0 * a).sqrt();
     a = (1.0 + s + s.square() * (1.0 / 3.0)) * (-s).exp();
   }
+}
+
+// Mean of one output for a group, SE kernel, D <= 16: the kernel values are summed into the
+// mean as they are made, never stored (the M x kGroup buffer does not fit L1 at M = 200).
+// Returns false (nothing written) when the case is not covered.
+template <class Cache>
+bool mean_group_se(const Cache& c, const Eigen::MatrixXd& X, Eigen::Index i0, int n, const double* alpha,
+                   double* m) {
+  constexpr int kMaxD = 16;
+  const Eigen::Index M = c.basis.rows(), D = c.basis.cols();
+  if (c.type != KernelType::SquaredExponential || D > kMaxD) return false;
+  // inputs and basis scaled by sqrt(1/2): the accumulated -|b - x|^2 is the exponent itself
+  constexpr double kRootHalf = 0.70710678118654752440;
+  alignas(64) double xs[kMaxD][kGroup];
+  for (Eigen::Index d = 0; d < D; ++d)
+    for (int j = 0; j < kGroup; ++j) xs[d][j] = X(i0 + std::min(j, n - 1), d) * (c.inv_ls[d] * kRootHalf);
+  vd acc[kNV];
+  for (int v = 0; v < kNV; ++v) acc[v] = vbroadcast(0.0);
+  for (Eigen::Index k = 0; k < M; ++k) {
+    vd e[kNV];
+    for (int v = 0; v < kNV; ++v) e[v] = vbroadcast(0.0);
+    for (Eigen::Index d = 0; d < D; ++d) {
+      const vd b = vbroadcast(c.basis(k, d) * kRootHalf);
+      for (int v = 0; v < kNV; ++v) {
+        const vd t = b - vload(&xs[d][v * kW]);
+        e[v] -= t * t;
+      }
+    }
+    const vd a = vbroadcast(alpha[k]);
+    for (int v = 0; v < kNV; ++v) acc[v] += a * exp_nonpositive(e[v]);
+  }
+  for (int v = 0; v < kNV; ++v) vstore(m + v * kW, acc[v]);
+  return true;
 }
 
 // q[j] = |G f_j|^2 for the group's F, G packed by pack_upper.
@@ -515,19 +488,27 @@ Eigen::MatrixXd GaussianProcess::predict_mean(const Eigen::MatrixXd& X) const {
   check_inputs(X, "X");
   const Eigen::Index N = X.rows(), P = outputs_;
   Eigen::MatrixXd out(N, P);
-  const Eigen::Index nblocks = (N + kBlock - 1) / kBlock;
+  // Groups of kGroup inputs: kernel vectors in a small buffer (own vectorised exp), then the
+  // weighted sums in registers, as in the fused mean + variance path below.
+  const Eigen::Index M = cache_.basis.rows();
+  const Eigen::Index ngroups = (N + kGroup - 1) / kGroup;
 #pragma omp parallel num_threads(threads_for(N, opt_.threads))
   {
-    Eigen::MatrixXd F;
+    std::vector<double> F(static_cast<std::size_t>(M) * kGroup);
+    alignas(64) double m[kGroup];
 #pragma omp for schedule(static)
-    for (Eigen::Index b = 0; b < nblocks; ++b) {
-      const Eigen::Index i0 = b * kBlock, n = std::min<Eigen::Index>(kBlock, N - i0);
-      shape_block(cache_, X, i0, n, F);
-      if (P == 1)
-        out.col(0).segment(i0, n).noalias() = F.transpose() * cache_.alpha.col(0);
-      else
-        out.middleRows(i0, n).noalias() = F.transpose() * cache_.alpha;
-      out.middleRows(i0, n).rowwise() += cache_.offset;
+    for (Eigen::Index g = 0; g < ngroups; ++g) {
+      const Eigen::Index i0 = g * kGroup;
+      const int n = static_cast<int>(std::min<Eigen::Index>(kGroup, N - i0));
+      if (P == 1 && mean_group_se(cache_, X, i0, n, cache_.alpha.data(), m)) {
+        for (int j = 0; j < n; ++j) out(i0 + j, 0) = m[j] + cache_.offset[0];
+        continue;
+      }
+      shape_group(cache_, X, i0, n, F.data());
+      for (Eigen::Index p = 0; p < P; ++p) {
+        mean_group(cache_.alpha.col(p).data(), M, F.data(), m);
+        for (int j = 0; j < n; ++j) out(i0 + j, p) = m[j] + cache_.offset[p];
+      }
     }
   }
   return out;

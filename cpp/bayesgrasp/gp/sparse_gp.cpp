@@ -1,5 +1,8 @@
 #include "bayesgrasp/gp/sparse_gp.hpp"
 
+#include "bayesgrasp/gp/blas.hpp"
+#include "bayesgrasp/gp/vector_exp.hpp"
+
 #include <Eigen/Eigenvalues>
 #include <Eigen/QR>
 
@@ -13,9 +16,10 @@ constexpr double kLog2Pi = 1.8378770664093453;
 
 // One FITC evaluation. Notation: Kmn = k(Z, X) (M x N), L = chol(Kmm + jitter), V = L^-1 Kmn,
 // lam = diag(Knn - V^T V) + noise, A = I + V diag(1/lam) V^T = L^-1 B L^-T, LA = chol(A).
-// The O(N M^2) work: V (GEMM with the explicit M x M triangular inverse, 2 N M^2), A (SYRK,
-// N M^2), A^-1 V (GEMM, 2 N M^2), L^-T (dL/dV) (GEMM, 2 N M^2), V diag(w) V^T (N M^2): 8 N M^2
-// flops at GEMM speed; nothing N x N. The whitened form (A >= I) keeps lam and the
+// The O(N M^2) work, all BLAS level 3 (blas.hpp): V (TRMM with the explicit M x M triangular
+// inverse, N M^2), A (SYRK, N M^2), A^-1 V (GEMM, 2 N M^2), L^-T (dL/dV) (TRMM, N M^2),
+// V diag(w) V^T (two SYRKs over the columns of either sign of w, N M^2): 6 N M^2 flops;
+// nothing N x N. The whitened form (A >= I) keeps lam and the
 // gradient accurate when Kmm is ill-conditioned (a Kmm^-1 / B^-1 form with 6 N M^2 flops was
 // 25% faster but its noisy gradients stalled L-BFGS on the benchmark data).
 struct FitcEval {
@@ -43,6 +47,8 @@ FitcEval fitc_eval(const Eigen::MatrixXd& Xn, const Eigen::MatrixXd& Yn, const E
   thread_local FitcWork ws;
   Eigen::MatrixXd& Kmn = ws.Kmn;
   Kmn.resize(M, N);
+  Eigen::MatrixXd& V = ws.V;  // (M, N), L^-1 Kmn below; filled with Kmn in the same pass
+  V.resize(M, N);
   Eigen::MatrixXd& R2mn = ws.R2mn;
   if (!se && grad) R2mn.resize(M, N);
   for (Eigen::Index j = 0; j < N; ++j) {  // fused distance + kernel, column by column
@@ -51,11 +57,14 @@ FitcEval fitc_eval(const Eigen::MatrixXd& Xn, const Eigen::MatrixXd& Yn, const E
     for (Eigen::Index d = 1; d < D; ++d) col += (Zs.col(d).array() - Xs(j, d)).square();
     if (!se && grad) R2mn.col(j) = Kmn.col(j);
     if (se) {
-      col = var * (-0.5 * col).exp();
+      col *= -0.5;
+      detail::exp_nonpositive(col.data(), col.data(), M);
+      col *= var;
     } else {
       k.shape_inplace(Kmn.col(j));
       col *= var;
     }
+    V.col(j) = Kmn.col(j);
   }
   Eigen::MatrixXd R2mm = detail::sq_dist(Zs, Zs);
   Eigen::MatrixXd Kmm = R2mm;
@@ -70,30 +79,32 @@ FitcEval fitc_eval(const Eigen::MatrixXd& Xn, const Eigen::MatrixXd& Yn, const E
   // cond(L) = sqrt(cond(Kmm)) only): the M x N products below are then GEMMs.
   Eigen::MatrixXd Linv = Eigen::MatrixXd::Identity(M, M);
   Lt.solveInPlace(Linv);
-  Eigen::MatrixXd& V = ws.V;  // (M, N) = L^-1 Kmn
-  V.resize(M, N);
-  Linv.triangularView<Eigen::StrictlyUpper>().setZero();
-  V.noalias() = Linv * Kmn;  // dense GEMM: Eigen's TRMM runs at half its GEMM rate
-  // lam_i = k(x_i, x_i) - q_i + noise, floored so that a noise-free fit stays finite.
+  blas::trmm_left(true, false, Linv, V);  // V = L^-1 Kmn
+  // One pass over the columns of V: lam_j = k(x_j, x_j) - |v_j|^2 + noise (floored so that a
+  // noise-free fit stays finite), Vs = V Lambda^-1/2 for the SYRK, and V Lambda^-1 r.
   const double floor = std::max(1e-12 * var, 1e-300);
-  Eigen::ArrayXd lam = ((var - V.colwise().squaredNorm().array().transpose()).max(0.0) + noise).max(floor);
-  const Eigen::ArrayXd ilam = lam.inverse();
-
-  Eigen::MatrixXd A = Eigen::MatrixXd::Identity(M, M);
-  {
-    Eigen::MatrixXd& Vs = ws.S;
-    Vs.resize(M, N);
-    Vs.array() = V.array().rowwise() * ilam.sqrt().transpose();
-    A.selfadjointView<Eigen::Lower>().rankUpdate(Vs);
+  const Eigen::MatrixXd r = Yn.rowwise() - c.transpose();  // (N, P)
+  Eigen::ArrayXd lam(N), ilam(N);
+  Eigen::MatrixXd rl(N, P);                                 // Lambda^-1 r
+  Eigen::MatrixXd& Vs = ws.S;
+  Vs.resize(M, N);
+  Eigen::MatrixXd Vrl = Eigen::MatrixXd::Zero(M, P);        // V Lambda^-1 r
+  for (Eigen::Index j = 0; j < N; ++j) {
+    const auto v = V.col(j);
+    lam[j] = std::max(std::max(var - v.squaredNorm(), 0.0) + noise, floor);
+    ilam[j] = 1.0 / lam[j];
+    rl.row(j) = r.row(j) * ilam[j];
+    Vs.col(j) = std::sqrt(ilam[j]) * v;
+    for (Eigen::Index p = 0; p < P; ++p) Vrl.col(p) += rl(j, p) * v;
   }
+  Eigen::MatrixXd A = Eigen::MatrixXd::Identity(M, M);
+  blas::syrk_lower(1.0, Vs, 1.0, A);
   A.triangularView<Eigen::StrictlyUpper>() = A.transpose();
   e.LA = robust_cholesky(A, 0.0, 1.0, "SparseGP inner matrix");
   const Eigen::MatrixXd& LAc = e.LA;
   const auto LAt = LAc.triangularView<Eigen::Lower>();
 
-  const Eigen::MatrixXd r = Yn.rowwise() - c.transpose();          // (N, P)
-  const Eigen::MatrixXd rl = r.array().colwise() * ilam;           // Lambda^-1 r
-  e.beta.noalias() = V * rl;                                       // (M, P)
+  e.beta = Vrl;                                                    // (M, P)
   LAt.solveInPlace(e.beta);
   const double quad = (r.array() * rl.array()).sum() - e.beta.squaredNorm();
   const double logdet = lam.log().sum() + 2.0 * e.LA.diagonal().array().log().sum();
@@ -102,49 +113,55 @@ FitcEval fitc_eval(const Eigen::MatrixXd& Xn, const Eigen::MatrixXd& Yn, const E
 
   // alpha = C^-1 r = Lambda^-1 (r - V^T A^-1 V Lambda^-1 r)
   const Eigen::MatrixXd Ab = LAt.transpose().solve(e.beta);        // A^-1 V Lambda^-1 r (M, P)
-  Eigen::MatrixXd alpha = r;
-  alpha.noalias() -= V.transpose() * Ab;
-  alpha.array().colwise() *= ilam;
+  Eigen::MatrixXd alpha(N, P);  // filled column by column in the pass below
   // T = A^-1 V (explicit A^-1: one GEMM)
   Eigen::MatrixXd Ainv = Eigen::MatrixXd::Identity(M, M);
   LAt.solveInPlace(Ainv);
   LAt.transpose().solveInPlace(Ainv);
   Eigen::MatrixXd& T = ws.T;
   T.resize(M, N);
-  T.noalias() = Ainv * V;  // (M, N)
+  blas::gemm(false, false, 1.0, Ainv, V, 0.0, T);  // (M, N)
   // diag(C^-1)_i = 1/lam_i - v_i^T A^-1 v_i / lam_i^2 ; w_i = sum_p alpha_ip^2 - P diag(C^-1)_i
-  const Eigen::MatrixXd Va = V * alpha;  // (M, P)
+  // V alpha = V Lambda^-1 r - (V Lambda^-1 V^T) Ab = Vrl - (A - I) Ab: no pass over V
+  Eigen::MatrixXd Va = Vrl + Ab;
+  Va.noalias() -= A * Ab;  // (M, P)
   // One fused pass per column j: w_j from v_j^T A^-1 v_j, then
   // dL/dKmn (before L^-T) = V alpha alpha^T - P A^-1 V Lambda^-1 - V diag(w), built in T.
+  // The same pass gathers the columns of V scaled by sqrt(|w|) by the sign of w, for
+  // V diag(w) V^T = Vp Vp^T - Vn Vn^T below (two SYRKs, N M^2 flops together).
   Eigen::ArrayXd w(N);
-  const Eigen::MatrixXd alphaT = alpha.transpose();  // (P, N)
+  Eigen::MatrixXd& Vw = ws.S;
+  Eigen::Index np = 0, nn = N;
   for (Eigen::Index j = 0; j < N; ++j) {
     auto t = T.col(j);
     const auto v = V.col(j);
+    double a2 = 0.0;
+    for (Eigen::Index p = 0; p < P; ++p) {
+      const double a = (r(j, p) - v.dot(Ab.col(p))) * ilam[j];
+      alpha(j, p) = a;
+      a2 += a * a;
+    }
     const double vAv = v.dot(t);
-    const double wj = alphaT.col(j).squaredNorm() - double(P) * (ilam[j] - vAv * ilam[j] * ilam[j]);
+    const double wj = a2 - double(P) * (ilam[j] - vAv * ilam[j] * ilam[j]);
     w[j] = wj;
+    if (wj >= 0.0) Vw.col(np++) = std::sqrt(wj) * v;
+    else Vw.col(--nn) = std::sqrt(-wj) * v;
     t *= -double(P) * ilam[j];
     t -= wj * v;
-    for (Eigen::Index p = 0; p < P; ++p) t += alphaT(p, j) * Va.col(p);
+    for (Eigen::Index p = 0; p < P; ++p) t += alpha(j, p) * Va.col(p);
   }
   // dL/dKmm = -1/2 L^-T [ Va Va^T - P (I - A^-1) - V diag(w) V^T ] L^-1
   Eigen::MatrixXd inner = Va * Va.transpose();
   inner.noalias() += double(P) * Ainv;
   inner.diagonal().array() -= double(P);
   {
-    Eigen::MatrixXd& Vw = ws.S;
-    Vw.array() = V.array().rowwise() * w.transpose();
-    Eigen::MatrixXd VwV(M, M);
-    VwV.triangularView<Eigen::Lower>() = Vw * V.transpose();
+    Eigen::MatrixXd VwV = Eigen::MatrixXd::Zero(M, M);
+    blas::syrk_lower(1.0, Vw.leftCols(np), 0.0, VwV);
+    blas::syrk_lower(-1.0, Vw.rightCols(N - nn), 1.0, VwV);
     VwV.triangularView<Eigen::StrictlyUpper>() = VwV.transpose();
     inner -= VwV;
   }
-  {
-    Eigen::MatrixXd& S = ws.S;  // dL/dKmn = L^-T T
-    S.noalias() = Linv.transpose() * T;
-    T.swap(S);
-  }
+  blas::trmm_left(true, true, Linv, T);  // dL/dKmn = L^-T T
   Lt.transpose().solveInPlace(inner);
   Eigen::MatrixXd dKmm = Lt.transpose().solve(inner.transpose());  // L^-T inner L^-1 (symmetric)
   dKmm *= -0.5;
