@@ -12,6 +12,8 @@ void dsyrk_(const char* uplo, const char* trans, const int* n, const int* k, con
             const int* lda, const double* beta, double* c, const int* ldc);
 void dtrmm_(const char* side, const char* uplo, const char* transa, const char* diag, const int* m, const int* n,
             const double* alpha, const double* a, const int* lda, double* b, const int* ldb);
+void dtrsm_(const char* side, const char* uplo, const char* transa, const char* diag, const int* m, const int* n,
+            const double* alpha, const double* a, const int* lda, double* b, const int* ldb);
 }
 
 namespace bayesgrasp::gp::blas {
@@ -54,6 +56,15 @@ void trmm_left(bool lower, bool trans, const ConstMatRef& T, MatRef B) {
   const int lda = ld(T), ldb = ld(B);
   const double one = 1.0;
   dtrmm_("L", lower ? "L" : "U", trans ? "T" : "N", "N", &m, &n, &one, T.data(), &lda, B.data(), &ldb);
+}
+
+void trsm_left(bool lower, bool trans, const ConstMatRef& T, MatRef B) {
+  if (T.rows() != T.cols() || T.rows() != B.rows()) throw std::invalid_argument("blas::trsm_left: size mismatch");
+  if (B.rows() == 0 || B.cols() == 0) return;
+  const int m = as_int(B.rows(), "rows"), n = as_int(B.cols(), "cols");
+  const int lda = ld(T), ldb = ld(B);
+  const double one = 1.0;
+  dtrsm_("L", lower ? "L" : "U", trans ? "T" : "N", "N", &m, &n, &one, T.data(), &lda, B.data(), &ldb);
 }
 
 }  // namespace bayesgrasp::gp::blas

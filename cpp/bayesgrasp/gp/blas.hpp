@@ -26,4 +26,7 @@ void syrk_lower(double alpha, const ConstMatRef& A, double beta, MatRef C);
 /// only T's triangle is read.
 void trmm_left(bool lower, bool trans, const ConstMatRef& T, MatRef B);
 
+/// B = op(T)^-1 B in place (triangular solve with many right-hand sides), T as in trmm_left.
+void trsm_left(bool lower, bool trans, const ConstMatRef& T, MatRef B);
+
 }  // namespace bayesgrasp::gp::blas

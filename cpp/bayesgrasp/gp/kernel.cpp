@@ -57,7 +57,8 @@ Eigen::MatrixXd sq_dist(const Eigen::MatrixXd& As, const Eigen::MatrixXd& Bs) {
 }
 
 void contract_gradient(const Kernel& k, const Eigen::MatrixXd& As, const Eigen::MatrixXd& Bs,
-                       const Eigen::MatrixXd& R2, const Eigen::MatrixXd& K, const Eigen::MatrixXd& G,
+                       const Eigen::Ref<const Eigen::MatrixXd>& R2, const Eigen::Ref<const Eigen::MatrixXd>& K,
+                       const Eigen::Ref<const Eigen::MatrixXd>& G,
                        Eigen::VectorXd& g_logls, double* g_logvar, Eigen::MatrixXd* gA,
                        Eigen::MatrixXd* gB) {
   const Eigen::Index na = As.rows(), nb = Bs.rows(), D = As.cols();

@@ -53,7 +53,8 @@ Eigen::MatrixXd sq_dist(const Eigen::MatrixXd& As, const Eigen::MatrixXd& Bs);
 /// (with the variance). Adds dL/dlog_lengthscale to g_logls (D), dL/dlog_variance to *g_logvar
 /// and, if non-null, dL/dA to *gA (Na x D) and dL/dB to *gB (Nb x D), in unscaled coordinates.
 void contract_gradient(const Kernel& k, const Eigen::MatrixXd& As, const Eigen::MatrixXd& Bs,
-                       const Eigen::MatrixXd& R2, const Eigen::MatrixXd& K, const Eigen::MatrixXd& G,
+                       const Eigen::Ref<const Eigen::MatrixXd>& R2, const Eigen::Ref<const Eigen::MatrixXd>& K,
+                       const Eigen::Ref<const Eigen::MatrixXd>& G,
                        Eigen::VectorXd& g_logls, double* g_logvar, Eigen::MatrixXd* gA,
                        Eigen::MatrixXd* gB);
 }  // namespace detail

@@ -2,6 +2,7 @@
 
 #include "bayesgrasp/gp/blas.hpp"
 #include "bayesgrasp/gp/vector_exp.hpp"
+#include "bayesgrasp/gp/workspace.hpp"
 
 #include <Eigen/Eigenvalues>
 #include <Eigen/QR>
@@ -29,9 +30,9 @@ struct FitcEval {
   double jitter = 0.0;
 };
 
-// Per-thread workspace: the M x N matrices are reused between evaluations (no page faults).
+// Per-thread workspace: the M x N matrices are reused between evaluations (workspace.hpp).
 struct FitcWork {
-  Eigen::MatrixXd Kmn, R2mn, V, S, T;
+  detail::Workspace Kmn, R2mn, V, S, T;
 };
 
 FitcEval fitc_eval(const Eigen::MatrixXd& Xn, const Eigen::MatrixXd& Yn, const Eigen::MatrixXd& Zn, const Kernel& k,
@@ -45,12 +46,9 @@ FitcEval fitc_eval(const Eigen::MatrixXd& Xn, const Eigen::MatrixXd& Yn, const E
   const Eigen::MatrixXd Zs = Zn.array().rowwise() * inv_ls.array();
 
   thread_local FitcWork ws;
-  Eigen::MatrixXd& Kmn = ws.Kmn;
-  Kmn.resize(M, N);
-  Eigen::MatrixXd& V = ws.V;  // (M, N), L^-1 Kmn below; filled with Kmn in the same pass
-  V.resize(M, N);
-  Eigen::MatrixXd& R2mn = ws.R2mn;
-  if (!se && grad) R2mn.resize(M, N);
+  auto Kmn = ws.Kmn.matrix(M, N);
+  auto V = ws.V.matrix(M, N);  // (M, N), L^-1 Kmn below; filled with Kmn in the same pass
+  auto R2mn = ws.R2mn.matrix(!se && grad ? M : 0, !se && grad ? N : 0);
   for (Eigen::Index j = 0; j < N; ++j) {  // fused distance + kernel, column by column
     auto col = Kmn.col(j).array();
     col = (Zs.col(0).array() - Xs(j, 0)).square();
@@ -74,11 +72,10 @@ FitcEval fitc_eval(const Eigen::MatrixXd& Xn, const Eigen::MatrixXd& Yn, const E
   FitcEval e;
   e.L = robust_cholesky(Kmm, jitter0, var, "SparseGP K_mm", &e.jitter);
   const Eigen::MatrixXd& Lc = e.L;
-  const auto Lt = Lc.triangularView<Eigen::Lower>();
   // Explicit inverse of the M x M triangular factor (its forward error grows with
   // cond(L) = sqrt(cond(Kmm)) only): the M x N products below are then GEMMs.
   Eigen::MatrixXd Linv = Eigen::MatrixXd::Identity(M, M);
-  Lt.solveInPlace(Linv);
+  blas::trsm_left(true, false, Lc, Linv);
   blas::trmm_left(true, false, Linv, V);  // V = L^-1 Kmn
   // One pass over the columns of V: lam_j = k(x_j, x_j) - |v_j|^2 + noise (floored so that a
   // noise-free fit stays finite), Vs = V Lambda^-1/2 for the SYRK, and V Lambda^-1 r.
@@ -86,8 +83,7 @@ FitcEval fitc_eval(const Eigen::MatrixXd& Xn, const Eigen::MatrixXd& Yn, const E
   const Eigen::MatrixXd r = Yn.rowwise() - c.transpose();  // (N, P)
   Eigen::ArrayXd lam(N), ilam(N);
   Eigen::MatrixXd rl(N, P);                                 // Lambda^-1 r
-  Eigen::MatrixXd& Vs = ws.S;
-  Vs.resize(M, N);
+  auto Vs = ws.S.matrix(M, N);
   Eigen::MatrixXd Vrl = Eigen::MatrixXd::Zero(M, P);        // V Lambda^-1 r
   for (Eigen::Index j = 0; j < N; ++j) {
     const auto v = V.col(j);
@@ -116,10 +112,9 @@ FitcEval fitc_eval(const Eigen::MatrixXd& Xn, const Eigen::MatrixXd& Yn, const E
   Eigen::MatrixXd alpha(N, P);  // filled column by column in the pass below
   // T = A^-1 V (explicit A^-1: one GEMM)
   Eigen::MatrixXd Ainv = Eigen::MatrixXd::Identity(M, M);
-  LAt.solveInPlace(Ainv);
-  LAt.transpose().solveInPlace(Ainv);
-  Eigen::MatrixXd& T = ws.T;
-  T.resize(M, N);
+  blas::trsm_left(true, false, LAc, Ainv);
+  blas::trsm_left(true, true, LAc, Ainv);
+  auto T = ws.T.matrix(M, N);
   blas::gemm(false, false, 1.0, Ainv, V, 0.0, T);  // (M, N)
   // diag(C^-1)_i = 1/lam_i - v_i^T A^-1 v_i / lam_i^2 ; w_i = sum_p alpha_ip^2 - P diag(C^-1)_i
   // V alpha = V Lambda^-1 r - (V Lambda^-1 V^T) Ab = Vrl - (A - I) Ab: no pass over V
@@ -130,7 +125,7 @@ FitcEval fitc_eval(const Eigen::MatrixXd& Xn, const Eigen::MatrixXd& Yn, const E
   // The same pass gathers the columns of V scaled by sqrt(|w|) by the sign of w, for
   // V diag(w) V^T = Vp Vp^T - Vn Vn^T below (two SYRKs, N M^2 flops together).
   Eigen::ArrayXd w(N);
-  Eigen::MatrixXd& Vw = ws.S;
+  auto Vw = ws.S.matrix(M, N);
   Eigen::Index np = 0, nn = N;
   for (Eigen::Index j = 0; j < N; ++j) {
     auto t = T.col(j);
@@ -162,8 +157,10 @@ FitcEval fitc_eval(const Eigen::MatrixXd& Xn, const Eigen::MatrixXd& Yn, const E
     inner -= VwV;
   }
   blas::trmm_left(true, true, Linv, T);  // dL/dKmn = L^-T T
-  Lt.transpose().solveInPlace(inner);
-  Eigen::MatrixXd dKmm = Lt.transpose().solve(inner.transpose());  // L^-T inner L^-1 (symmetric)
+  blas::trsm_left(true, true, Lc, inner);
+  inner.transposeInPlace();
+  blas::trsm_left(true, true, Lc, inner);
+  Eigen::MatrixXd dKmm = std::move(inner);  // L^-T inner L^-1 (symmetric)
   dKmm *= -0.5;
   dKmm = 0.5 * (dKmm + dKmm.transpose()).eval();
 
