@@ -121,7 +121,9 @@ void bind_physics(py::module_& m) {
           [](LiftOptions& o, const std::string& s) { o.shape = shape_from(s); },
           "object collision shape: 'auto', 'hull', 'tetrahedra' or 'decomposition' (needs convex pieces)")
       .def_readwrite("tet_depth", &LiftOptions::tet_depth, "m, depth of the tetrahedra skin")
-      .def_readwrite("margin", &LiftOptions::margin, "m, collision margin");
+      .def_readwrite("margin", &LiftOptions::margin, "m, collision margin")
+      .def_readwrite("skip_separated_pairs", &LiftOptions::skip_separated_pairs,
+                     "skip Bullet's narrowphase for shape pairs proven apart (same results, faster)");
 
   py::class_<LiftTester>(m, "LiftTester", R"doc(Lift tests of one object with one hand (see ``lift_test``).
 

@@ -56,6 +56,13 @@
 //    decomposition ~tens of tests/s, tetrahedra ~0.5/s on a 512-triangle cup).
 // Collision margins are `margin` (0.5 mm) on every shape (Bullet's default 4 cm is meant for
 // metre-sized bodies).
+// Speed. Bullet runs a GJK query at every step for every pair of child shapes (a hand link's
+// capsule or box, one convex piece of the object) whose bounding boxes overlap; with a finger
+// inside a mug that is most of the 7 x 24 pairs, nearly all of them apart. With
+// `skip_separated_pairs` a pair found apart keeps a separating axis and a lower bound on its
+// separation that is updated from the two shapes' motion; while the bound exceeds the
+// contact-breaking distance and the pair has no contact point, Bullet's query (which would
+// add no point) is skipped. Same results, 2-2.5x faster on the built-in mugs and pitcher.
 //
 // Thread safety: LiftTester is immutable after construction; each run builds its own Bullet
 // world, so run() may be called from many threads at once.
@@ -94,6 +101,10 @@ struct LiftOptions {
   Shape shape = Shape::Auto;
   double tet_depth = 0.01;  // m, for Shape::Tetrahedra
   double margin = 5e-4;     // m, collision margin
+  // Skip Bullet's narrowphase query for a hand shape and an object piece that a
+  // conservative bound proves apart (see the note on speed above); the simulation is the
+  // same with or without (tests/cpp/test_physics.cpp checks equal results), only faster.
+  bool skip_separated_pairs = true;
 };
 
 struct LiftResult {
@@ -106,6 +117,7 @@ struct LiftResult {
   bool tetrahedra = false;    // the object used the tetrahedra shape
   LiftOptions::Shape shape = LiftOptions::Shape::ConvexHull;  // the shape used (never Auto)
   int steps = 0;
+  long skipped_queries = 0;  // narrowphase queries skipped (LiftOptions::skip_separated_pairs)
 };
 
 class LiftTester {
