@@ -1,4 +1,4 @@
-// Lift tests per second on one core (Bullet, default options: 1/720 s steps, 1.15 s script).
+// Lift tests per second on one core (Bullet, default options: 1/480 s steps, 1.15 s script).
 //  * BoxHeld:  an 8 x 5 x 12 cm box (hull shape) held by three fingertips - full script.
 //  * BoxOpen:  the same box, open hand - the box stays on the table, early exit.
 //  * CupHeld:  a concave cup (outer radius 4 cm, wall 4 mm, 10 cm tall, 64 segments,

@@ -101,7 +101,7 @@ void bind_physics(py::module_& m) {
       .def_readwrite("mu", &LiftOptions::mu, "friction coefficient hand-object")
       .def_readwrite("table_mu", &LiftOptions::table_mu, "friction coefficient object-table")
       .def_readwrite("density", &LiftOptions::density, "object density, kg/m^3 (mass from the mesh)")
-      .def_readwrite("time_step", &LiftOptions::time_step, "fixed time step, s (default 1/720)")
+      .def_readwrite("time_step", &LiftOptions::time_step, "fixed time step, s (default 1/480)")
       .def_readwrite("solver_iterations", &LiftOptions::solver_iterations)
       .def_readwrite("squeeze_time", &LiftOptions::squeeze_time, "s, palm still while the fingers tighten")
       .def_readwrite("lift_height", &LiftOptions::lift_height, "m the palm rises (default 0.1)")

