@@ -191,6 +191,63 @@ TEST(GPGradient, FitcMatchesFiniteDifferencesFixedInducingFarFromTheOrigin) {
   }
 }
 
+TEST(GPGradient, ProfiledScaleObjectiveMatchesFiniteDifferencesAndTheFullObjective) {
+  // theta_p = [log lengthscales, log(noise / variance), mean]; the profiled objective equals
+  // the full objective at the returned scale and is its minimum over the scale.
+  for (const int P : {1, 3}) {
+    Eigen::MatrixXd X, Y;
+    make_data(90, 3, P, 21 + P, X, Y);
+    GPOptions o = fixed_options();
+    o.mean = P == 1 ? MeanType::Constant : MeanType::Zero;
+    o.n_inducing = 15;
+    SparseGP gp(o);
+    gp.fit(X, Y);
+    ASSERT_TRUE(gp.supports_profile());
+    const int nc = P == 1 ? 1 : 0;
+    Eigen::VectorXd tp(3 + 1 + nc);
+    tp << std::log(0.7), std::log(1.3), std::log(1.0), std::log(0.04);
+    if (nc) tp[4] = 0.2;
+    Eigen::VectorXd g, gd;
+    double ls = 0.0;
+    const double f0 = gp.profiled_objective(tp, g, &ls);
+    ASSERT_TRUE(std::isfinite(f0));
+    for (Eigen::Index i = 0; i < tp.size(); ++i) {
+      const double h = 1e-5 * std::max(1.0, std::abs(tp[i]));
+      Eigen::VectorXd a = tp, b = tp;
+      a[i] += h;
+      b[i] -= h;
+      const double fd = (gp.profiled_objective(a, gd, nullptr) - gp.profiled_objective(b, gd, nullptr)) / (2 * h);
+      EXPECT_NEAR(g[i], fd, 1e-5 * std::max(1.0, std::abs(fd))) << "P=" << P << " parameter " << i;
+    }
+    Eigen::VectorXd th(3 + 2 + nc), gf;
+    th << tp.head(3), ls, tp[3] + ls, tp.tail(nc);
+    EXPECT_NEAR(gp.objective(th, gf), f0, 1e-9 * std::abs(f0));
+    for (const double dls : {-0.3, 0.3}) {  // any other scale is worse
+      Eigen::VectorXd t2 = th;
+      t2[3] += dls;
+      t2[4] += dls;
+      EXPECT_GT(gp.objective(t2, gf), f0);
+    }
+  }
+}
+
+TEST(GPFit, ProfiledScaleFitReachesTheSameOptimum) {
+  Eigen::MatrixXd X, Y;
+  make_data(150, 2, 1, 33, X, Y);
+  GPOptions o;
+  o.n_inducing = 20;
+  o.lengthscale = Eigen::VectorXd::Constant(1, 1.0);
+  o.variance = 1.0;
+  o.noise = 1.0;
+  SparseGP full_gp([&] { GPOptions a = o; a.profile_scale = false; return a; }());
+  SparseGP prof_gp(o);
+  full_gp.fit(X, Y);
+  prof_gp.fit(X, Y);
+  EXPECT_NEAR(prof_gp.log_marginal_likelihood(), full_gp.log_marginal_likelihood(),
+              1e-5 * std::abs(full_gp.log_marginal_likelihood()));
+  EXPECT_NEAR(prof_gp.kernel().variance(), full_gp.kernel().variance(), 1e-2 * full_gp.kernel().variance());
+}
+
 TEST(GPFit, OptimisationIncreasesLikelihoodAndRecoversNoise) {
   Eigen::MatrixXd X, Y;
   make_data(300, 2, 1, 7, X, Y, 0.1);

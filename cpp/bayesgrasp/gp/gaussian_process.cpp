@@ -419,7 +419,20 @@ Eigen::VectorXd GaussianProcess::optimise(int n_extra) {
   lb[D + 1] = std::log(1e-9 * yv);
   ub[D + 1] = std::log(1e2 * yv);
   x = x.cwiseMax(lb).cwiseMin(ub);
-  (void)n_extra;
+  // Profiled scale (GPOptions::profile_scale): drop the log variance; the log noise entry
+  // becomes log(noise / variance), bounded by the box above.
+  const bool prof = opt_.profile_scale && n_extra == 0 && supports_profile();
+  const Eigen::VectorXd lb_full = lb, ub_full = ub;
+  if (prof) {
+    auto drop = [&](const Eigen::VectorXd& v, double ratio_entry) {
+      Eigen::VectorXd out(v.size() - 1);
+      out << v.head(D), ratio_entry, v.tail(v.size() - D - 2);
+      return out;
+    };
+    x = drop(x, x[D + 1] - x[D]);
+    lb = drop(lb, lb_full[D + 1] - ub_full[D]);
+    ub = drop(ub, ub_full[D + 1] - lb_full[D]);
+  }
 
   LBFGSpp::LBFGSBParam<double> param;
   param.m = 10;
@@ -433,15 +446,17 @@ Eigen::VectorXd GaussianProcess::optimise(int n_extra) {
 
   struct Fn {
     const GaussianProcess* self;
+    bool prof = false;
     int evals = 0;
     double best_f = std::numeric_limits<double>::infinity();
     Eigen::VectorXd best_x;
+    double best_log_scale = 0.0;
     std::string last_error;
     double operator()(const Eigen::VectorXd& t, Eigen::VectorXd& g) {
       ++evals;
-      double f;
+      double f, ls = 0.0;
       try {
-        f = self->objective(t, g);
+        f = prof ? self->profiled_objective(t, g, &ls) : self->objective(t, g);
       } catch (const std::runtime_error& e) {
         last_error = e.what();
         g.setZero();
@@ -454,10 +469,11 @@ Eigen::VectorXd GaussianProcess::optimise(int n_extra) {
       if (f < best_f) {
         best_f = f;
         best_x = t;
+        best_log_scale = ls;
       }
       return f;
     }
-  } fn{this, 0, std::numeric_limits<double>::infinity(), Eigen::VectorXd(), std::string()};
+  } fn{this, prof, 0, std::numeric_limits<double>::infinity(), Eigen::VectorXd(), 0.0, std::string()};
   double fx = 0.0;
   info_ = FitInfo{};
   try {
@@ -470,10 +486,19 @@ Eigen::VectorXd GaussianProcess::optimise(int n_extra) {
   if (fn.best_x.size() == 0)
     throw std::runtime_error("fit: the log marginal likelihood could not be evaluated at the initial "
                              "hyper-parameters (" + fn.last_error + ")");
+  if (prof) {  // back to [log lengthscales, log variance, log noise, ...]
+    const Eigen::VectorXd t = fn.best_x;
+    fn.best_x.resize(t.size() + 1);
+    fn.best_x << t.head(D), fn.best_log_scale, t[D] + fn.best_log_scale, t.tail(t.size() - D - 1);
+  }
   Eigen::VectorXd c;
   unpack(fn.best_x, kernel_, noise_, c, nullptr);
   mean_c_ = c;
   return fn.best_x;
+}
+
+double GaussianProcess::profiled_objective(const Eigen::VectorXd&, Eigen::VectorXd&, double*) const {
+  throw std::logic_error("profiled_objective: not supported by this model");
 }
 
 void GaussianProcess::pack_factor() {

@@ -55,6 +55,11 @@ struct GPOptions {
   // SparseGP only
   int n_inducing = 200;          ///< M (capped at the number of distinct training inputs)
   bool optimize_inducing = false;
+  /// SparseGP: optimise with the signal variance profiled out. The FITC covariance scales
+  /// with (variance, noise) together, so for fixed lengthscales and noise/variance ratio the
+  /// best overall scale is quad / (N P) in closed form; L-BFGS then searches one dimension
+  /// fewer (the same optimum; 19 vs 36 evaluations with SciPy's L-BFGS-B on bench_gp's data).
+  bool profile_scale = true;
   std::uint64_t seed = 0;        ///< k-means++ seed for the inducing inputs
   Eigen::MatrixXd inducing;      ///< (M, D) initial inducing inputs in input units; empty = k-means++
   int kmeans_iter = 10;          ///< Lloyd iterations after k-means++ seeding
@@ -125,6 +130,12 @@ class GaussianProcess {
   /// Negative log marginal likelihood at theta and its analytic gradient (for the current
   /// training data), without changing the model.
   virtual double objective(const Eigen::VectorXd& theta, Eigen::VectorXd& grad) const = 0;
+  /// The objective with the signal variance profiled out (see GPOptions::profile_scale):
+  /// theta_p = theta without the log variance, its log noise entry read as log(noise /
+  /// variance); the gradient is that of the profiled objective; *log_scale = the optimal
+  /// log variance. Models without it throw std::logic_error (supports_profile() is false).
+  virtual bool supports_profile() const { return false; }
+  virtual double profiled_objective(const Eigen::VectorXd& theta_p, Eigen::VectorXd& grad, double* log_scale) const;
 
  protected:
   // Scaled basis for the fused prediction kernels, in raw input coordinates:

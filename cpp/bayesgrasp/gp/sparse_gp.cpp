@@ -37,7 +37,7 @@ struct FitcWork {
 
 FitcEval fitc_eval(const Eigen::MatrixXd& Xn, const Eigen::MatrixXd& Yn, const Eigen::MatrixXd& Zn, const Kernel& k,
                    double noise, const Eigen::VectorXd& c, double jitter0, Eigen::VectorXd* grad,
-                   bool constant_mean, bool grad_Z) {
+                   bool constant_mean, bool grad_Z, double* profile_log_scale = nullptr) {
   const Eigen::Index N = Xn.rows(), P = Yn.cols(), D = Xn.cols(), M = Zn.rows();
   const double var = k.variance();
   const bool se = k.type == KernelType::SquaredExponential;
@@ -80,7 +80,7 @@ FitcEval fitc_eval(const Eigen::MatrixXd& Xn, const Eigen::MatrixXd& Yn, const E
   // One pass over the columns of V: lam_j = k(x_j, x_j) - |v_j|^2 + noise (floored so that a
   // noise-free fit stays finite), Vs = V Lambda^-1/2 for the SYRK, and V Lambda^-1 r.
   const double floor = std::max(1e-12 * var, 1e-300);
-  const Eigen::MatrixXd r = Yn.rowwise() - c.transpose();  // (N, P)
+  Eigen::MatrixXd r = Yn.rowwise() - c.transpose();  // (N, P)
   Eigen::ArrayXd lam(N), ilam(N);
   Eigen::MatrixXd rl(N, P);                                 // Lambda^-1 r
   auto Vs = ws.S.matrix(M, N);
@@ -105,6 +105,23 @@ FitcEval fitc_eval(const Eigen::MatrixXd& Xn, const Eigen::MatrixXd& Yn, const E
   const double quad = (r.array() * rl.array()).sum() - e.beta.squaredNorm();
   const double logdet = lam.log().sum() + 2.0 * e.LA.diagonal().array().log().sum();
   e.lml = -0.5 * quad - 0.5 * double(P) * logdet - 0.5 * double(N * P) * kLog2Pi;
+  double mean_grad_scale = 1.0;
+  if (profile_log_scale) {
+    // C = s C1 for the overall scale s (variance and noise together; the jitter and the
+    // noise floor scale with the variance too): the LML is -quad / (2 s) - N P log(s) / 2 + ...,
+    // maximal at s* = quad / (N P). The gradient of the profiled LML is the gradient at s*
+    // (envelope theorem): the data term alpha alpha^T / s* and the model term C1^-1, i.e. the
+    // formulas below with r scaled by 1 / sqrt(s*) (alpha, beta and V Lambda^-1 r are linear in r).
+    const double NP = double(N * P);
+    const double sstar = std::max(quad / NP, 1e-300);
+    *profile_log_scale = std::log(sstar);
+    e.lml = -0.5 * NP - 0.5 * double(P) * (logdet + double(N) * std::log(sstar)) - 0.5 * NP * kLog2Pi;
+    const double f = 1.0 / std::sqrt(sstar);
+    r *= f;
+    Vrl *= f;
+    e.beta *= f;
+    mean_grad_scale = f;  // d LML / d c = 1^T alpha_true = 1^T alpha_scaled / sqrt(s*)
+  }
   if (!grad) return e;
 
   // alpha = C^-1 r = Lambda^-1 (r - V^T A^-1 V Lambda^-1 r)
@@ -178,7 +195,7 @@ FitcEval fitc_eval(const Eigen::MatrixXd& Xn, const Eigen::MatrixXd& Yn, const E
   grad->head(D) = -gls;
   (*grad)[D] = -gvar;
   (*grad)[D + 1] = -0.5 * w.sum() * noise;
-  if (nc) grad->segment(D + 2, nc) = -alpha.colwise().sum().transpose();
+  if (nc) grad->segment(D + 2, nc) = -mean_grad_scale * alpha.colwise().sum().transpose();
   if (grad_Z) grad->tail(M * D) = -Eigen::Map<const Eigen::VectorXd>(gZ.data(), M * D);
   return e;
 }
@@ -204,6 +221,26 @@ double SparseGP::objective(const Eigen::VectorXd& theta, Eigen::VectorXd& grad) 
   const bool gz = theta.size() > dim_ + 2 + (opt_.mean == MeanType::Constant ? outputs_ : 0);
   if (gz && Z.rows() != Zn_.rows()) throw std::invalid_argument("theta: inducing block has the wrong size");
   const FitcEval e = fitc_eval(Xn_, Yn_, Z, k, noise, c, opt_.jitter, &grad, opt_.mean == MeanType::Constant, gz);
+  return -e.lml;
+}
+
+double SparseGP::profiled_objective(const Eigen::VectorXd& theta_p, Eigen::VectorXd& grad, double* log_scale) const {
+  if (Xn_.size() == 0) throw std::logic_error("objective: no training data; call fit() first");
+  const int D = dim_;
+  const int nc = opt_.mean == MeanType::Constant ? outputs_ : 0;
+  if (theta_p.size() != D + 1 + nc) throw std::invalid_argument("theta_p: expected D + 1 (+ P) entries");
+  Eigen::VectorXd theta(D + 2 + nc);
+  theta << theta_p.head(D), 0.0, theta_p.tail(1 + nc);  // log variance 0: the scale is profiled
+  Kernel k;
+  double noise;
+  Eigen::VectorXd c;
+  unpack(theta, k, noise, c, nullptr);
+  Eigen::VectorXd g;
+  double ls = 0.0;
+  const FitcEval e = fitc_eval(Xn_, Yn_, Zn_, k, noise, c, opt_.jitter, &g, nc > 0, false, &ls);
+  grad.resize(theta_p.size());
+  grad << g.head(D), g.tail(1 + nc);  // drop d/dlog variance (zero at the profiled scale)
+  if (log_scale) *log_scale = ls;
   return -e.lml;
 }
 

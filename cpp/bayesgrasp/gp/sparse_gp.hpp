@@ -15,6 +15,8 @@ class SparseGP : public GaussianProcess {
   void fit(const Eigen::MatrixXd& X, const Eigen::MatrixXd& Y) override;
   double objective(const Eigen::VectorXd& theta, Eigen::VectorXd& grad) const override;
   Eigen::VectorXd parameters() const override;
+  bool supports_profile() const override { return true; }
+  double profiled_objective(const Eigen::VectorXd& theta_p, Eigen::VectorXd& grad, double* log_scale) const override;
 
   /// Inducing inputs (M, D) in input units.
   Eigen::MatrixXd inducing_inputs() const;

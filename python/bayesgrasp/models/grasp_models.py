@@ -32,7 +32,7 @@ from .. import gp as _gp
 from ..objects import ObjectModel, load_object
 from ..world import World
 
-CACHE_VERSION = 5  # bump when the simulator or the models change what a key means
+CACHE_VERSION = 6  # bump when the simulator or the models change what a key means
 
 #: Grid nodes of highest P(S) a ModelTable keeps (the planners' PSO seeds).
 N_BEST = 64
