@@ -34,17 +34,23 @@ Intrinsics intrinsics(int width, int height, double fx, double fy, double cx, do
   return K;
 }
 
+// Item i of a Python list of 2-tuples, or a ValueError naming it ("name: expected a (what) tuple").
+py::tuple pair_at(const py::list& list, std::size_t i, const std::string& name, const char* what) {
+  py::tuple t;
+  try {
+    t = list[i].cast<py::tuple>();
+  } catch (const py::cast_error&) {
+    throw py::value_error(name + ": expected a (" + what + ") tuple");
+  }
+  if (t.size() != 2) throw py::value_error(name + ": expected a (" + what + ") tuple");
+  return t;
+}
+
 std::vector<TriMesh> meshes_arg(const py::list& meshes) {
   std::vector<TriMesh> out;
   for (std::size_t i = 0; i < meshes.size(); ++i) {
     const std::string name = "meshes[" + std::to_string(i) + "]";
-    py::tuple t;
-    try {
-      t = meshes[i].cast<py::tuple>();
-    } catch (const py::cast_error&) {
-      throw py::value_error(name + ": expected a (vertices, faces) tuple");
-    }
-    if (t.size() != 2) throw py::value_error(name + ": expected a (vertices, faces) tuple");
+    const py::tuple t = pair_at(meshes, i, name, "vertices, faces");
     out.push_back(mesh(t[0].cast<DArray>(), t[1].cast<IArray>(), name.c_str()));
   }
   return out;
@@ -129,13 +135,7 @@ std::vector<ModelCloud> models_arg(const py::list& models, bool allow_empty = fa
   std::vector<ModelCloud> ms;
   for (std::size_t i = 0; i < models.size(); ++i) {
     const std::string name = "models[" + std::to_string(i) + "]";
-    py::tuple t;
-    try {
-      t = models[i].cast<py::tuple>();
-    } catch (const py::cast_error&) {
-      throw py::value_error(name + ": expected a (points, normals) tuple");
-    }
-    if (t.size() != 2) throw py::value_error(name + ": expected a (points, normals) tuple");
+    const py::tuple t = pair_at(models, i, name, "points, normals");
     ModelCloud mc;
     mc.surface.points = points_arg(t[0].cast<DArray>(), (name + " points").c_str(), false);
     mc.surface.normals = points_arg(t[1].cast<DArray>(), (name + " normals").c_str(), false);

@@ -49,22 +49,28 @@ void syrk_lower(double alpha, const ConstMatRef& A, double beta, MatRef C) {
   dsyrk_("L", "N", &n, &k, &alpha, A.data(), &lda, &beta, C.data(), &ldc);
 }
 
-void trmm_left(bool lower, bool trans, const ConstMatRef& T, MatRef B) {
-  if (T.rows() != T.cols() || T.rows() != B.rows()) throw std::invalid_argument("blas::trmm_left: size mismatch");
+namespace {
+// dtrmm_ and dtrsm_ share their signature: B = op(T) B or op(T)^-1 B, T on the left.
+using TriangularLeft = void (*)(const char*, const char*, const char*, const char*, const int*, const int*,
+                                const double*, const double*, const int*, double*, const int*);
+void triangular_left(TriangularLeft routine, const char* what, bool lower, bool trans, const ConstMatRef& T,
+                     MatRef B) {
+  if (T.rows() != T.cols() || T.rows() != B.rows())
+    throw std::invalid_argument(std::string("blas::") + what + ": size mismatch");
   if (B.rows() == 0 || B.cols() == 0) return;
   const int m = as_int(B.rows(), "rows"), n = as_int(B.cols(), "cols");
   const int lda = ld(T), ldb = ld(B);
   const double one = 1.0;
-  dtrmm_("L", lower ? "L" : "U", trans ? "T" : "N", "N", &m, &n, &one, T.data(), &lda, B.data(), &ldb);
+  routine("L", lower ? "L" : "U", trans ? "T" : "N", "N", &m, &n, &one, T.data(), &lda, B.data(), &ldb);
+}
+}  // namespace
+
+void trmm_left(bool lower, bool trans, const ConstMatRef& T, MatRef B) {
+  triangular_left(dtrmm_, "trmm_left", lower, trans, T, B);
 }
 
 void trsm_left(bool lower, bool trans, const ConstMatRef& T, MatRef B) {
-  if (T.rows() != T.cols() || T.rows() != B.rows()) throw std::invalid_argument("blas::trsm_left: size mismatch");
-  if (B.rows() == 0 || B.cols() == 0) return;
-  const int m = as_int(B.rows(), "rows"), n = as_int(B.cols(), "cols");
-  const int lda = ld(T), ldb = ld(B);
-  const double one = 1.0;
-  dtrsm_("L", lower ? "L" : "U", trans ? "T" : "N", "N", &m, &n, &one, T.data(), &lda, B.data(), &ldb);
+  triangular_left(dtrsm_, "trsm_left", lower, trans, T, B);
 }
 
 }  // namespace bayesgrasp::gp::blas

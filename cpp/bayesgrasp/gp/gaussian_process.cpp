@@ -11,7 +11,6 @@
 #include <limits>
 #include <stdexcept>
 
-
 namespace bayesgrasp::gp {
 
 namespace {

@@ -73,7 +73,7 @@ FitcEval fitc_eval(const Eigen::MatrixXd& Xn, const Eigen::MatrixXd& Yn, const E
   e.L = robust_cholesky(Kmm, jitter0, var, "SparseGP K_mm", &e.jitter);
   const Eigen::MatrixXd& Lc = e.L;
   // Explicit inverse of the M x M triangular factor (its forward error grows with
-  // cond(L) = sqrt(cond(Kmm)) only): the M x N products below are then GEMMs.
+  // cond(L) = sqrt(cond(Kmm)) only): the M x N products with it below are TRMMs.
   Eigen::MatrixXd Linv = Eigen::MatrixXd::Identity(M, M);
   blas::trsm_left(true, false, Lc, Linv);
   blas::trmm_left(true, false, Linv, V);  // V = L^-1 Kmn

@@ -411,13 +411,14 @@ class SeparatedPairSkip : public btCollisionAlgorithm {
   btVector3 n_a_{0, 0, 0}, m_{0, 0, 0};
 };
 
-// Owns every Bullet object of one lift test; destroyed in reverse order of creation.
+// Room in Bullet's algorithm pool for the SeparatedPairSkip wrappers.
 btDefaultCollisionConstructionInfo config_info() {
   btDefaultCollisionConstructionInfo ci;
   ci.m_customCollisionAlgorithmMaxElementSize = static_cast<int>(sizeof(SeparatedPairSkip));
   return ci;
 }
 
+// Owns every Bullet object of one lift test; destroyed in reverse order of creation.
 struct World {
   explicit World(bool skip_separated_pairs) : skip_funcs(skip_separated_pairs ? make_skip_funcs() : Funcs{}) {}
 
