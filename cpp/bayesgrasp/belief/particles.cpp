@@ -4,18 +4,12 @@
 #include <cmath>
 #include <limits>
 
+#include "bayesgrasp/common/interval.hpp"
+
 namespace bayesgrasp::belief {
 
 namespace {
 constexpr double kInf = std::numeric_limits<double>::infinity();
-
-double reflect(double x, double lo, double hi) {
-  const double w = hi - lo;
-  if (w <= 0.0) return lo;
-  double y = std::fmod(x - lo, 2.0 * w);
-  if (y < 0.0) y += 2.0 * w;
-  return lo + (y <= w ? y : 2.0 * w - y);
-}
 
 void check_log_likelihood(const Eigen::VectorXd& ll, Eigen::Index n, const char* what) {
   if (ll.size() != n)
@@ -324,7 +318,7 @@ void ParticleBelief::roughen(Rng& rng, double kk) {
   for (int i = 0; i < n; ++i)
     for (int k = 0; k < d; ++k) {
       const double y = X_(i, k) + sigma[k] * normal(rng);
-      X_(i, k) = space_.wrap(k) ? space_.wrap_value(k, y) : reflect(y, space_.low[k], space_.high[k]);
+      X_(i, k) = space_.wrap(k) ? space_.wrap_value(k, y) : reflect_into(y, space_.low[k], space_.high[k]);
     }
 }
 

@@ -2,20 +2,10 @@
 
 #include <cmath>
 
-#include "bayesgrasp/optim/random.hpp"
+#include "bayesgrasp/common/interval.hpp"
+#include "bayesgrasp/common/random.hpp"
 
 namespace bayesgrasp::optim {
-
-namespace {
-/// Reflects x into [lo, hi] (repeatedly, for far excursions).
-double reflect(double x, double lo, double hi) {
-  const double w = hi - lo;
-  if (w <= 0.0) return lo;
-  double y = std::fmod(x - lo, 2.0 * w);
-  if (y < 0.0) y += 2.0 * w;
-  return lo + (y <= w ? y : 2.0 * w - y);
-}
-}  // namespace
 
 Result simulated_annealing(const BatchObjective& fun, const Bounds& b, const AnnealingOptions& o) {
   validate_bounds(b);
@@ -66,7 +56,7 @@ Result simulated_annealing(const BatchObjective& fun, const Bounds& b, const Ann
   for (; it < o.max_iter && !(bf <= o.target); ++it) {
     for (int i = 0; i < n; ++i)
       for (int k = 0; k < d; ++k)
-        Y(i, k) = reflect(X(i, k) + step[i] * range[k] * normal(rng), b.low[k], b.high[k]);
+        Y(i, k) = reflect_into(X(i, k) + step[i] * range[k] * normal(rng), b.low[k], b.high[k]);
     eval(Y, fy);
     for (int i = 0; i < n; ++i) {
       const double u = uniform01(rng);  // drawn for every chain: the stream does not depend on f

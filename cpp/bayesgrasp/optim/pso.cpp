@@ -2,7 +2,7 @@
 
 #include <cmath>
 
-#include "bayesgrasp/optim/random.hpp"
+#include "bayesgrasp/common/random.hpp"
 
 namespace bayesgrasp::optim {
 
