@@ -20,7 +20,7 @@ import time
 import numpy as np
 
 from bayesgrasp.planners import ExplorationPlanner, PlannerSettings, StabilityPlanner, get_models
-from bayesgrasp.planners.loop import run_episode
+from bayesgrasp.experiments import EpisodeSettings, RunContext, run_episode
 
 OBJECTS = ("cube", "cylinder", "mug", "mug2", "pitcher")
 
@@ -74,8 +74,8 @@ def main():
             pose = np.array([rng.uniform(-0.08, 0.08), rng.uniform(-0.08, 0.08), rng.uniform(-np.pi, np.pi)])
             est = pose + rng.uniform(-1, 1, 3) * np.array([0.04, 0.04, np.radians(45)])
             # a failed first grasp from the real loop gives the second belief
-            ep = run_episode(obj, pose, method="stability", seed=r, attempts=1, estimate=est, models=models,
-                             lift=False, stop_when_stable=False)
+            ep = run_episode(obj, pose, EpisodeSettings(method="stability", attempts=1, stop_when_stable=False),
+                             RunContext(lift=False), seed=r, estimate=est, models=models)
             a0 = ep["attempts"][0]
             obs = (np.array(a0["action"]), np.array(a0["joint_angles"]), a0["stable"])
             for observe in (None, obs):

@@ -51,6 +51,7 @@ def test_grasp_relative_to_the_object_pose_is_invariant():
     (["plan", "--object", "cube", "--true-pose", "3,0,0"], "table"),
     (["plan", "--object", "cube", "--true-pose", "0,0,0", "--attempts", "0"], "--attempts"),
     (["experiment", "pub9"], "unknown experiment"),
+    (["plan", "--object", "cube", "--true-pose", "-1,0"], "--true-pose"),
     (["experiment", "pub2", "--runs", "0"], "--runs"),
     (["experiment", "pub2", "--workers", "0"], "--workers"),
     (["experiment", "pub2", "--objects", "no_such_thing"], "neither a built-in"),
@@ -97,3 +98,34 @@ def test_experiment_writes_tables_and_plots_and_resumes(tmp_path):
     assert "2/3" in err  # the progress bar starts at the stored runs
     again = json.loads((tmp_path / "e" / "summary.json").read_text())
     assert first["stability"]["runs"] == 2 and again["stability"]["runs"] == 3
+
+
+@pytest.mark.parametrize("argv, dest, expected", [
+    (["grasp", "--object", "cube", "--top", "-0.01,0,0"], "top", [-0.01, 0.0, 0.0]),
+    (["grasp", "--object", "cube", "--top", "0,0,0", "--object-pose", "-0.05,-0.02,-1.5"], "object_pose",
+     [-0.05, -0.02, -1.5]),
+    (["plan", "--object", "cube", "--true-pose", "-0.02,0.01,0.3"], "true_pose", [-0.02, 0.01, 0.3]),
+    (["plan", "--object", "cube", "--true-pose", "0,0,0", "--estimate", "-.5e-2,-0.01,-3"], "estimate",
+     [-0.005, -0.01, -3.0]),
+    (["register", "--scene-object", "mug/3", "--pose", "-0.05,0,1", "--models", "mug/0"], "pose", [-0.05, 0.0, 1.0]),
+])
+def test_comma_separated_options_take_negative_numbers(argv, dest, expected):
+    from bayesgrasp.cli import build_parser
+    from bayesgrasp.cli.args import floats, join_negative_values
+
+    args = build_parser().parse_args(join_negative_values(argv))
+    assert floats(getattr(args, dest), 3, dest) == pytest.approx(expected)
+
+
+def test_negative_top_grasp_runs_end_to_end():
+    code, out, err = run_cli("grasp", "--object", "cube", "--top", "-0.01,0,0", "--no-lift", "--json")
+    assert code == 0, err
+    assert json.loads(out)["top"] == [-0.01, 0.0, 0.0]
+
+
+def test_negative_lone_numbers_and_option_like_values_are_left_to_argparse():
+    from bayesgrasp.cli.args import join_negative_values
+
+    assert join_negative_values(["plan", "--seed", "-1"]) == ["plan", "--seed=-1"]
+    assert join_negative_values(["grasp", "--top", "--json"]) == ["grasp", "--top", "--json"]
+    assert join_negative_values(["grasp", "--top=-1,0,0"]) == ["grasp", "--top=-1,0,0"]

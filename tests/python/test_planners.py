@@ -7,8 +7,10 @@ import pytest
 
 from bayesgrasp import _core
 from bayesgrasp.belief import relative_planar_pose
-from bayesgrasp.planners import (ExplorationPlanner, PlannerSettings, StabilityPlanner, get_models, make_planner,
-                                 run_episode)
+from bayesgrasp.experiments import EpisodeSettings, RunContext, run_episode
+from bayesgrasp.planners import ExplorationPlanner, PlannerSettings, StabilityPlanner, get_models, make_planner
+
+NO_LIFT = RunContext(lift=False)
 
 Grid = _core.belief.RelativePoseGrid
 
@@ -84,14 +86,14 @@ def test_planner_interface_and_bad_input(cube):
     with pytest.raises(ValueError, match="n_particles"):
         PlannerSettings(n_particles=1)
     with pytest.raises(ValueError, match="attempts"):
-        run_episode("cube", (0, 0, 0), attempts=0, models=cube)
+        EpisodeSettings(attempts=0)
     with pytest.raises(ValueError):
         run_episode("cube", (5.0, 0, 0), models=cube)  # off the table
 
 
 def test_same_seed_same_episode(cube):
-    a = run_episode("cube", (0.03, -0.02, 0.7), method="explore", seed=5, models=cube, lift=False)
-    b = run_episode("cube", (0.03, -0.02, 0.7), method="explore", seed=5, models=cube, lift=False)
+    a = run_episode("cube", (0.03, -0.02, 0.7), EpisodeSettings(method="explore"), NO_LIFT, seed=5, models=cube)
+    b = run_episode("cube", (0.03, -0.02, 0.7), EpisodeSettings(method="explore"), NO_LIFT, seed=5, models=cube)
     def strip(r):  # wall times differ, nothing else may
         return json.dumps([{k: v for k, v in x.items() if k != "plan_seconds"} for x in r["attempts"]])
 
@@ -105,7 +107,7 @@ def test_success_rises_over_attempts_on_a_batch(cube):
     first, by_four = [], []
     for i in range(12):
         pose = (rng.uniform(-0.08, 0.08), rng.uniform(-0.08, 0.08), rng.uniform(-np.pi, np.pi))
-        r = run_episode("cube", pose, method="stability", seed=i, models=cube, lift=False)
+        r = run_episode("cube", pose, EpisodeSettings(method="stability"), NO_LIFT, seed=i, models=cube)
         first.append(r["attempts"][0]["stable"])
         by_four.append(r["success"])
     # (cumulative success cannot fall; it has to rise by a margin)
@@ -116,7 +118,7 @@ def test_success_rises_over_attempts_on_a_batch(cube):
 def test_informative_grasp_shrinks_the_pose_error_and_beats_a_random_grasp(cube):
     from bayesgrasp.experiments.pose_uncertainty import entropy_gain_run
 
-    r = [entropy_gain_run("cube", i, cache=None, models=cube) for i in range(6)]
+    r = [entropy_gain_run("cube", i, models=cube) for i in range(6)]
     # the pose error of the posterior mean after the informative grasp is below the prior's
     assert np.mean([x["error_after_informative"] for x in r]) < np.mean([x["error_before"] for x in r])
     # and its realised posterior entropy is below that of a random grasp from the same belief

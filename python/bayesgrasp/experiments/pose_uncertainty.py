@@ -2,8 +2,8 @@
 
 Each experiment is a set of runs; each run is a pure function of (experiment, object, run
 index, seed) that returns a JSON-ready dict, stored as soon as it finishes
-(:mod:`bayesgrasp.experiments.runner`); :func:`run` then writes the tables (Markdown and CSV) and
-the plots. Experiments:
+(:mod:`bayesgrasp.experiments.runner`); :mod:`.report` writes the tables (Markdown and CSV) and
+the plots. The experiments registered here:
 
 * ``pub2`` - stability maximisation (Pub. II): cube, cylinder, mug, mug2, pitcher; random true
   poses; up to 4 attempts; success rate, predicted stability, epsilon, pose error and entropy
@@ -22,43 +22,26 @@ True poses: x, y uniform in +-10 cm, yaw uniform; the same for every method at a
 """
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import replace
 from functools import partial
 from pathlib import Path
-from typing import Dict, Optional, Sequence
+from typing import List, Optional
 
 import numpy as np
 from scipy import stats
 
 from ..belief import relative_planar_pose, weight_entropy
 from ..models import relative_top_grasps
-from ..planners import PlannerSettings, get_models, make_planner, run_episode
+from ..planners import PlannerSettings, make_planner
 from ..world import World
-from .runner import ResultStore, run_experiment, run_seed
+from . import report
+from .context import RunContext
+from .episode import EpisodeSettings, run_episode
+from .registry import Experiment, register
+from .runner import run_seed
 
 FIVE = ("cube", "cylinder", "mug", "mug2", "pitcher")
 METHODS = ("stability", "explore", "ml_pose", "open_loop")
-
-
-@dataclass(frozen=True)
-class Experiment:
-    name: str
-    objects: Sequence[str]
-    runs: int
-    methods: Sequence[str] = ("stability",)
-    description: str = ""
-
-
-EXPERIMENTS: Dict[str, Experiment] = {
-    "pub2": Experiment("pub2", FIVE, 100, ("stability",), "stability maximisation (Pub. II)"),
-    "baselines": Experiment("baselines", FIVE, 30, METHODS, "all planners and the two baselines"),
-    "pub4": Experiment("pub4", ("cube", "mug", "cylinder"), 30, ("explore", "stability"),
-                       "exploration vs stability only, 4 grasps per run (Pub. IV)"),
-    "entropy_order": Experiment("entropy_order", ("cube", "mug"), 30, ("explore",),
-                                "predicted vs realised entropy order of three grasps (Fig. 3.6)"),
-    "landscapes": Experiment("landscapes", ("mug", "cube"), 3, ("explore",),
-                             "weight vs kernel entropy landscapes; 1,000 vs 10,000 samples"),
-}
 
 
 def true_pose(experiment: str, obj: str, run_index: int, base_seed: int = 0) -> np.ndarray:
@@ -73,36 +56,36 @@ def _strip(result: dict) -> dict:
 
 # ---- run functions (module level: sent to worker processes) ----------------------------------------
 def episode_run(experiment: str, obj: str, run_index: int, seed: int, *, base: str, method: str,
-                base_seed: int, stop_when_stable: bool, cache_dir: Optional[str], lift: bool) -> dict:
-    pose = true_pose(base, obj, run_index, base_seed)
-    r = run_episode(obj, pose, method=method, seed=run_seed(base_seed, base, obj, run_index), cache_dir=cache_dir,
-                    stop_when_stable=stop_when_stable, lift=lift)
-    return _strip(r)
+                stop_when_stable: bool, ctx: RunContext) -> dict:
+    """One closed-loop episode on the run's true pose (the same problem for every method)."""
+    pose = true_pose(base, obj, run_index, ctx.seed)
+    episode = EpisodeSettings(method=method, stop_when_stable=stop_when_stable)
+    return _strip(run_episode(obj, pose, episode, ctx, seed=run_seed(ctx.seed, base, obj, run_index)))
 
 
-def _initial_planner(name: str, obj: str, run_index: int, base_seed: int, seed: int, cache_dir, models=None,
+def _initial_planner(name: str, obj: str, run_index: int, ctx: RunContext, seed: int, models=None,
                      settings: Optional[PlannerSettings] = None):
     """A run's hidden true pose and an exploration planner on its initial belief (around a
     noisy estimate of that pose): (pose, models, planner, rng, settings); rng (seeded by
     ``seed``) has drawn the estimate and the planner's seed and serves the rest of the run."""
-    pose = true_pose(name, obj, run_index, base_seed)
-    models = models or get_models(obj, cache_dir=cache_dir)
+    pose = true_pose(name, obj, run_index, ctx.seed)
+    models = models or ctx.models(obj)
     rng = np.random.default_rng(seed)
     s = settings or PlannerSettings()
     est = pose + rng.uniform(-np.asarray(s.half_width), np.asarray(s.half_width))
     return pose, models, make_planner("explore", models, est, s, seed=int(rng.integers(2**31))), rng, s
 
 
-def entropy_order_run(experiment: str, obj: str, run_index: int, seed: int, *, base_seed: int,
-                      cache_dir: Optional[str], grid: int = 15) -> dict:
+def entropy_order_run(experiment: str, obj: str, run_index: int, seed: int, *, ctx: RunContext,
+                      grid: int = 15) -> dict:
     """Predict the expected entropy of a grid of grasps from the initial belief, execute the best,
     the median and the worst, and compare the realised weight entropies after reweighting."""
-    pose, models, planner, _, _ = _initial_planner("entropy_order", obj, run_index, base_seed, seed, cache_dir)
+    pose, models, planner, _, _ = _initial_planner("entropy_order", obj, run_index, ctx, seed)
     cands = _grid_actions(planner, grid, yaw=planner.belief.mean()[2])
     h, se = planner.expected_entropy(cands, n_samples=200, seed=1)
     order = np.argsort(h)
     picks = {"best": order[0], "good": order[len(order) // 2], "worst": order[-1]}
-    world = World.single(obj, pose=pose)
+    world = World.single(obj, pose=pose, hand=ctx.hand)
     out = {"true_pose": pose.tolist(), "predicted": {}, "realised": {}, "actions": {}, "grid": grid,
            "landscape": h.tolist(), "candidates": cands.tolist(), "particles": planner.belief.particles.tolist()}
     for name, i in picks.items():
@@ -129,14 +112,15 @@ def _reweighted(planner, models, world, pose, action):
     return weight_entropy(lw), float(np.hypot(*(w @ P[:, :2] - pose[:2])))
 
 
-def entropy_gain_run(obj: str, run_index: int, cache=None, models=None, base_seed: int = 0) -> dict:
+def entropy_gain_run(obj: str, run_index: int, ctx: Optional[RunContext] = None, models=None) -> dict:
     """From one initial belief: the planner's most informative grasp (Eq. 3.2) and a random grasp
     in the same search box, each executed at the true pose; realised posterior weight entropies
     and posterior-mean position errors (before: the prior's)."""
+    ctx = ctx or RunContext()
     pose, models, planner, rng, _ = _initial_planner(
-        "entropy_gain", obj, run_index, base_seed, run_seed(base_seed, "entropy_gain", obj, run_index), cache,
-        models, PlannerSettings(explore_stability_weight=0.0))  # Eq. 3.2 alone
-    world = World.single(obj, pose=pose)
+        "entropy_gain", obj, run_index, ctx, run_seed(ctx.seed, "entropy_gain", obj, run_index), models,
+        PlannerSettings(explore_stability_weight=0.0))  # Eq. 3.2 alone
+    world = World.single(obj, pose=pose, hand=ctx.hand)
     informative, _, _ = planner.minimise_entropy()
     low, high = planner.action_bounds()
     random_action = rng.uniform(low, high)
@@ -157,11 +141,11 @@ def _grid_actions(planner, n: int, yaw: float) -> np.ndarray:
     return np.column_stack([X.ravel(), Y.ravel(), np.full(X.size, yaw)])
 
 
-def landscapes_run(experiment: str, obj: str, run_index: int, seed: int, *, base_seed: int,
-                   cache_dir: Optional[str], grid: int = 21) -> dict:
+def landscapes_run(experiment: str, obj: str, run_index: int, seed: int, *, ctx: RunContext,
+                   grid: int = 21) -> dict:
     """Weight vs kernel expected-entropy landscapes over (x, y) at the belief's mean yaw; for the
     cube also the 1-D (x only) uncertainty case with 1,000 and 10,000 measurement samples."""
-    pose, models, planner, rng, s = _initial_planner("landscapes", obj, run_index, base_seed, seed, cache_dir)
+    pose, models, planner, rng, s = _initial_planner("landscapes", obj, run_index, ctx, seed)
     cands = _grid_actions(planner, grid, yaw=planner.belief.mean()[2])
     hw, _ = planner.expected_entropy(cands, n_samples=200, seed=3, method="weight")
     hk, _ = planner.expected_entropy(cands, n_samples=200, seed=3, method="kernel")
@@ -188,55 +172,43 @@ def landscapes_run(experiment: str, obj: str, run_index: int, seed: int, *, base
     return out
 
 
-# ---- driver -----------------------------------------------------------------------------------------
-def run(name: str, out_dir, runs: Optional[int] = None, workers: int = 1, base_seed: int = 0,
-        objects: Optional[Sequence[str]] = None, cache_dir=None, progress: bool = True, lift: bool = True) -> dict:
-    """Runs (or resumes) experiment ``name`` into ``out_dir`` and writes its tables and plots.
-    Returns the summary dict (also written as summary.json)."""
-    if name not in EXPERIMENTS:
-        raise ValueError(f"unknown experiment {name!r}; one of: {', '.join(EXPERIMENTS)}")
-    exp = EXPERIMENTS[name]
-    runs = exp.runs if runs is None else int(runs)
-    if runs < 1:
-        raise ValueError(f"runs: must be at least 1, got {runs}")
-    objects = list(exp.objects if objects is None else objects)
-    out = Path(out_dir)
-    cache = str(cache_dir) if cache_dir is not None else None
-    store = ResultStore(out / "results.sqlite")
-    # Models first, in this process (their disk cache is then shared by the workers).
-    for o in objects:
-        get_models(o, cache_dir=cache, progress=(lambda m: print(m, flush=True)) if progress else None)
-    results: Dict[str, list] = {}
-    try:
-        if name in ("pub2", "baselines", "pub4"):
-            for method in exp.methods:
-                fn = partial(episode_run, base=name, method=method, base_seed=base_seed,
-                             stop_when_stable=(name != "pub4"), cache_dir=cache, lift=lift)
-                results[method] = run_experiment(f"{name}/{method}", objects, runs, fn, store, base_seed, workers,
-                                                 progress)
-        elif name == "entropy_order":
-            fn = partial(entropy_order_run, base_seed=base_seed, cache_dir=cache)
-            results["explore"] = run_experiment(name, objects, runs, fn, store, base_seed, workers, progress)
-        else:
-            fn = partial(landscapes_run, base_seed=base_seed, cache_dir=cache)
-            results["explore"] = run_experiment(name, objects, runs, fn, store, base_seed, workers, progress)
-    finally:
-        store.close()
-    from . import report
+# ---- the registered experiments ---------------------------------------------------------------------
+def _episodes(exp: Experiment, method: str, ctx: RunContext):
+    fn = partial(episode_run, base=exp.name, method=method, stop_when_stable=(exp.name != "pub4"), ctx=ctx)
+    return f"{exp.name}/{method}", fn
 
-    summary = report.write(name, results, out)
-    if name in ("pub2", "pub4"):
-        # Figs. 3.3 / 3.5: the belief's evolution in run 0 of each object (re-run, it is pure).
-        method = exp.methods[0]
-        lines = []
-        for o in objects:
-            pose = true_pose(name, o, 0, base_seed)
-            r = run_episode(o, pose, method=method, seed=run_seed(base_seed, name, o, 0), cache_dir=cache,
-                            stop_when_stable=(name != "pub4"), lift=False, keep_planner=True)
-            p = report.plot_belief_evolution(r["snapshots"], pose, out / f"belief_{o}.png",
-                                             f"{o}, {method}, run 0: true pose {np.round(pose, 3).tolist()}",
-                                             r["attempts"])
-            lines.append(f"![{o}]({p.name})")
-        with open(out / "summary.md", "a") as f:
-            f.write("\n## Belief evolution (run 0)\n\n" + "\n\n".join(lines) + "\n")
-    return summary
+
+def _explore_runs(run_function):
+    def make(exp: Experiment, method: str, ctx: RunContext):
+        return exp.name, partial(run_function, ctx=ctx)
+    return make
+
+
+def belief_figures(exp: Experiment, objects: List[str], ctx: RunContext, out: Path) -> None:
+    """Figs. 3.3 / 3.5: the belief's evolution in run 0 of each object (re-run: it is pure)."""
+    method = exp.methods[0]
+    lines = []
+    for o in objects:
+        pose = true_pose(exp.name, o, 0, ctx.seed)
+        episode = EpisodeSettings(method=method, stop_when_stable=(exp.name != "pub4"))
+        r = run_episode(o, pose, episode, replace(ctx, lift=False),
+                        seed=run_seed(ctx.seed, exp.name, o, 0), keep_planner=True)
+        p = report.plot_belief_evolution(r["snapshots"], pose, out / f"belief_{o}.png",
+                                         f"{o}, {method}, run 0: true pose {np.round(pose, 3).tolist()}", r["attempts"])
+        lines.append(f"![{o}]({p.name})")
+    with open(out / "summary.md", "a") as f:
+        f.write("\n## Belief evolution (run 0)\n\n" + "\n\n".join(lines) + "\n")
+
+
+register(Experiment("pub2", FIVE, 100, "stability maximisation (Pub. II)", _episodes, report.write_episodes,
+                    ("stability",), belief_figures))
+register(Experiment("baselines", FIVE, 30, "all planners and the two baselines", _episodes, report.write_episodes,
+                    METHODS))
+register(Experiment("pub4", ("cube", "mug", "cylinder"), 30,
+                    "exploration vs stability only, 4 grasps per run (Pub. IV)", _episodes, report.write_episodes,
+                    ("explore", "stability"), belief_figures))
+register(Experiment("entropy_order", ("cube", "mug"), 30,
+                    "predicted vs realised entropy order of three grasps (Fig. 3.6)", _explore_runs(entropy_order_run),
+                    report.write_entropy_order, ("explore",)))
+register(Experiment("landscapes", ("mug", "cube"), 3, "weight vs kernel entropy landscapes; 1,000 vs 10,000 samples",
+                    _explore_runs(landscapes_run), report.write_landscapes, ("explore",)))

@@ -1,11 +1,13 @@
 """Planners for known objects under pose uncertainty (thesis §3.2-3.3), one module per method:
-:mod:`.stability` (Eq. 3.1), :mod:`.exploration` (Eq. 3.2), :mod:`.baselines`; the loop that
-runs them against the simulator is :mod:`.loop`."""
+:mod:`.stability` (Eq. 3.1), :mod:`.exploration` (Eq. 3.2), :mod:`.baselines`; :mod:`.registry`
+makes one by name. The closed loop that runs them against the simulator is
+:mod:`bayesgrasp.experiments.episode`."""
+from ..models import get_models
 from .base import Plan, Planner, PlannerSettings
 from .baselines import MLPosePlanner, OpenLoopPlanner
 from .exploration import ExplorationPlanner
-from .loop import PLANNERS, default_cache_dir, get_models, make_planner, run_episode
+from .registry import PLANNERS, make_planner
 from .stability import StabilityPlanner
 
 __all__ = ["Plan", "Planner", "PlannerSettings", "StabilityPlanner", "ExplorationPlanner", "MLPosePlanner",
-           "OpenLoopPlanner", "PLANNERS", "make_planner", "run_episode", "get_models", "default_cache_dir"]
+           "OpenLoopPlanner", "PLANNERS", "make_planner", "get_models"]

@@ -46,10 +46,8 @@ class PlannerSettings:
     explore_pso_iter: int = 12
     # The exploration search minimises E[H] - explore_stability_weight * P(S) (nats per unit of
     # belief-weighted stability): 0 is the thesis's pure entropy minimisation; a positive weight
-    # prefers, among about equally informative grasps, the ones that may also hold. On the 150
-    # problems of `experiment baselines` (lift off), success by attempt 1-4 was 0.16 / 0.71 / 0.92 /
-    # 0.95 with 0, 0.27 / 0.76 / 0.95 / 0.99 with 2 (stability only: 0.29 / 0.75 / 0.93 / 0.99), and
-    # the final KDE entropy -7.46 vs -7.02 nats (stability only -6.82).
+    # prefers, among about equally informative grasps, the ones that may also hold (the two are
+    # compared in BENCHMARKS.md, "Exploration's stability weight").
     explore_stability_weight: float = 2.0
     # Belief update.
     metropolis_steps: int = 10

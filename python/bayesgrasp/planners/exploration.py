@@ -5,9 +5,8 @@ Plan the maximally stable grasp first; if its expected stability is below
 the posterior, E_M[H(P(O | a, M))], estimated by drawing measurements from the GP measurement
 model at particles drawn by weight (Monte Carlo, common random numbers across candidates).
 By default the search minimises E[H] - 2 P(S) (``settings.explore_stability_weight``): among
-about equally informative grasps it takes one that may also hold, which on the baselines
-experiment keeps exploration's success at least the stability planner's from the second attempt
-on; a weight of 0 is the thesis's pure entropy minimisation.
+about equally informative grasps it takes one that may also hold; a weight of 0 is the thesis's
+pure entropy minimisation.
 
 Entropy estimates: "weight" - the thesis's weight-based estimate, -sum w log w of the posterior
 weights (fast, comparable only for the same particle positions, which is what planning needs);

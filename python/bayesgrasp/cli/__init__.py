@@ -1,0 +1,51 @@
+"""bayesgrasp command line: grasp planning under uncertainty.
+
+Sub-commands:
+  demo        the main job: plan, grasp, update the belief, re-plan, on a built-in mug
+  plan        the same loop for any object (built-in or mesh file) at a given true pose
+  experiment  the thesis's experiments (pub2, baselines, pub4, entropy_order, landscapes)
+  grasp       close the hand on an object at a top-grasp pose; quality and lift test
+  register    simulated depth view, table segmentation, registration against models
+  objects     list the built-in objects
+
+Comma-separated numbers may start with a minus sign: ``--top -0.01,0,0``.
+"""
+from __future__ import annotations
+
+import argparse
+import os
+import sys
+
+from . import experiment, grasp, objects, plan, register
+from .args import CliError, join_negative_values
+
+COMMANDS = (grasp, plan, experiment, register, objects)
+
+
+def build_parser() -> argparse.ArgumentParser:
+    parser = argparse.ArgumentParser(prog="bayesgrasp", description=__doc__,
+                                     formatter_class=argparse.RawDescriptionHelpFormatter)
+    sub = parser.add_subparsers(dest="command", metavar="COMMAND")
+    for command in COMMANDS:
+        command.add(sub)
+    return parser
+
+
+def main(argv=None) -> int:
+    parser = build_parser()
+    args = parser.parse_args(join_negative_values(sys.argv[1:] if argv is None else list(argv)))
+    if args.command is None:
+        parser.print_help()
+        return 0
+    try:
+        return args.run(args)
+    except (CliError, ValueError, FileNotFoundError) as e:
+        print(f"bayesgrasp {args.command}: error: {e}", file=sys.stderr)
+        return 2
+    except BrokenPipeError:  # output piped into e.g. `head`, which stopped reading
+        os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
+        return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,88 @@
+"""Argument helpers shared by the sub-commands: user errors, comma-separated numbers (negative ones
+included), output paths, and the run context built from the common options."""
+from __future__ import annotations
+
+import argparse
+import math
+import re
+from pathlib import Path
+from typing import List, Optional, Sequence
+
+
+class CliError(Exception):
+    """A user error: printed as one line, exit status 2."""
+
+
+# A value that argparse would take for an option because it starts with '-': a negative number or
+# a comma-separated list of numbers whose first one is negative ("-0.01,0,0", "-1e-3", "-.5,2").
+_NEGATIVE_VALUE = re.compile(r"^-(\d|\.\d|inf|nan)[^\s]*$", re.IGNORECASE)
+
+
+def join_negative_values(argv: Sequence[str]) -> List[str]:
+    """Rewrites ``--opt -0.01,0,0`` as ``--opt=-0.01,0,0`` so that argparse reads the value as the
+    option's argument instead of an unknown option (argparse only accepts lone negative numbers)."""
+    out: List[str] = []
+    i = 0
+    while i < len(argv):
+        a = argv[i]
+        if a.startswith("--") and "=" not in a and i + 1 < len(argv) and _NEGATIVE_VALUE.match(argv[i + 1]):
+            out.append(f"{a}={argv[i + 1]}")
+            i += 2
+        else:
+            out.append(a)
+            i += 1
+    return out
+
+
+def floats(text: str, n: int, what: str) -> List[float]:
+    """``n`` finite comma-separated numbers from ``text`` (``what`` names the option in errors)."""
+    try:
+        values = [float(v) for v in text.split(",")]
+    except ValueError:
+        raise CliError(f"{what}: expected {n} comma-separated numbers, got {text!r}") from None
+    if len(values) != n:
+        raise CliError(f"{what}: expected {n} comma-separated numbers, got {len(values)}")
+    if not all(math.isfinite(v) for v in values):
+        raise CliError(f"{what}: values must be finite, got {text!r}")
+    return values
+
+
+def out_dir(path: str, what: str = "--out") -> Path:
+    """Creates ``path`` if needed and checks it is writable."""
+    out = Path(path)
+    try:
+        out.mkdir(parents=True, exist_ok=True)
+        probe = out / ".write-test"
+        probe.write_text("")
+        probe.unlink()
+    except OSError as e:
+        raise CliError(f"{what}: cannot write to {out}: {e.strerror or e}") from None
+    return out
+
+
+def output_file(path: Optional[str], what: str) -> Optional[Path]:
+    """Checks that the directory of an output file is writable (before any long work)."""
+    if not path:
+        return None
+    out_dir(str(Path(path).parent or "."), what)
+    return Path(path)
+
+
+def add_context_options(p: argparse.ArgumentParser, lift: bool = False, seed: bool = True) -> None:
+    """The options every run context is built from: --hand, --cache (and --seed, --no-lift)."""
+    p.add_argument("--hand", default="barrett_bh8", help="hand file name or path")
+    p.add_argument("--cache", default=None, help="model cache directory (default: $BAYESGRASP_CACHE/models, "
+                                                 "$BAYESGRASP_CACHE defaulting to ~/.cache/bayesgrasp)")
+    if seed:
+        p.add_argument("--seed", type=int, default=0, help="seed")
+    if lift:
+        p.add_argument("--no-lift", action="store_true", help="skip the physical lift tests (faster)")
+
+
+def context(args: argparse.Namespace, progress: bool = True):
+    """The :class:`~bayesgrasp.experiments.context.RunContext` of a command, built once from its options."""
+    from ..experiments.context import RunContext, stderr_progress
+
+    return RunContext(hand=getattr(args, "hand", "barrett_bh8"), cache_dir=getattr(args, "cache", None),
+                      lift=not getattr(args, "no_lift", False), seed=getattr(args, "seed", 0),
+                      progress=stderr_progress if progress else None)

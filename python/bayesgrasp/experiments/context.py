@@ -1,0 +1,47 @@
+"""What a command, an experiment or an episode needs from its caller, built once at the edge (the
+CLI or the experiment driver) and passed down instead of threading each setting by hand."""
+from __future__ import annotations
+
+import sys
+from dataclasses import dataclass, field, replace
+from typing import Callable, Optional, Union
+
+from ..models import GraspModels, ModelSettings, get_models
+from ..objects import ObjectModel
+
+
+def stderr_progress(message: str) -> None:
+    """Progress messages go to stderr (stdout stays clean for --json)."""
+    print(message, file=sys.stderr, flush=True)
+
+
+@dataclass(frozen=True)
+class RunContext:
+    """hand: hand name or file; cache_dir: the model cache (None: $BAYESGRASP_CACHE/models);
+    lift: run the physical lift test; threads: C++ threads for batches (0 = all cores); seed: the
+    base seed; progress: a callable taking a message (None: silent; not sent to worker processes)."""
+
+    hand: str = "barrett_bh8"
+    cache_dir: Optional[str] = None
+    lift: bool = True
+    threads: int = 1
+    seed: int = 0
+    progress: Optional[Callable[[str], None]] = field(default=None, compare=False)
+
+    def __post_init__(self):
+        if self.threads < 0:
+            raise ValueError(f"threads: must be >= 0 (0 = all cores), got {self.threads}")
+        if self.cache_dir is not None:
+            object.__setattr__(self, "cache_dir", str(self.cache_dir))
+
+    def say(self, message: str) -> None:
+        if self.progress is not None:
+            self.progress(message)
+
+    def models(self, obj: Union[str, ObjectModel], settings: Optional[ModelSettings] = None) -> GraspModels:
+        """The object's grasp models for this context's hand and cache (memoised per process)."""
+        return get_models(obj, self.hand, settings, cache_dir=self.cache_dir, progress=self.progress)
+
+    def for_workers(self) -> "RunContext":
+        """The same context without the progress callable (worker processes get it pickled)."""
+        return replace(self, progress=None)

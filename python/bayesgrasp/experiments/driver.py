@@ -1,0 +1,43 @@
+"""Running an experiment: build each object's models once, run every (method, object, run) not
+yet stored, write the report. Any registered experiment (:mod:`.registry`) runs this way."""
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Dict, Optional, Sequence
+
+from .context import RunContext
+from .registry import get_experiment
+from .runner import ResultStore, run_experiment
+
+
+def run(name: str, out_dir, ctx: Optional[RunContext] = None, runs: Optional[int] = None, workers: int = 1,
+        objects: Optional[Sequence[str]] = None) -> dict:
+    """Runs (or resumes) experiment ``name`` into ``out_dir`` and writes its tables and plots.
+    Returns the summary dict (also written as summary.json). Progress (model building, the
+    progress bar) is shown when ``ctx.progress`` is set."""
+    exp = get_experiment(name)
+    ctx = ctx or RunContext()
+    runs = exp.runs if runs is None else int(runs)
+    if runs < 1:
+        raise ValueError(f"runs: must be at least 1, got {runs}")
+    if workers < 1:
+        raise ValueError(f"workers: must be at least 1, got {workers}")
+    objects = list(exp.objects if objects is None else objects)
+    out = Path(out_dir)
+    # Models first, in this process (their disk cache is then shared by the workers).
+    for o in objects:
+        ctx.models(o)
+    store = ResultStore(out / "results.sqlite")
+    results: Dict[str, list] = {}
+    worker_ctx = ctx.for_workers()
+    try:
+        for method in exp.methods:
+            series, fn = exp.make_run(exp, method, worker_ctx)
+            results[method] = run_experiment(series, objects, runs, fn, store, ctx.seed, workers,
+                                             progress=ctx.progress is not None)
+    finally:
+        store.close()
+    summary = exp.report(exp, results, out)
+    if exp.finish is not None:
+        exp.finish(exp, objects, ctx, out)
+    return summary

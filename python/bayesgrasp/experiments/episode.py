@@ -1,0 +1,158 @@
+"""The closed loop of thesis Figs. 3.1 and 3.4: plan, execute at the hidden true pose in the
+simulator, read the joint angles, update the belief, re-plan, until the grasp is stable or the
+attempts run out.
+
+:func:`run_episode` is a pure function of its arguments (object, true pose, episode settings,
+context, seed): the experiments call it run by run, in any process. One attempt is four named
+steps: :func:`plan` is the planner's, then :func:`execute` (the grasp at the true pose, scored),
+:func:`read_fingers` (the measured joint angles) and the planner's ``observe``.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import Callable, Optional, Sequence, Union
+
+import numpy as np
+
+from ..models import GraspModels, ModelSettings, relative_top_grasps
+from ..objects import ObjectModel, load_object
+from ..planners import Planner, PlannerSettings, make_planner
+from ..world import World
+from .context import RunContext
+
+
+@dataclass(frozen=True)
+class EpisodeSettings:
+    """method: a planner name (see :data:`bayesgrasp.planners.PLANNERS`); attempts: grasps at most;
+    measurement_noise: std (rad) of Gaussian noise on the measured joint angles; stop_when_stable:
+    stop at the first stable grasp (False: every attempt is made, the thesis's fixed number of
+    grasps, and the belief is updated after stable grasps too)."""
+
+    method: str = "explore"
+    attempts: int = 4
+    measurement_noise: float = 0.0
+    stop_when_stable: bool = True
+    planner: PlannerSettings = field(default_factory=PlannerSettings)
+    models: ModelSettings = field(default_factory=ModelSettings)
+
+    def __post_init__(self):
+        if self.attempts < 1:
+            raise ValueError(f"attempts: must be at least 1, got {self.attempts}")
+        if not (np.isfinite(self.measurement_noise) and self.measurement_noise >= 0):
+            raise ValueError(f"measurement_noise: must be >= 0, got {self.measurement_noise}")
+
+
+@dataclass
+class Execution:
+    """One executed grasp: where it was relative to the object, how it scored, what the fingers read."""
+
+    relative_grasp: np.ndarray
+    epsilon: float
+    stable: bool
+    lifted: Optional[bool]
+    collision_at_start: bool
+    joint_angles: np.ndarray
+
+
+def initial_estimate(true_pose: np.ndarray, settings: PlannerSettings, rng: np.random.Generator) -> np.ndarray:
+    """The "vision" estimate: the true pose plus noise uniform within the belief's half-widths, so
+    that the true pose lies inside the initial belief."""
+    hw = np.asarray(settings.half_width, dtype=float)
+    return true_pose + rng.uniform(-hw, hw)
+
+
+def execute(world: World, models: GraspModels, action: np.ndarray, true_pose: np.ndarray, lift: bool) -> Execution:
+    """The world top grasp ``action`` executed on the object at its true pose: stable = epsilon
+    above the models' eps_stable; the lift test (when ``lift``) on stable grasps."""
+    rel = relative_top_grasps(action, true_pose)[0, 0]
+    g = world.grasp_batch(rel[None, :], spread=models.spread)
+    eps = float(g["epsilon"][0])
+    stable = eps > models.settings.eps_stable
+    lifted = None
+    if lift and stable:
+        lifted = bool(world.grasp_batch(rel[None, :], spread=models.spread, lift=True)["lifted"][0])
+    return Execution(rel, eps, bool(stable), lifted, bool(g["collision_at_start"][0]),
+                     np.asarray(g["joint_angles"][0], dtype=float))
+
+
+def read_fingers(execution: Execution, models: GraspModels, noise: float, rng: np.random.Generator) -> np.ndarray:
+    """The measurement M: the modelled joint angles, plus Gaussian noise of std ``noise`` rad."""
+    q = execution.joint_angles[models.joint_index]
+    if noise > 0:
+        q = q + rng.normal(0.0, noise, q.shape)
+    return q
+
+
+def _attempt_record(k: int, plan, ex: Execution, q: np.ndarray, before: dict) -> dict:
+    return {"attempt": k + 1, "kind": plan.kind, "action": plan.action.tolist(),
+            "relative_grasp": ex.relative_grasp.tolist(), "predicted_stability": float(plan.predicted_stability),
+            "objective": float(plan.objective), "expected_entropy": plan.expected_entropy,
+            "plan_seconds": plan.seconds, "evaluations": plan.evaluations, "epsilon": ex.epsilon,
+            "force_closure": ex.epsilon > 0.0, "stable": ex.stable, "lifted": ex.lifted,
+            "collision_at_start": ex.collision_at_start, "joint_angles": q.tolist(), "belief_before": before}
+
+
+def _check_pose(true_pose) -> np.ndarray:
+    p = np.asarray(true_pose, dtype=float).ravel()
+    if p.shape != (3,) or not np.all(np.isfinite(p)):
+        raise ValueError(f"true pose: expected three finite numbers (x, y, yaw), got {p}")
+    return p
+
+
+def run_episode(obj: Union[str, ObjectModel], true_pose: Sequence[float], episode: Optional[EpisodeSettings] = None,
+                ctx: Optional[RunContext] = None, seed: int = 0, estimate: Optional[Sequence[float]] = None,
+                models: Optional[GraspModels] = None, keep_planner: bool = False,
+                on_attempt: Optional[Callable[[dict], None]] = None) -> dict:
+    """One run of the loop on ``obj`` whose hidden true pose is ``true_pose`` (x, y, yaw).
+
+    The estimate defaults to :func:`initial_estimate`. Returns a JSON-ready dict: success,
+    attempts (one dict per attempt), the initial and final belief summaries; with ``keep_planner``
+    also "planner" (the Planner object, not JSON) and "snapshots" (the particles and weights
+    before each attempt and at the end).
+    """
+    episode = episode or EpisodeSettings()
+    ctx = ctx or RunContext()
+    obj_model = load_object(obj) if isinstance(obj, str) else obj
+    true_pose = _check_pose(true_pose)
+    world = World.single(obj_model, pose=true_pose, hand=ctx.hand)  # raises if off the table
+    models = models or ctx.models(obj if isinstance(obj, str) else obj_model, episode.models)
+    rng = np.random.default_rng(seed)
+    estimate = initial_estimate(true_pose, episode.planner, rng) if estimate is None else estimate
+    estimate = np.asarray(estimate, dtype=float)
+    planner = make_planner(episode.method, models, estimate, episode.planner, seed=int(rng.integers(2**31)))
+    initial = planner.summary(true_pose)
+    snapshots, attempts = [], []
+    for k in range(episode.attempts):
+        before = planner.summary(true_pose)
+        if keep_planner:
+            snapshots.append((planner.belief.particles, planner.belief.weights))
+        plan = planner.plan()
+        ex = execute(world, models, plan.action, true_pose, ctx.lift)
+        q = read_fingers(ex, models, episode.measurement_noise, rng)
+        rec = _attempt_record(k, plan, ex, q, before)
+        stop = ex.stable and episode.stop_when_stable
+        if not stop:
+            planner.observe(plan.action, q, stable=ex.stable)
+            rec["belief_after"] = planner.summary(true_pose)
+        attempts.append(rec)
+        if on_attempt is not None:
+            on_attempt(rec)
+        if stop:
+            break
+    return _episode_result(obj_model.name, episode.method, true_pose, estimate, seed, attempts, initial,
+                           planner, true_pose, snapshots if keep_planner else None)
+
+
+def _episode_result(name: str, method: str, true_pose, estimate, seed: int, attempts: list, initial: dict,
+                    planner: Planner, truth, snapshots: Optional[list]) -> dict:
+    result = {"object": name, "method": method, "true_pose": true_pose.tolist(),
+              "estimate": np.asarray(estimate).tolist(), "seed": int(seed),
+              "success": any(a["stable"] for a in attempts),
+              "first_success": next((a["attempt"] for a in attempts if a["stable"]), None),
+              "lifted": any(a["lifted"] for a in attempts if a["lifted"] is not None),
+              "attempts": attempts, "initial_belief": initial, "final_belief": planner.summary(truth)}
+    if snapshots is not None:
+        result["planner"] = planner
+        snapshots.append((planner.belief.particles, planner.belief.weights))
+        result["snapshots"] = snapshots
+    return result

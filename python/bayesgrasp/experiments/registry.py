@@ -1,0 +1,55 @@
+"""The experiments by name. Each module of experiments registers its own (see
+:mod:`.pose_uncertainty`; the package imports every such module); the driver (:mod:`.driver`)
+runs any of them the same way."""
+from __future__ import annotations
+
+from dataclasses import dataclass
+from pathlib import Path
+from typing import TYPE_CHECKING, Callable, Dict, List, Optional, Sequence
+
+if TYPE_CHECKING:
+    from .context import RunContext
+
+#: (experiment, object, run index, seed) -> a JSON-ready dict; module level (sent to workers).
+RunFunction = Callable[[str, str, int, int], dict]
+
+
+@dataclass(frozen=True)
+class Experiment:
+    """name, objects and runs per object by default, the methods compared (one stored series per
+    method), a one-line description, and three functions:
+
+    * ``make_run(experiment, method, ctx)`` -> (series key in the result store, RunFunction);
+    * ``report(experiment, results, out)`` -> summary dict; ``results`` maps method -> [(RunKey, dict)];
+      writes summary.md, summary.json, tables and plots into ``out``;
+    * ``finish(experiment, objects, ctx, out)`` (optional): extra figures after the report.
+    """
+
+    name: str
+    objects: Sequence[str]
+    runs: int
+    description: str
+    make_run: Callable[["Experiment", str, "RunContext"], tuple]
+    report: Callable[["Experiment", Dict[str, list], Path], dict]
+    methods: Sequence[str] = ("stability",)
+    finish: Optional[Callable[["Experiment", List[str], "RunContext", Path], None]] = None
+
+
+EXPERIMENTS: Dict[str, Experiment] = {}
+
+
+def register(experiment: Experiment) -> Experiment:
+    if experiment.name in EXPERIMENTS:
+        raise ValueError(f"experiment {experiment.name!r} is registered twice")
+    EXPERIMENTS[experiment.name] = experiment
+    return experiment
+
+
+def get_experiment(name: str) -> Experiment:
+    if name not in EXPERIMENTS:
+        raise ValueError(f"unknown experiment {name!r}; one of: {', '.join(EXPERIMENTS)}")
+    return EXPERIMENTS[name]
+
+
+def experiment_names() -> List[str]:
+    return list(EXPERIMENTS)

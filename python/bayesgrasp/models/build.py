@@ -1,0 +1,149 @@
+"""Building the grasp models of an object: simulate, fit, calibrate, cache.
+
+Models are cached on disk under a key made of the object's mesh, the hand file and the settings
+(:func:`cache_key`); they are rebuilt only when one of those changes. :func:`get_models` adds a
+per-process memo, so a worker builds or loads each object's models once.
+"""
+from __future__ import annotations
+
+import hashlib
+import json
+from dataclasses import asdict
+from pathlib import Path
+from typing import Callable, Optional, Union
+
+import numpy as np
+
+from .. import gp as _gp
+from ..cache import cache_root
+from ..objects import ObjectModel, load_object
+from ..world import World
+from .grasp_models import DEFAULT_CALIBRATION, GraspModels, features
+from .settings import CACHE_VERSION, ModelSettings
+from .training import choose_spread, fit_calibration, simulate_training_data
+
+Say = Callable[[str], None]
+
+
+def default_cache_dir() -> Path:
+    """Where models are cached: $BAYESGRASP_CACHE/models, else ~/.cache/bayesgrasp/models."""
+    return cache_root() / "models"
+
+
+def cache_key(obj: ObjectModel, hand_text: str, settings: ModelSettings) -> str:
+    """The models' identity: cache version, the object's mesh, the hand file and the settings."""
+    h = hashlib.sha256()
+    h.update(f"v{CACHE_VERSION}".encode())
+    h.update(np.ascontiguousarray(obj.vertices, dtype=np.float64).tobytes())
+    h.update(np.ascontiguousarray(obj.faces, dtype=np.int64).tobytes())
+    h.update(hand_text.encode())
+    h.update(json.dumps(asdict(settings), sort_keys=True).encode())
+    return h.hexdigest()[:20]
+
+
+class _CacheFiles:
+    """The three files of one cache entry: the two GPs and the info JSON."""
+
+    def __init__(self, cache_dir, key: str):
+        d = Path(cache_dir)
+        self.measurement, self.stability, self.info = (d / f"{key}_measurement.npz", d / f"{key}_stability.npz",
+                                                       d / f"{key}.json")
+
+    def complete(self) -> bool:
+        return self.measurement.exists() and self.stability.exists() and self.info.exists()
+
+    def load(self, settings: ModelSettings) -> GraspModels:
+        info = json.loads(self.info.read_text())
+        models = GraspModels(_gp.load(self.measurement), _gp.load(self.stability), settings, info["joint_index"], info)
+        models.loaded_from_cache = True
+        return models
+
+    def save(self, models: GraspModels) -> None:
+        try:
+            self.measurement.parent.mkdir(parents=True, exist_ok=True)
+            models.measurement.save(self.measurement)
+            models.stability.save(self.stability)
+            self.info.write_text(json.dumps(models.info, indent=1))
+        except OSError as e:
+            raise ValueError(f"cache_dir: cannot write models to {self.info.parent}: {e}") from e
+
+
+def _fit(X, Y, settings: ModelSettings, n: int) -> _gp.SparseGP:
+    return _gp.SparseGP(n_inducing=min(settings.n_inducing, n), max_iter=settings.max_iter, seed=settings.seed,
+                        noise=1e-2).fit(X, Y)
+
+
+def _calibrate(models: GraspModels, world: World, settings: ModelSettings, spread: float, say: Say) -> tuple:
+    """The logistic calibration of P(S) on held-out simulated grasps (the probit-like default
+    when there are too few)."""
+    if settings.n_calibration <= 0:
+        return DEFAULT_CALIBRATION
+    say(f"models for {world.object.name}: calibrating P(S) on {settings.n_calibration} held-out grasps")
+    rel_c, _, eps_c = simulate_training_data(world, settings, seed_offset=1, n=settings.n_calibration, spread=spread)
+    if len(rel_c) < 10:
+        return DEFAULT_CALIBRATION
+    return fit_calibration(models.stability_z(rel_c), eps_c > settings.eps_stable)
+
+
+def _train(world: World, settings: ModelSettings, key: str, say: Say) -> GraspModels:
+    """Spread pilot (when the spread is not given), training grasps, the two FITC fits, calibration."""
+    name = world.object.name
+    spread, pilot = settings.spread, None
+    if spread is None:
+        say(f"models for {name}: choosing the finger spread (pilot of {settings.n_pilot} grasps per spread)")
+        spread, pilot = choose_spread(world, settings, say)
+    say(f"models for {name}: simulating {settings.n_samples} grasps at spread {np.degrees(spread):.0f} deg")
+    rel, q, eps = simulate_training_data(world, settings, spread=spread)
+    if len(rel) < 10:
+        raise ValueError(f"{name}: only {len(rel)} collision-free grasps in the sampled range")
+    joint_index = np.arange(1, q.shape[1])     # every phalanx joint (the spread is fixed)
+    X = features(rel)
+    say(f"models for {name}: fitting FITC GPs on {len(rel)} grasps")
+    measurement = _fit(X, q[:, joint_index], settings, len(rel))
+    stability = _fit(X, np.maximum(eps, 0.0), settings, len(rel))
+    models = GraspModels(measurement, stability, settings, joint_index, {"spread": float(spread)})
+    calibration = _calibrate(models, world, settings, spread, say)
+    models.info = {"key": key, "object": name, "calibration": list(calibration), "hand": world.hand.name,
+                   "settings": asdict(settings), "samples": int(len(rel)),
+                   "force_closure_fraction": float(np.mean(eps > 0)),
+                   "stable_fraction": float(np.mean(eps > settings.eps_stable)),
+                   "joint_index": joint_index.tolist(), "spread": float(spread), "spread_pilot": pilot}
+    return models
+
+
+def build_models(obj: Union[str, ObjectModel], hand="barrett_bh8", settings: Optional[ModelSettings] = None,
+                 cache_dir: Union[str, Path, None] = None, progress: Optional[Say] = None) -> GraspModels:
+    """Fits (or loads from ``cache_dir``) the measurement and stability models of ``obj``.
+
+    ``progress`` is an optional callable taking a message string. The result's
+    ``loaded_from_cache`` says whether it came from the cache.
+    """
+    settings = settings or ModelSettings()
+    obj = load_object(obj) if isinstance(obj, str) else obj
+    world = World.single(obj, pose=(0.0, 0.0, 0.0), hand=hand)
+    hand_text = Path(world.hand.path).read_text() if getattr(world.hand, "path", None) else world.hand.name
+    key = cache_key(world.object, hand_text, settings)
+    say = progress or (lambda msg: None)
+    files = None if cache_dir is None else _CacheFiles(cache_dir, key)
+    if files is not None and files.complete():
+        say(f"models for {obj.name}: loaded from cache ({key})")
+        return files.load(settings)
+    models = _train(world, settings, key, say)
+    if files is not None:
+        files.save(models)
+    return models
+
+
+_MODELS: dict = {}
+
+
+def get_models(obj: Union[str, ObjectModel], hand: str = "barrett_bh8", settings: Optional[ModelSettings] = None,
+               cache_dir=None, progress: Optional[Say] = None) -> GraspModels:
+    """build_models with a per-process memo (a worker builds or loads each object's models once);
+    ``cache_dir`` None means :func:`default_cache_dir`."""
+    settings = settings or ModelSettings()
+    cache_dir = default_cache_dir() if cache_dir is None else cache_dir
+    key = (obj if isinstance(obj, str) else id(obj), hand, settings, str(cache_dir))
+    if key not in _MODELS:
+        _MODELS[key] = build_models(obj, hand, settings, cache_dir=cache_dir, progress=progress)
+    return _MODELS[key]

@@ -1,0 +1,50 @@
+"""How the grasp models of an object are built: :class:`ModelSettings` (every field is part of
+the model cache key) and the constants of the model builder."""
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Optional
+
+import numpy as np
+
+#: Bumped when the simulator or the models change what a cache key means.
+CACHE_VERSION = 6
+
+#: Grid nodes of highest P(S) a ModelTable keeps (the planners' PSO seeds).
+N_BEST = 64
+
+#: Candidate finger spreads (rad) when ModelSettings.spread is None.
+AUTO_SPREADS = tuple(float(np.radians(d)) for d in (0.0, 30.0, 45.0, 60.0, 90.0))
+
+
+@dataclass(frozen=True)
+class ModelSettings:
+    """How the models are built (every field is part of the cache key)."""
+
+    n_samples: int = 2000         # simulated grasps
+    n_inducing: int = 200         # FITC inducing inputs
+    xy_range: float = 0.06        # relative x, y sampled uniformly in +-xy_range (m)
+    # Finger spread of the grasps (rad), or None (the default): chosen per object from
+    # AUTO_SPREADS by a pilot sample, as the spread with the most grasps that are both stable
+    # (epsilon) and held in the physical lift test (see training.choose_spread): a spread at which
+    # grasps are often stable by epsilon may still rarely hold when lifted.
+    spread: Optional[float] = None
+    n_pilot: int = 300            # pilot grasps per candidate spread (spread=None)
+    n_pilot_lifts: int = 16       # lift tests per candidate spread (on its stable pilot grasps)
+    # Epsilon above which a grasp counts as stable: force closure with a margin.
+    eps_stable: float = 0.01
+    max_iter: int = 150           # hyper-parameter optimisation iterations
+    n_calibration: int = 1000     # held-out simulated grasps for the P(S) calibration
+    seed: int = 0
+
+    def __post_init__(self):
+        if self.n_samples < 10:
+            raise ValueError(f"n_samples: need at least 10, got {self.n_samples}")
+        if self.n_inducing < 1:
+            raise ValueError(f"n_inducing: must be >= 1, got {self.n_inducing}")
+        if not (self.xy_range > 0 and np.isfinite(self.xy_range)):
+            raise ValueError(f"xy_range: must be positive, got {self.xy_range}")
+        if self.spread is not None and not (np.isfinite(self.spread) and 0.0 <= self.spread <= np.pi):
+            raise ValueError(f"spread: must be None (choose per object) or in [0, pi], got {self.spread}")
+        if self.n_pilot < 10 or self.n_pilot_lifts < 1:
+            raise ValueError("n_pilot: need at least 10 grasps and n_pilot_lifts at least 1")
