@@ -1,4 +1,4 @@
-"""One planning decision with 500 particles (issue 4 target: <= 250 ms on one core, aim 100 ms).
+"""One planning decision with 500 particles (target: <= 250 ms on one core).
 
 For each of the five Pub. II objects, beliefs are taken from real runs of the loop (the initial
 belief, +-4 cm / +-45 deg uniform, and the belief after one failed grasp), and a decision is

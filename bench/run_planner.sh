@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# One planning decision with 500 particles (issue 4): stability and exploration planners on the
+# One planning decision with 500 particles: stability and exploration planners on the
 # tabulated models vs the same stability search evaluating the FITC GP directly; one thread.
 set -euo pipefail
 cd "$(dirname "$0")/.."

@@ -1,4 +1,4 @@
-"""Planners for known objects under pose uncertainty (issue 4): the tabulated models, the
+"""Planners for known objects under pose uncertainty: the tabulated models, the
 planner interface, and small fixed-seed versions of the experiments' qualitative claims."""
 import json
 
