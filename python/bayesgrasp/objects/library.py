@@ -29,6 +29,7 @@ from typing import Callable, Dict, List, Optional
 import numpy as np
 
 from .mesh_io import DEFAULT_DENSITY, ObjectModel, orient_outward
+from .parts import part_labels
 
 # --------------------------------------------------------------------------------------------
 # mesh primitives (all return (V float64 (N,3), F int64 (M,3)), closed and outward-wound)
@@ -450,7 +451,9 @@ def generate(params: dict, name: str = "object", use_boolean: Optional[bool] = N
         raise ValueError(f"params['kind'] must be one of cube, cylinder, vessel, bottle, hammer, "
                          f"knife; got {kind!r}")
     d = params.get("density", DEFAULT_DENSITY) if density is None else density
-    return ObjectModel(name, V, F.astype(np.int32), d, source=f"builtin:{name}", params=dict(params))
+    parts, part_names = part_labels(params, V, F)
+    return ObjectModel(name, V, F.astype(np.int32), d, source=f"builtin:{name}", params=dict(params),
+                       parts=parts, part_names=part_names)
 
 
 _NAME_RE = re.compile(r"^([a-z]+)/(\d+)$")

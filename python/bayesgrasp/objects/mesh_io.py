@@ -17,7 +17,7 @@ import warnings
 from collections import deque
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Optional, Union
+from typing import Optional, Tuple, Union
 
 import numpy as np
 
@@ -151,6 +151,8 @@ class ObjectModel:
         density: kg/m^3 (> 0).
         source: where it came from (``"builtin:mug/3"`` or the file path).
         params: the parameter dict that generated a built-in object (empty for files).
+        parts: (M,) int32 part index per triangle, or None (no labels); ``part_names`` names them
+            (see :mod:`bayesgrasp.objects.parts`).
 
     Mass properties (``volume``, ``mass``, ``com``, ``inertia`` about the centre of mass, in this
     frame) are computed once at construction. For a mesh that is not watertight they come from its
@@ -164,6 +166,8 @@ class ObjectModel:
     source: str = ""
     params: dict = field(default_factory=dict)
     warn_if_open: bool = True
+    parts: Optional[np.ndarray] = None
+    part_names: Tuple[str, ...] = ()
 
     def __post_init__(self):
         V = np.ascontiguousarray(np.asarray(self.vertices, dtype=np.float64))
@@ -185,6 +189,13 @@ class ObjectModel:
         self.density = float(self.density)
         self.vertices = V
         self.faces = np.ascontiguousarray(F, dtype=np.int32)
+        if self.parts is not None:
+            from .parts import check_part_labels
+
+            self.parts, self.part_names = check_part_labels(self.parts, self.part_names, len(self.faces),
+                                                            what=f"parts of '{self.name}'")
+        elif self.part_names:
+            raise ValueError(f"part_names of '{self.name}' given without parts")
         self._watertight = mesh_is_watertight(self.faces)
         self.mass_from_hull = not self._watertight
         if self._watertight:
@@ -255,7 +266,14 @@ class ObjectModel:
             raise ValueError(f"T must be a finite 4x4 transform, got shape {T.shape}")
         V = self.vertices @ T[:3, :3].T + T[:3, 3]
         return ObjectModel(name or self.name, V, self.faces.copy(), self.density, self.source,
-                           dict(self.params), warn_if_open=False)
+                           dict(self.params), warn_if_open=False,
+                           parts=None if self.parts is None else self.parts.copy(), part_names=self.part_names)
+
+    def part_of_faces(self, faces) -> np.ndarray:
+        """The part names (array of str) of triangles given by index; ValueError without labels."""
+        if self.parts is None:
+            raise ValueError(f"object '{self.name}' has no part labels")
+        return np.asarray(self.part_names, dtype=object)[self.parts[np.asarray(faces, dtype=np.int64)]]
 
     def to_trimesh(self):
         """A ``trimesh.Trimesh`` view of the mesh (no processing)."""
@@ -340,9 +358,21 @@ def load_mesh(path: Union[str, os.PathLike], density: Optional[float] = None,
     F = np.asarray(mesh.faces, dtype=np.int64)
     # drop faces that collapse to a line or point (repeated indices)
     keep = (F[:, 0] != F[:, 1]) & (F[:, 1] != F[:, 2]) & (F[:, 2] != F[:, 0])
+    parts, part_names = _label_file(p, len(F))
     F = F[keep]
     if len(F) == 0:
         raise ValueError(f"'{p}': mesh has no non-degenerate faces")
     F = orient_outward(V, F)
     d = DEFAULT_DENSITY if density is None else density
-    return ObjectModel(name or p.stem, V, F.astype(np.int32), d, source=str(p))
+    return ObjectModel(name or p.stem, V, F.astype(np.int32), d, source=str(p),
+                       parts=None if parts is None else parts[keep], part_names=part_names)
+
+
+def _label_file(mesh_path: Path, n_faces: int):
+    """The mesh's part labels from ``<stem>.parts.json`` beside it, if there is one."""
+    from .parts import label_file_for, load_part_labels
+
+    f = label_file_for(mesh_path)
+    if not f.is_file():
+        return None, ()
+    return load_part_labels(f, n_faces)

@@ -1,0 +1,128 @@
+"""Part labels of the procedural objects and the task rules (data files)."""
+import json
+
+import numpy as np
+import pytest
+
+from bayesgrasp.models.tasks import load_task_file, load_tasks, task_categories, task_rule
+from bayesgrasp.objects import load_object
+from bayesgrasp.objects.parts import load_part_labels
+
+
+def _areas(o):
+    V, F = o.vertices, o.faces
+    return 0.5 * np.linalg.norm(np.cross(V[F[:, 1]] - V[F[:, 0]], V[F[:, 2]] - V[F[:, 0]]), axis=1)
+
+
+@pytest.mark.parametrize("name", ["mug", "mug2", "pitcher", "mug/0", "mug/5"])
+def test_vessel_parts_lie_where_they_belong(name):
+    o = load_object(name)
+    assert o.part_names == ("body", "rim", "handle")
+    C = o.vertices[o.faces].mean(axis=1)
+    p = o.params
+    handle = o.parts == 2
+    # every handle triangle is on the +x side beyond the body, every rim triangle near the top
+    assert handle.any() and np.all(C[handle, 0] > p["r_bottom"] * 0.8)
+    rim = o.parts == 1
+    assert rim.any() and np.all(C[rim, 2] > p["height"] - 1.5 * p["wall"])
+    # the handle's area is about its tube's lateral area (perimeter x length), not the body's
+    a = _areas(o)
+    perimeter = np.pi * (p["handle_width"] + p["handle_thickness"]) / 2
+    assert 0.3 < a[handle].sum() / (perimeter * np.pi * (p["handle_z"][1] - p["handle_z"][0]) / 2 + 1e-9) < 3
+    assert a[o.parts == 0].sum() > 5 * a[handle].sum()
+
+
+def test_bottle_parts_are_ordered_by_height():
+    o = load_object("bottle/4")
+    assert o.part_names == ("body", "shoulder", "neck", "cap")
+    z = o.vertices[o.faces].mean(axis=1)[:, 2]
+    means = [z[o.parts == i].mean() for i in range(4)]
+    assert means == sorted(means)
+    assert z[o.parts == 3].min() >= o.params["height"] - o.params["cap_height"] - 1e-9
+
+
+@pytest.mark.parametrize("name, parts", [("hammer/0", ("handle", "head")), ("knife/1", ("handle", "blade"))])
+def test_tool_parts_split_along_the_handle_axis(name, parts):
+    o = load_object(name)
+    assert o.part_names == parts
+    x = o.vertices[o.faces].mean(axis=1)[:, 0]
+    assert x[o.parts == 0].max() < x[o.parts == 1].max() and x[o.parts == 0].min() < x[o.parts == 1].min()
+
+
+def test_labels_survive_a_rigid_transform_and_user_label_files(tmp_path):
+    o = load_object("cube")
+    assert o.part_names == ("body",) and np.all(o.parts == 0)
+    T = np.eye(4)
+    T[:3, 3] = (0.1, 0, 0)
+    assert np.array_equal(o.transformed(T).parts, o.parts)
+    path = tmp_path / "box.stl"
+    o.save(path)
+    labels = (np.arange(o.n_faces) % 2).tolist()
+    (tmp_path / "box.parts.json").write_text(json.dumps({"parts": ["a", "b"], "faces": labels}))
+    from bayesgrasp.objects import load_mesh
+
+    m = load_mesh(path)
+    assert m.part_names == ("a", "b") and m.parts.tolist() == labels
+    assert m.part_of_faces([0, 1]).tolist() == ["a", "b"]
+    (tmp_path / "box.parts.json").write_text(json.dumps({"parts": ["a"], "faces": [0, 1]}))
+    with pytest.raises(ValueError, match="one label per triangle"):
+        load_mesh(path)
+    with pytest.raises(ValueError, match="labels must lie"):
+        load_part_labels(_write(tmp_path / "x.json", {"parts": ["a"], "faces": [1] * 12}), 12)
+
+
+def _write(path, doc):
+    path.write_text(json.dumps(doc))
+    return path
+
+
+def test_every_category_with_objects_has_tasks_that_name_real_parts():
+    assert task_categories() == ["bottle", "hammer", "knife", "mug"]
+    for cat, member in [("mug", "mug/0"), ("bottle", "bottle/0"), ("hammer", "hammer/0"), ("knife", "knife/0")]:
+        parts = set(load_object(member).part_names)
+        for rule in load_tasks(cat).values():
+            assert set(rule.allowed_parts) <= parts and set(rule.targets) <= parts
+    assert set(load_tasks("mug")) == {"top", "side", "handle"}
+
+
+def test_approach_rules_by_hand():
+    top = task_rule("mug", "top")
+    down, tilted, sideways = [0, 0, -1], [np.sin(np.radians(20)), 0, -np.cos(np.radians(20))], [-1, 0, 0]
+    assert top.approach_ok([down, tilted, sideways]).tolist() == [True, False, False]
+    side = task_rule("mug", "side")
+    # coming from -x (opposite the handle at +x) moves along +x; from +y moves along -y; from +x is the handle
+    assert side.approach_ok([[1, 0, 0], [0, -1, 0], [-1, 0, 0], [0, 0, -1]]).tolist() == [True, True, False, False]
+    handle = task_rule("mug", "handle")
+    assert handle.approach_ok([[-1, 0, 0], [1, 0, 0]]).tolist() == [True, False]
+    tool = task_rule("knife", "handle")
+    assert tool.approach_ok([[0, 0, -1], [0, 1, 0], [-1, 0, 0]]).tolist() == [True, True, False]
+
+
+def test_contact_rules_by_hand():
+    handle = task_rule("mug", "handle")
+    assert handle.contacts_ok(["handle", "handle", "body"])
+    assert not handle.contacts_ok(["handle", "body", "body"])      # one finger on the handle
+    knife = task_rule("knife", "handle")
+    assert knife.contacts_ok(["handle", "handle"]) and not knife.contacts_ok(["handle", "blade"])
+    assert not knife.contacts_ok(["handle"])                        # too few contacts
+
+
+@pytest.mark.parametrize("doc, needle", [
+    ({"category": "c", "parts": ["a"], "tasks": {"t": {"approach": {}, "contacts": {"allowed": ["z"]}}}}, "unknown parts"),
+    ({"category": "c", "parts": ["a"], "tasks": {"t": {"approach": {"from_sky": {}}, "contacts": {"allowed": ["a"]}}}},
+     "unknown constraint"),
+    ({"category": "c", "parts": ["a"], "tasks": {"t": {"approach": {"from_axis": {"axis": [0, 0, 0], "max_angle_deg": 5}},
+                                                       "contacts": {"allowed": ["a"]}}}}, "non-zero"),
+    ({"category": "c", "parts": ["a"], "tasks": {}}, "at least one task"),
+    ({"category": "c", "parts": ["a"], "tasks": {"t": {"contacts": {"allowed": ["a"]}}}}, "needs 'approach'"),
+])
+def test_bad_task_files_name_the_problem(tmp_path, doc, needle):
+    with pytest.raises(ValueError, match=needle):
+        load_task_file(_write(tmp_path / "t.json", doc))
+
+
+def test_unknown_category_or_task():
+    with pytest.raises(ValueError, match="no tasks for 'spoon'"):
+        load_tasks("spoon")
+    with pytest.raises(ValueError, match="its tasks: top, side, handle"):
+        task_rule("mug", "throw")
