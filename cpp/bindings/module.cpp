@@ -13,6 +13,7 @@ void bind_gp(py::module_& m);
 void bind_belief(py::module_& m);
 void bind_optim(py::module_& m);
 void bind_vision(py::module_& m);
+void bind_task(py::module_& m);
 }  // namespace bayesgrasp::bind
 
 PYBIND11_MODULE(_core, m) {
@@ -36,4 +37,6 @@ PYBIND11_MODULE(_core, m) {
   bind_optim(optim);
   auto vision = m.def_submodule("vision", "Simulated depth camera, table segmentation, FPFH + RANSAC + ICP registration.");
   bind_vision(vision);
+  auto task = m.def_submodule("task", "Task grasping (Eq. 4.1): pose densities, grasp mixtures, hand clearance.");
+  bind_task(task);
 }

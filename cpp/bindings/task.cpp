@@ -1,0 +1,133 @@
+// Bindings for cpp/bayesgrasp/task: Eq. 4.1's pose densities and grasp mixture, local pose
+// coordinates for the optimisers, and the open hand's clearance from the table and a cloud.
+#include <pybind11/stl.h>
+
+#include "bayesgrasp/task/grasp_mixture.hpp"
+#include "bayesgrasp/task/hand_clearance.hpp"
+#include "bayesgrasp/task/pose_density.hpp"
+#include "validate.hpp"
+
+namespace bayesgrasp::bind {
+
+namespace {
+
+using namespace bayesgrasp::task;
+
+std::vector<Iso3> pose_stack(const DArray& a, const char* name) {
+  if (a.ndim() != 3 || a.shape(1) != 4 || a.shape(2) != 4)
+    throw py::value_error(std::string(name) + ": expected shape (N, 4, 4), got " + shape_str(a));
+  std::vector<Iso3> out(static_cast<size_t>(a.shape(0)));
+  for (py::ssize_t i = 0; i < a.shape(0); ++i) {
+    Eigen::Map<const Eigen::Matrix<double, 4, 4, Eigen::RowMajor>> m(a.data() + 16 * i);
+    try {
+      out[static_cast<size_t>(i)] = pose_from_matrix(m);
+    } catch (const std::invalid_argument& e) {
+      throw py::value_error(std::string(name) + "[" + std::to_string(i) + "]: " + e.what());
+    }
+  }
+  return out;
+}
+
+py::array_t<double> pose_stack_out(const std::vector<Iso3>& poses) {
+  py::array_t<double> out({static_cast<py::ssize_t>(poses.size()), py::ssize_t{4}, py::ssize_t{4}});
+  auto o = out.mutable_unchecked<3>();
+  for (size_t i = 0; i < poses.size(); ++i)
+    for (int r = 0; r < 4; ++r)
+      for (int c = 0; c < 4; ++c) o(static_cast<py::ssize_t>(i), r, c) = poses[i].matrix()(r, c);
+  return out;
+}
+
+}  // namespace
+
+void bind_task(py::module_& m) {
+  py::enum_<DensityKind>(m, "DensityKind", "Form of the pose density around a task grasp (Eq. 4.1).")
+      .value("gaussian", DensityKind::Gaussian)
+      .value("regularised", DensityKind::RegularisedGaussian)
+      .value("laplace", DensityKind::Laplace);
+
+  py::class_<PoseDensity>(m, "PoseDensity", R"doc(A density over hand poses around a task grasp.
+
+With d_t the translation distance and d_R the rotation angle between the candidate and the grasp:
+Gaussian exp(-(d_t^2/s_t^2 + d_R^2/s_R^2)/2); regularised Gaussian (1 - lambda) Gauss(s) +
+lambda Gauss(kappa s); Laplace exp(-(d_t/s_t + d_R/s_R)). 1 at the grasp.)doc")
+      .def(py::init<>())
+      .def_readwrite("kind", &PoseDensity::kind, "kind : DensityKind\n    gaussian, regularised or laplace")
+      .def_readwrite("translation_scale", &PoseDensity::translation_scale, "translation_scale : float\n    s_t (m)")
+      .def_readwrite("rotation_scale", &PoseDensity::rotation_scale, "rotation_scale : float\n    s_R (rad)")
+      .def_readwrite("wide_weight", &PoseDensity::wide_weight,
+                     "wide_weight : float\n    lambda, the wide component's weight (regularised only)")
+      .def_readwrite("wide_factor", &PoseDensity::wide_factor,
+                     "wide_factor : float\n    kappa, the wide component's scale multiple (regularised only)")
+      .def("validate", &PoseDensity::validate, "Raises ValueError naming a bad field.")
+      .def("__call__", [](const PoseDensity& d, double dt, double dr) { d.validate(); return d(dt, dr); },
+           py::arg("dt"), py::arg("dr"), "The density at translation distance dt (m) and rotation angle dr (rad).");
+
+  py::class_<MixtureValues>(m, "MixtureValues", "Eq. 4.1's objective at a batch of candidate hand poses.")
+      .def_readonly("value", &MixtureValues::value, "value : ndarray (N,)\n    J(A)")
+      .def_readonly("per_model", &MixtureValues::per_model,
+                    "per_model : ndarray (N, M)\n    each model's share of J(A) (empty unless asked for)")
+      .def_readonly("dominant", &MixtureValues::dominant,
+                    "dominant : ndarray (N,)\n    the component contributing most (-1 where J = 0)");
+
+  py::class_<GraspMixture>(m, "GraspMixture", R"doc(Eq. 4.1's mixture: task grasps of the training
+models carried into the scene, each with weight psi(q_ik) phi(delta_i).)doc")
+      .def(py::init([](const DArray& grasps, const DArray& weights, const std::vector<int>& models, int num_models) {
+             return GraspMixture(pose_stack(grasps, "grasps"), vector(weights, "weights"), models, num_models);
+           }),
+           py::arg("grasps"), py::arg("weights"), py::arg("models"), py::arg("num_models"),
+           "grasps (K, 4, 4) in the scene frame; weights (K,) >= 0; models (K,) model index of each.")
+      .def_property_readonly("size", &GraspMixture::size)
+      .def_property_readonly("num_models", &GraspMixture::num_models)
+      .def(
+          "evaluate",
+          [](const GraspMixture& g, const DArray& candidates, const PoseDensity& d, bool per_model, int threads) {
+            const std::vector<Iso3> c = pose_stack(candidates, "candidates");
+            py::gil_scoped_release release;
+            return g.evaluate(c, d, per_model, threads);
+          },
+          py::arg("candidates"), py::arg("density"), py::arg("per_model") = false, py::arg("threads") = 1,
+          "J at candidate hand poses (N, 4, 4); threads 0 = all cores.")
+      .def(
+          "evaluate_local",
+          [](const GraspMixture& g, const DArray& reference, const DArray& X, const PoseDensity& d, int threads) {
+            const Iso3 ref = pose(reference, "reference");
+            const LocalPoses L = matrix(X, "X", 6, true);
+            const std::vector<Iso3> c = poses_from_local(ref, L);
+            py::gil_scoped_release release;
+            return Eigen::VectorXd(g.evaluate(c, d, false, threads).value);
+          },
+          py::arg("reference"), py::arg("X"), py::arg("density"), py::arg("threads") = 1,
+          "J at poses given by local coordinates X (N, 6) around a reference pose (see poses_from_local).");
+
+  m.def(
+      "poses_from_local",
+      [](const DArray& reference, const DArray& X) {
+        return pose_stack_out(poses_from_local(pose(reference, "reference"), matrix(X, "X", 6, true)));
+      },
+      py::arg("reference"), py::arg("X"),
+      "Poses (N, 4, 4) from rows (t, r) of X (N, 6): rotation exp([r]) R_ref, translation t_ref + t.");
+
+  py::class_<ClearanceOptions>(m, "ClearanceOptions", "What the open hand must be clear of.")
+      .def(py::init<>())
+      .def_readwrite("table", &ClearanceOptions::table, "table : bool\n    the plane z = 0 is an obstacle")
+      .def_readwrite("margin", &ClearanceOptions::margin, "margin : float\n    shapes grown by this (m)");
+
+  py::class_<Clearance>(m, "Clearance", "Intrusions into the open hand at each candidate pose (m, 0 = clear).")
+      .def_readonly("table", &Clearance::table, "table : ndarray (N,)\n    depth below z = 0")
+      .def_readonly("cloud", &Clearance::cloud, "cloud : ndarray (N,)\n    deepest cloud point inside a hand shape");
+
+  m.def(
+      "hand_clearance",
+      [](const HandModel& hand, const DArray& q, const DArray& poses, const DArray& cloud,
+         const ClearanceOptions& options, int threads) {
+        const Eigen::VectorXd qv = vector(q, "q");
+        const std::vector<Iso3> P = pose_stack(poses, "poses");
+        const CloudPoints C = matrix(cloud, "cloud", 3, true);
+        py::gil_scoped_release release;
+        return hand_clearance(hand, qv, P, C, options, threads);
+      },
+      py::arg("hand"), py::arg("q"), py::arg("poses"), py::arg("cloud"), py::arg("options") = ClearanceOptions(),
+      py::arg("threads") = 1, "Intrusions of the table and the cloud (K, 3) into the hand at joints q, per pose.");
+}
+
+}  // namespace bayesgrasp::bind
