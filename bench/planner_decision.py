@@ -75,7 +75,7 @@ def main():
             est = pose + rng.uniform(-1, 1, 3) * np.array([0.04, 0.04, np.radians(45)])
             # a failed first grasp from the real loop gives the second belief
             ep = run_episode(obj, pose, EpisodeSettings(method="stability", attempts=1, stop_when_stable=False),
-                             RunContext(lift=False), seed=r, estimate=est, models=models)
+                             RunContext(success="epsilon", lift=False), seed=r, estimate=est, models=models)
             a0 = ep["attempts"][0]
             obs = (np.array(a0["action"]), np.array(a0["joint_angles"]), a0["stable"])
             for observe in (None, obs):

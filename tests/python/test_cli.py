@@ -56,6 +56,7 @@ def test_grasp_relative_to_the_object_pose_is_invariant():
     (["experiment", "pub2", "--workers", "0"], "--workers"),
     (["experiment", "pub2", "--objects", "no_such_thing"], "neither a built-in"),
     (["experiment", "pub2", "--out", "/proc/forbidden/dir"], "--out"),
+    (["experiment", "pub2", "--no-lift"], "--success epsilon"),
 ])
 def test_bad_input_gives_a_message_and_exit_status_2(args, needle, capsys):
     assert main(args) == 2
@@ -77,16 +78,18 @@ def test_plan_json_on_a_user_mesh_file(tmp_path):
     assert isinstance(r["success"], bool) and 1 <= len(r["attempts"]) <= 4
     for a in r["attempts"]:
         assert a["plan_type"] in ("stability", "explore") and len(a["grasp"]) == 3
-        assert 0.0 <= a["predicted_stability"] <= 1.0 and a["outcome"] in ("stable", "unstable")
+        assert 0.0 <= a["predicted_stability"] <= 1.0 and a["outcome"] in ("success", "failure")
+        assert a["success"] == bool(a["lifted"])   # the default criterion: held in the lift test
         assert {"entropy", "epsilon", "lifted"} <= set(a)
-    assert r["attempts"][-1]["outcome"] == ("stable" if r["success"] else "unstable")
+    assert r["attempts"][-1]["outcome"] == ("success" if r["success"] else "failure")
+    assert r["success_criterion"] == "lift"
     assert {"mean", "std", "entropy", "position_error"} <= set(r["final_belief"])
     assert (tmp_path / "belief.png").stat().st_size > 1000
 
 
 def test_experiment_writes_tables_and_plots_and_resumes(tmp_path):
     args = ["experiment", "pub2", "--objects", "cube", "--runs", "2", "--out", str(tmp_path / "e"),
-            "--cache", str(tmp_path / "cache"), "--no-lift"]
+            "--cache", str(tmp_path / "cache"), "--success", "epsilon", "--no-lift"]
     code, out, err = run_cli(*args)
     assert code == 0, err
     for f in ("summary.md", "summary.json", "stability.csv", "per_attempt.png", "belief_cube.png", "results.sqlite"):

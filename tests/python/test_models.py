@@ -3,9 +3,11 @@ import pytest
 
 from bayesgrasp.models import ModelSettings, build_models, relative_top_grasps
 from bayesgrasp.models import AUTO_SPREADS, simulate_training_data
+from bayesgrasp.models.training import lift_outcomes
 from bayesgrasp.world import World
 
-SMALL = ModelSettings(n_samples=400, n_inducing=60, xy_range=0.03, max_iter=40, seed=3)
+SMALL = ModelSettings(n_samples=400, n_inducing=60, xy_range=0.03, max_iter=40, seed=3, n_lift_samples=300,
+                      n_calibration=200, n_pilot=100, n_pilot_lifts=20)
 
 
 def test_relative_top_grasps_by_hand():
@@ -36,17 +38,18 @@ def test_models_predict_held_out_simulations_and_are_cached(tmp_path):
     assert np.mean(wins) > 0.7
     p = models.stability_probability(rel)
     assert np.all((p >= 0) & (p <= 1))
-    # stable grasps (by simulation) get a higher predicted stability on average
-    stable = eps > SMALL.eps_stable
-    assert 5 <= stable.sum() <= len(stable) - 5  # both classes among the held-out grasps
-    assert p[stable].mean() > p[~stable].mean()
+    # grasps the simulator's lift test holds get a higher predicted P(S) than those it drops
+    lifted = lift_outcomes(World.single("cylinder"), rel, models.spread)
+    assert 5 <= lifted.sum() <= len(lifted) - 5  # both classes among the held-out grasps
+    assert p[lifted].mean() > p[~lifted].mean() + 0.1
 
     again = build_models("cylinder", settings=SMALL, cache_dir=tmp_path)
     assert again.loaded_from_cache
     np.testing.assert_allclose(again.predict_measurement(rel[:5])[0], mean[:5], atol=1e-10)
-    # other settings: a new key, the models are rebuilt
-    other = build_models("cylinder", settings=ModelSettings(**{**SMALL.__dict__, "seed": 4}), cache_dir=tmp_path)
-    assert not other.loaded_from_cache
+    # other settings (here the success criterion): a new key, the models are rebuilt
+    other = build_models("cylinder", settings=ModelSettings(**{**SMALL.__dict__, "success": "epsilon"}),
+                         cache_dir=tmp_path)
+    assert not other.loaded_from_cache and other.settings.stability_threshold == SMALL.eps_stable
     assert len(list(tmp_path.glob("*.json"))) == 2
 
 
@@ -55,6 +58,8 @@ def test_bad_settings():
         ModelSettings(n_samples=2)
     with pytest.raises(ValueError, match="xy_range"):
         ModelSettings(xy_range=-1.0)
+    with pytest.raises(ValueError, match="success"):
+        ModelSettings(success="quality")
 
 
 def test_spread_chosen_by_the_pilot_is_recorded_and_fixed_spreads_are_kept(tmp_path):
@@ -69,3 +74,15 @@ def test_spread_chosen_by_the_pilot_is_recorded_and_fixed_spreads_are_kept(tmp_p
     assert fixed.spread == 0.5 and fixed.info["spread_pilot"] is None
     with pytest.raises(ValueError, match="spread"):
         ModelSettings(spread=4.0)
+
+
+def test_epsilon_criterion_models_learn_epsilon(tmp_path):
+    eps_settings = ModelSettings(**{**SMALL.__dict__, "success": "epsilon", "spread": 0.5})
+    m = build_models("cube", settings=eps_settings, cache_dir=tmp_path)
+    assert m.settings.stability_threshold == eps_settings.eps_stable
+    held = ModelSettings(n_samples=150, xy_range=0.03, seed=98)
+    rel, q, eps = simulate_training_data(World.single("cube"), held, spread=0.5)
+    stable = eps > eps_settings.eps_stable
+    assert 5 <= stable.sum() <= len(stable) - 5
+    p = m.stability_probability(rel)
+    assert p[stable].mean() > p[~stable].mean() + 0.1

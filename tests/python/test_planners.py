@@ -8,9 +8,11 @@ import pytest
 from bayesgrasp import _core
 from bayesgrasp.belief import relative_planar_pose
 from bayesgrasp.experiments import EpisodeSettings, RunContext, run_episode
+from bayesgrasp.models import ModelSettings
 from bayesgrasp.planners import ExplorationPlanner, PlannerSettings, StabilityPlanner, get_models, make_planner
 
-NO_LIFT = RunContext(lift=False)
+EPSILON = ModelSettings(success="epsilon")
+NO_LIFT = RunContext(success="epsilon", lift=False)
 
 Grid = _core.belief.RelativePoseGrid
 
@@ -66,7 +68,7 @@ def cache(tmp_path_factory):
 
 @pytest.fixture(scope="module")
 def cube(cache):
-    return get_models("cube", cache_dir=cache)
+    return get_models("cube", settings=EPSILON, cache_dir=cache)
 
 
 def test_planner_interface_and_bad_input(cube):
@@ -123,3 +125,21 @@ def test_informative_grasp_shrinks_the_pose_error_and_beats_a_random_grasp(cube)
     assert np.mean([x["error_after_informative"] for x in r]) < np.mean([x["error_before"] for x in r])
     # and its realised posterior entropy is below that of a random grasp from the same belief
     assert np.mean([x["entropy_informative"] for x in r]) < np.mean([x["entropy_random"] for x in r])
+
+
+def test_lift_criterion_loop_stops_at_a_lifted_grasp_and_learns_from_dropped_ones(cache):
+    small = ModelSettings(n_samples=400, n_inducing=60, max_iter=40, n_lift_samples=300, n_calibration=200,
+                          n_pilot=100, n_pilot_lifts=20)
+    models = get_models("cube", settings=small, cache_dir=cache)
+    ctx = RunContext()   # success = lifted, the default
+    runs = [run_episode("cube", (0.02 * i, -0.01, 0.5 * i), EpisodeSettings(method="stability"), ctx, seed=i,
+                        models=models) for i in range(4)]
+    for r in runs:
+        for a in r["attempts"]:
+            assert a["lifted"] is not None and a["success"] == a["lifted"]
+        for a in r["attempts"][:-1]:          # every attempt before the last was dropped ...
+            assert not a["success"] and "belief_after" in a   # ... and updated the belief
+        last = r["attempts"][-1]
+        assert r["success"] == last["success"]
+        assert ("belief_after" in last) == (not last["success"])
+    assert any(r["success"] for r in runs)

@@ -69,8 +69,11 @@ def output_file(path: Optional[str], what: str) -> Optional[Path]:
 
 
 def add_context_options(p: argparse.ArgumentParser, lift: bool = False, seed: bool = True) -> None:
-    """The options every run context is built from: --hand, --cache (and --seed, --no-lift)."""
+    """The options every run context is built from: --hand, --cache, --success (and --seed, --no-lift)."""
     p.add_argument("--hand", default="barrett_bh8", help="hand file name or path")
+    p.add_argument("--success", default="lift", choices=["lift", "epsilon"],
+                   help="what a successful grasp is: held in the lift test (default) or epsilon above the "
+                        "models' eps_stable (the thesis's simulation criterion)")
     p.add_argument("--cache", default=None, help="model cache directory (default: $BAYESGRASP_CACHE/models, "
                                                  "$BAYESGRASP_CACHE defaulting to ~/.cache/bayesgrasp)")
     if seed:
@@ -83,6 +86,9 @@ def context(args: argparse.Namespace, progress: bool = True):
     """The :class:`~bayesgrasp.experiments.context.RunContext` of a command, built once from its options."""
     from ..experiments.context import RunContext, stderr_progress
 
+    success, lift = getattr(args, "success", "lift"), not getattr(args, "no_lift", False)
+    if success == "lift" and not lift:
+        raise CliError("--no-lift: needs --success epsilon (success 'lift' is decided by the lift test)")
     return RunContext(hand=getattr(args, "hand", "barrett_bh8"), cache_dir=getattr(args, "cache", None),
-                      lift=not getattr(args, "no_lift", False), seed=getattr(args, "seed", 0),
+                      success=success, lift=lift, seed=getattr(args, "seed", 0),
                       progress=stderr_progress if progress else None)

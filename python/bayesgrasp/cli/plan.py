@@ -37,12 +37,13 @@ def add(sub) -> None:
 def _print_attempt(a: dict) -> None:
     lift = "" if a["lifted"] is None else (", lifted" if a["lifted"] else ", dropped in the lift test")
     ent = "" if a["expected_entropy"] is None else f", expected entropy {a['expected_entropy']:.2f}"
+    verdict = "SUCCESS" if a["success"] else "failed"
     x, y, yaw = a["action"]
     b = a["belief_before"]
     print(f"  attempt {a['attempt']}: {a['kind']:<9} grasp ({100 * x:6.1f} cm, {100 * y:6.1f} cm, "
           f"{np.degrees(yaw):6.1f} deg)  predicted P(S) {a['predicted_stability']:.2f}{ent}  "
           f"[belief: error {100 * b['position_error']:.1f} cm, entropy {b['kde_entropy']:.2f}]  "
-          f"-> epsilon {a['epsilon']:.3f}: {'STABLE' if a['stable'] else 'not stable'}{lift}  "
+          f"-> epsilon {a['epsilon']:.3f} ({'stable' if a['stable'] else 'not stable'}){lift}: {verdict}  "
           f"({1e3 * a['plan_seconds']:.0f} ms to plan)", flush=True)
 
 
@@ -83,7 +84,7 @@ def demo(args) -> int:
           f"{np.degrees(pose[2]):.0f} deg); belief: 500 particles, +-4 cm, +-45 deg; method {args.method}")
     r = _loop(args, pose)
     f = r["final_belief"]
-    print(f"{'success' if r['success'] else 'no stable grasp'} after {len(r['attempts'])} attempt(s); "
+    print(f"{'success' if r['success'] else 'no successful grasp'} after {len(r['attempts'])} attempt(s); "
           f"final belief error {100 * f['position_error']:.1f} cm, {np.degrees(f['yaw_error']):.0f} deg")
     png = _belief_png(r, out / "belief_evolution.png")
     (out / "demo.json").write_text(json.dumps(_json_ready(r), indent=1))
@@ -94,11 +95,12 @@ def demo(args) -> int:
 def _plan_json(args, pose, r: dict) -> dict:
     f = r["final_belief"]
     return {"object": args.object, "method": args.method, "true_pose": pose, "estimate": r["estimate"],
-            "success": r["success"],
+            "success_criterion": args.success, "success": r["success"],
             "attempts": [{"plan_type": a["kind"], "grasp": a["action"], "predicted_stability": a["predicted_stability"],
                           "expected_entropy": a["expected_entropy"], "entropy": a["belief_before"]["kde_entropy"],
-                          "epsilon": a["epsilon"], "lifted": a["lifted"],
-                          "outcome": "stable" if a["stable"] else "unstable", "plan_seconds": a["plan_seconds"],
+                          "epsilon": a["epsilon"], "stable": a["stable"], "lifted": a["lifted"],
+                          "success": a["success"], "outcome": "success" if a["success"] else "failure",
+                          "plan_seconds": a["plan_seconds"],
                           "joint_angles": a["joint_angles"]} for a in r["attempts"]],
             "final_belief": {"mean": f["mean"], "std": f["std"], "entropy": f["kde_entropy"], "ess": f["ess"],
                              "position_error": f["position_error"], "yaw_error": f["yaw_error"]}}
@@ -116,5 +118,5 @@ def plan(args) -> int:
     if args.json:
         print(json.dumps(_plan_json(args, pose, r)))
     else:
-        print(f"{'success' if r['success'] else 'no stable grasp'} after {len(r['attempts'])} attempt(s)")
+        print(f"{'success' if r['success'] else 'no successful grasp'} after {len(r['attempts'])} attempt(s)")
     return 0

@@ -25,15 +25,16 @@ from .context import RunContext
 class EpisodeSettings:
     """method: a planner name (see :data:`bayesgrasp.planners.PLANNERS`); attempts: grasps at most;
     measurement_noise: std (rad) of Gaussian noise on the measured joint angles; stop_when_stable:
-    stop at the first stable grasp (False: every attempt is made, the thesis's fixed number of
-    grasps, and the belief is updated after stable grasps too)."""
+    stop at the first successful grasp (False: every attempt is made, the thesis's fixed number of
+    grasps, and the belief is updated after successful grasps too). What success is comes from
+    the run context (:attr:`RunContext.success`)."""
 
     method: str = "explore"
     attempts: int = 4
     measurement_noise: float = 0.0
     stop_when_stable: bool = True
     planner: PlannerSettings = field(default_factory=PlannerSettings)
-    models: ModelSettings = field(default_factory=ModelSettings)
+    models: Optional[ModelSettings] = None   # None: the run context's (its success criterion)
 
     def __post_init__(self):
         if self.attempts < 1:
@@ -44,12 +45,15 @@ class EpisodeSettings:
 
 @dataclass
 class Execution:
-    """One executed grasp: where it was relative to the object, how it scored, what the fingers read."""
+    """One executed grasp: where it was relative to the object, how it scored, what the fingers
+    read. ``success`` is the context's criterion (lifted, or ``stable``: epsilon above the models'
+    eps_stable); ``lifted`` is None when no lift test ran."""
 
     relative_grasp: np.ndarray
     epsilon: float
     stable: bool
     lifted: Optional[bool]
+    success: bool
     collision_at_start: bool
     joint_angles: np.ndarray
 
@@ -61,18 +65,22 @@ def initial_estimate(true_pose: np.ndarray, settings: PlannerSettings, rng: np.r
     return true_pose + rng.uniform(-hw, hw)
 
 
-def execute(world: World, models: GraspModels, action: np.ndarray, true_pose: np.ndarray, lift: bool) -> Execution:
-    """The world top grasp ``action`` executed on the object at its true pose: stable = epsilon
-    above the models' eps_stable; the lift test (when ``lift``) on stable grasps."""
+def execute(world: World, models: GraspModels, action: np.ndarray, true_pose: np.ndarray,
+            ctx: RunContext) -> Execution:
+    """The world top grasp ``action`` executed on the object at its true pose and scored: with
+    success "lift" every grasp is lift-tested and success means lifted; with "epsilon" success
+    means epsilon above the models' eps_stable, and the lift test (if ``ctx.lift``) runs on
+    stable grasps only."""
     rel = relative_top_grasps(action, true_pose)[0, 0]
-    g = world.grasp_batch(rel[None, :], spread=models.spread)
+    by_lift = ctx.success == "lift"
+    g = world.grasp_batch(rel[None, :], spread=models.spread, lift=by_lift)
     eps = float(g["epsilon"][0])
     stable = eps > models.settings.eps_stable
-    lifted = None
-    if lift and stable:
+    lifted = bool(g["lifted"][0]) if by_lift else None
+    if not by_lift and ctx.lift and stable:
         lifted = bool(world.grasp_batch(rel[None, :], spread=models.spread, lift=True)["lifted"][0])
-    return Execution(rel, eps, bool(stable), lifted, bool(g["collision_at_start"][0]),
-                     np.asarray(g["joint_angles"][0], dtype=float))
+    return Execution(rel, eps, bool(stable), lifted, bool(lifted) if by_lift else bool(stable),
+                     bool(g["collision_at_start"][0]), np.asarray(g["joint_angles"][0], dtype=float))
 
 
 def read_fingers(execution: Execution, models: GraspModels, noise: float, rng: np.random.Generator) -> np.ndarray:
@@ -88,7 +96,7 @@ def _attempt_record(k: int, plan, ex: Execution, q: np.ndarray, before: dict) ->
             "relative_grasp": ex.relative_grasp.tolist(), "predicted_stability": float(plan.predicted_stability),
             "objective": float(plan.objective), "expected_entropy": plan.expected_entropy,
             "plan_seconds": plan.seconds, "evaluations": plan.evaluations, "epsilon": ex.epsilon,
-            "force_closure": ex.epsilon > 0.0, "stable": ex.stable, "lifted": ex.lifted,
+            "force_closure": ex.epsilon > 0.0, "stable": ex.stable, "lifted": ex.lifted, "success": ex.success,
             "collision_at_start": ex.collision_at_start, "joint_angles": q.tolist(), "belief_before": before}
 
 
@@ -127,12 +135,12 @@ def run_episode(obj: Union[str, ObjectModel], true_pose: Sequence[float], episod
         if keep_planner:
             snapshots.append((planner.belief.particles, planner.belief.weights))
         plan = planner.plan()
-        ex = execute(world, models, plan.action, true_pose, ctx.lift)
+        ex = execute(world, models, plan.action, true_pose, ctx)
         q = read_fingers(ex, models, episode.measurement_noise, rng)
         rec = _attempt_record(k, plan, ex, q, before)
-        stop = ex.stable and episode.stop_when_stable
+        stop = ex.success and episode.stop_when_stable
         if not stop:
-            planner.observe(plan.action, q, stable=ex.stable)
+            planner.observe(plan.action, q, stable=ex.success)
             rec["belief_after"] = planner.summary(true_pose)
         attempts.append(rec)
         if on_attempt is not None:
@@ -147,8 +155,8 @@ def _episode_result(name: str, method: str, true_pose, estimate, seed: int, atte
                     planner: Planner, truth, snapshots: Optional[list]) -> dict:
     result = {"object": name, "method": method, "true_pose": true_pose.tolist(),
               "estimate": np.asarray(estimate).tolist(), "seed": int(seed),
-              "success": any(a["stable"] for a in attempts),
-              "first_success": next((a["attempt"] for a in attempts if a["stable"]), None),
+              "success": any(a["success"] for a in attempts),
+              "first_success": next((a["attempt"] for a in attempts if a["success"]), None),
               "lifted": any(a["lifted"] for a in attempts if a["lifted"] is not None),
               "attempts": attempts, "initial_belief": initial, "final_belief": planner.summary(truth)}
     if snapshots is not None:

@@ -22,7 +22,6 @@ True poses: x, y uniform in +-10 cm, yaw uniform; the same for every method at a
 """
 from __future__ import annotations
 
-from dataclasses import replace
 from functools import partial
 from pathlib import Path
 from typing import List, Optional
@@ -191,7 +190,7 @@ def belief_figures(exp: Experiment, objects: List[str], ctx: RunContext, out: Pa
     for o in objects:
         pose = true_pose(exp.name, o, 0, ctx.seed)
         episode = EpisodeSettings(method=method, stop_when_stable=(exp.name != "pub4"))
-        r = run_episode(o, pose, episode, replace(ctx, lift=False),
+        r = run_episode(o, pose, episode, ctx,
                         seed=run_seed(ctx.seed, exp.name, o, 0), keep_planner=True)
         p = report.plot_belief_evolution(r["snapshots"], pose, out / f"belief_{o}.png",
                                          f"{o}, {method}, run 0: true pose {np.round(pose, 3).tolist()}", r["attempts"])

@@ -20,7 +20,7 @@ from ..objects import ObjectModel, load_object
 from ..world import World
 from .grasp_models import DEFAULT_CALIBRATION, GraspModels, features
 from .settings import CACHE_VERSION, ModelSettings
-from .training import choose_spread, fit_calibration, simulate_training_data
+from .training import choose_spread, fit_calibration, simulate_training_data, success_labels
 
 Say = Callable[[str], None]
 
@@ -74,15 +74,27 @@ def _fit(X, Y, settings: ModelSettings, n: int) -> _gp.SparseGP:
 
 
 def _calibrate(models: GraspModels, world: World, settings: ModelSettings, spread: float, say: Say) -> tuple:
-    """The logistic calibration of P(S) on held-out simulated grasps (the probit-like default
-    when there are too few)."""
+    """The logistic calibration of P(S) on the outcomes of held-out simulated grasps (the
+    probit-like default when there are too few)."""
     if settings.n_calibration <= 0:
         return DEFAULT_CALIBRATION
-    say(f"models for {world.object.name}: calibrating P(S) on {settings.n_calibration} held-out grasps")
+    say(f"models for {world.object.name}: calibrating P(S) on {settings.n_calibration} held-out grasps "
+        f"({settings.success} outcomes)")
     rel_c, _, eps_c = simulate_training_data(world, settings, seed_offset=1, n=settings.n_calibration, spread=spread)
     if len(rel_c) < 10:
         return DEFAULT_CALIBRATION
-    return fit_calibration(models.stability_z(rel_c), eps_c > settings.eps_stable)
+    return fit_calibration(models.stability_z(rel_c), success_labels(world, settings, rel_c, eps_c, spread))
+
+
+def _fit_stability(world: World, settings: ModelSettings, rel, eps, spread: float, say: Say):
+    """The stability GP and the outcomes it was fitted on: lift outcomes (0/1) of the first
+    n_lift_samples training grasps, or the epsilon of all of them."""
+    if settings.success == "lift":
+        n = min(settings.n_lift_samples, len(rel))
+        say(f"models for {world.object.name}: lift tests of {n} training grasps")
+        lifted = success_labels(world, settings, rel[:n], eps[:n], spread)
+        return _fit(features(rel[:n]), lifted.astype(float), settings, n), lifted
+    return _fit(features(rel), np.maximum(eps, 0.0), settings, len(rel)), eps > settings.eps_stable
 
 
 def _train(world: World, settings: ModelSettings, key: str, say: Say) -> GraspModels:
@@ -100,13 +112,14 @@ def _train(world: World, settings: ModelSettings, key: str, say: Say) -> GraspMo
     X = features(rel)
     say(f"models for {name}: fitting FITC GPs on {len(rel)} grasps")
     measurement = _fit(X, q[:, joint_index], settings, len(rel))
-    stability = _fit(X, np.maximum(eps, 0.0), settings, len(rel))
+    stability, outcomes = _fit_stability(world, settings, rel, eps, spread, say)
     models = GraspModels(measurement, stability, settings, joint_index, {"spread": float(spread)})
     calibration = _calibrate(models, world, settings, spread, say)
     models.info = {"key": key, "object": name, "calibration": list(calibration), "hand": world.hand.name,
                    "settings": asdict(settings), "samples": int(len(rel)),
                    "force_closure_fraction": float(np.mean(eps > 0)),
                    "stable_fraction": float(np.mean(eps > settings.eps_stable)),
+                   "success_fraction": float(np.mean(outcomes)),
                    "joint_index": joint_index.tolist(), "spread": float(spread), "spread_pilot": pilot}
     return models
 

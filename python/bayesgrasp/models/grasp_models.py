@@ -6,10 +6,12 @@ are fitted on simulated grasps of the object with the hand (:mod:`.build`):
 
 * measurement model P(M|A,O): the hand's phalanx joint angles after closing (one output per
   phalanx joint, shared hyper-parameters), Gaussian with the GP's predictive variance plus noise;
-* stability model P(S|A,O): the GP regression of the grasp's epsilon quality (0 without force
-  closure), mapped to a probability through z = (mu - eps_stable) / sd of the latent epsilon and
-  a logistic calibration P(S) = 1 / (1 + exp(-(a z + b))) fitted on held-out simulated grasps
-  (the plain probit Phi(z) is overconfident on held-out grasps).
+* stability model P(S|A,O): the GP regression of the grasp's outcome - by default whether the lift
+  test held the object (0 or 1); with ``ModelSettings.success = "epsilon"`` the epsilon quality
+  (0 without force closure) - mapped to a probability through z = (mu - threshold) / sd of the
+  latent value (threshold 0.5 for the lift outcome, eps_stable for epsilon) and a logistic
+  calibration P(S) = 1 / (1 + exp(-(a z + b))) fitted on the outcomes of held-out simulated
+  grasps (the plain probit Phi(z) is overconfident on held-out grasps).
 """
 from __future__ import annotations
 
@@ -74,12 +76,12 @@ class GraspModels:
         return self.measurement.log_predictive_density(X, Y).reshape(rel.shape[:-1])
 
     def stability_z(self, rel) -> np.ndarray:
-        """z = (mu - eps_stable) / sd of the latent epsilon at relative grasps (..., 3). The
-        observation noise is left out: in epsilon it is mostly the simulator's discontinuity, not
+        """z = (mu - threshold) / sd of the stability GP's latent value at relative grasps (..., 3).
+        The observation noise is left out: it is mostly the simulator's discontinuity, not
         uncertainty about the grasp."""
         rel = np.asarray(rel, dtype=float)
         mean, var = _mean_var(self.stability, features(rel).reshape(-1, 4), include_noise=False)
-        z = (mean[:, 0] - self.settings.eps_stable) / np.sqrt(np.maximum(var[:, 0], 1e-12))
+        z = (mean[:, 0] - self.settings.stability_threshold) / np.sqrt(np.maximum(var[:, 0], 1e-12))
         return z.reshape(rel.shape[:-1])
 
     def _calibration(self):

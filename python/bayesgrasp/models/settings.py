@@ -8,7 +8,10 @@ from typing import Optional
 import numpy as np
 
 #: Bumped when the simulator or the models change what a cache key means.
-CACHE_VERSION = 6
+CACHE_VERSION = 7
+
+#: What a successful grasp is: held in the lift test (the default) or epsilon above eps_stable.
+SUCCESS_CRITERIA = ("lift", "epsilon")
 
 #: Grid nodes of highest P(S) a ModelTable keeps (the planners' PSO seeds).
 N_BEST = 64
@@ -19,9 +22,13 @@ AUTO_SPREADS = tuple(float(np.radians(d)) for d in (0.0, 30.0, 45.0, 60.0, 90.0)
 
 @dataclass(frozen=True)
 class ModelSettings:
-    """How the models are built (every field is part of the cache key)."""
+    """How the models are built (every field is part of the cache key).
 
-    n_samples: int = 2000         # simulated grasps
+    ``success`` says what the stability model P(S|A,O) learns: "lift" (S = held in the physical
+    lift test, as in the thesis's robot experiments) or "epsilon" (S = epsilon > eps_stable, the
+    thesis's simulation criterion)."""
+
+    n_samples: int = 2000         # simulated grasps (the measurement model's training set)
     n_inducing: int = 200         # FITC inducing inputs
     xy_range: float = 0.06        # relative x, y sampled uniformly in +-xy_range (m)
     # Finger spread of the grasps (rad), or None (the default): chosen per object from
@@ -30,12 +37,14 @@ class ModelSettings:
     # grasps are often stable by epsilon may still rarely hold when lifted.
     spread: Optional[float] = None
     n_pilot: int = 300            # pilot grasps per candidate spread (spread=None)
-    n_pilot_lifts: int = 16       # lift tests per candidate spread (on its stable pilot grasps)
+    n_pilot_lifts: int = 60       # pilot grasps per spread that are lift-tested
     # Epsilon above which a grasp counts as stable: force closure with a margin.
     eps_stable: float = 0.01
     max_iter: int = 150           # hyper-parameter optimisation iterations
     n_calibration: int = 1000     # held-out simulated grasps for the P(S) calibration
     seed: int = 0
+    success: str = "lift"
+    n_lift_samples: int = 1000    # training grasps lift-tested for the stability model (success "lift")
 
     def __post_init__(self):
         if self.n_samples < 10:
@@ -48,3 +57,13 @@ class ModelSettings:
             raise ValueError(f"spread: must be None (choose per object) or in [0, pi], got {self.spread}")
         if self.n_pilot < 10 or self.n_pilot_lifts < 1:
             raise ValueError("n_pilot: need at least 10 grasps and n_pilot_lifts at least 1")
+        if self.success not in SUCCESS_CRITERIA:
+            raise ValueError(f"success: one of {', '.join(SUCCESS_CRITERIA)}; got {self.success!r}")
+        if not 10 <= self.n_lift_samples:
+            raise ValueError(f"n_lift_samples: need at least 10, got {self.n_lift_samples}")
+
+    @property
+    def stability_threshold(self) -> float:
+        """The level of the stability GP's latent value above which a grasp counts as stable: 0.5
+        for the lift outcome (0/1), eps_stable for epsilon."""
+        return 0.5 if self.success == "lift" else self.eps_stable

@@ -1,5 +1,6 @@
-"""Training data for the grasp models, from the simulator: random relative top grasps, the
-finger-spread pilot and the logistic calibration of P(S)."""
+"""Training data for the grasp models, from the simulator: random relative top grasps, their
+outcomes (joint angles, epsilon, and the lift test), the finger-spread pilot and the logistic
+calibration of P(S)."""
 from __future__ import annotations
 
 from typing import Optional
@@ -31,23 +32,53 @@ def simulate_training_data(world: World, settings: ModelSettings, seed_offset: i
     return rel[ok], np.asarray(b["joint_angles"])[ok], np.asarray(b["epsilon"])[ok]
 
 
+def lift_outcomes(world: World, rel: np.ndarray, spread: float) -> np.ndarray:
+    """(n,) bool: each relative grasp held in the lift test. A grasp whose hand touches nothing of
+    the object cannot hold it and is not simulated."""
+    rel = np.atleast_2d(np.asarray(rel, dtype=float))
+    b = world.grasp_batch(rel, spread=spread, threads=0)
+    touches = np.asarray(b["link_contact"], dtype=bool).any(axis=1) & ~np.asarray(b["collision_at_start"], bool)
+    lifted = np.zeros(len(rel), dtype=bool)
+    idx = np.flatnonzero(touches)
+    if len(idx):
+        lifted[idx] = np.asarray(world.grasp_batch(rel[idx], spread=spread, lift=True, threads=0)["lifted"], bool)
+    return lifted
+
+
+def success_labels(world: World, settings: ModelSettings, rel: np.ndarray, eps: np.ndarray, spread: float) -> np.ndarray:
+    """S for each grasp under the settings' success criterion (lift test or epsilon)."""
+    if settings.success == "lift":
+        return lift_outcomes(world, rel, spread)
+    return np.asarray(eps) > settings.eps_stable
+
+
 def choose_spread(world: World, settings: ModelSettings, say=lambda m: None) -> tuple:
     """The pilot behind ModelSettings.spread = None: for each spread in AUTO_SPREADS, simulate
-    n_pilot random relative top grasps, lift-test up to n_pilot_lifts of the stable ones, and score
-    stable fraction x lifted fraction. Returns (best spread, {degrees: (stable, lifted, tested)});
-    with no grasp lifted at any spread, the spread with the most stable grasps."""
+    n_pilot random relative top grasps and score how often a random grasp succeeds.
+
+    With success "lift": the first n_pilot_lifts collision-free grasps that touch the object are
+    lift-tested; score = touching fraction x lifted fraction. With "epsilon": up to n_pilot_lifts
+    of the stable grasps are lift-tested; score = stable fraction x lifted fraction. Returns
+    (best spread, {degrees: (fraction, lifted, tested)}); with no grasp lifted at any spread, the
+    spread with the largest fraction."""
     rng = np.random.default_rng([settings.seed, 7])
     rel = random_relative_grasps(rng, settings.n_pilot, settings.xy_range)
     table, scores = {}, []
     for sp in AUTO_SPREADS:
         b = world.grasp_batch(rel, spread=sp, threads=0)
-        ok = (np.asarray(b["epsilon"]) > settings.eps_stable) & ~np.asarray(b["collision_at_start"], dtype=bool)
+        free = ~np.asarray(b["collision_at_start"], dtype=bool)
+        if settings.success == "lift":
+            ok = free & np.asarray(b["link_contact"], dtype=bool).any(axis=1)
+            what = "touch the object"
+        else:
+            ok = free & (np.asarray(b["epsilon"]) > settings.eps_stable)
+            what = "stable"
         idx = np.flatnonzero(ok)[:settings.n_pilot_lifts]
         lifted = int(np.sum(world.grasp_batch(rel[idx], spread=sp, lift=True, threads=0)["lifted"])) if len(idx) else 0
         frac = float(np.mean(ok))
         table[round(float(np.degrees(sp)))] = (frac, lifted, int(len(idx)))
         scores.append((frac * (lifted / len(idx) if len(idx) else 0.0), frac))
-        say(f"  spread {np.degrees(sp):3.0f} deg: {100 * frac:.0f}% stable, {lifted}/{len(idx)} of those lifted")
+        say(f"  spread {np.degrees(sp):3.0f} deg: {100 * frac:.0f}% {what}, {lifted}/{len(idx)} of those tested lifted")
     best = max(range(len(scores)), key=lambda i: scores[i])
     return AUTO_SPREADS[best], table
 
