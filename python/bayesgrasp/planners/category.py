@@ -1,0 +1,278 @@
+"""Grasping a new object of a known category for a task (thesis §4.2, Pub. V, Eq. 4.1).
+
+The robot has training models of the category, each with task grasps demonstrated in the model's
+frame (:class:`TaskGrasp`), and registrations of the new object's partial cloud against every
+model: a transform T_i (model -> scene) and a fitting weight phi(delta_i). It looks for the hand
+pose A that maximises
+
+    J(A) = sum_{i,k} P(A | T_ik, O_i; theta_ik) psi(q_ik) phi(delta_i)        (Eq. 4.1)
+
+where T_i theta_ik is grasp k of model i carried into the scene, psi(q) the stability weight of
+its quality and P one of three pose densities (:class:`bayesgrasp._core.task.PoseDensity`:
+Gaussian, regularised Gaussian, Laplace over the translation distance and rotation angle).
+
+Choices the thesis leaves open (documented here and in the README):
+
+* psi(q) = 1 - exp(-q / q_s) for q > 0 and ``psi_min`` otherwise, q_s the median positive epsilon of
+  the task grasps (a grasp twice as good as the typical one counts about as fully stable);
+* phi(delta) is the registration's exp(-delta^2 / 2 sigma^2), normalised over the models that
+  registered (:func:`bayesgrasp.belief.shape_weights`);
+* the search: PSO over 6-D local coordinates (translation, rotation vector) around each model's
+  mapped task grasp with the highest psi x phi, as the thesis starts "once per training object from
+  that model's grasp"; the best over the starts wins;
+* the environment constraint: the open hand at A must be clear of the table and of the observed
+  cloud; J is multiplied by exp(-d / d_0) with d the deepest intrusion (``clearance_scale`` d_0),
+  so the search is pushed out of collision smoothly.
+
+The baseline ("best single grasp"): the best-fitting model's task grasp of highest psi, mapped by
+its registration, no optimisation.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import List, Optional, Sequence
+
+import numpy as np
+
+from .. import _core, optim
+from ..hand import Hand
+
+_task = _core.task
+
+METHODS = ("laplace", "regularised", "gaussian", "baseline")
+
+
+@dataclass(frozen=True)
+class TaskGrasp:
+    """A demonstrated grasp of a training model for a task: the hand pose (4x4, model frame) and
+    spread, its epsilon and whether the lift test held it."""
+
+    model: str
+    task: str
+    pose: np.ndarray
+    spread: float
+    epsilon: float
+    lifted: bool
+
+
+@dataclass(frozen=True)
+class Registration:
+    """A training model registered to the scene: transform (model -> scene, 4x4), phi(delta), success."""
+
+    model: str
+    transform: np.ndarray
+    phi: float
+    success: bool = True
+
+
+@dataclass(frozen=True)
+class CategorySettings:
+    """method: laplace, regularised, gaussian or baseline; the density scales (m, rad) and the
+    regularised Gaussian's wide component (weight, scale factor); psi_min and psi_scale (None: the
+    median positive epsilon of the task grasps); the local search box half-widths (m, rad) and PSO
+    size; clearance_margin (m, shapes grown by it) and clearance_scale (m, the penalty's length)."""
+
+    method: str = "laplace"
+    translation_scale: float = 0.01
+    rotation_scale: float = float(np.radians(10.0))
+    wide_weight: float = 0.2
+    wide_factor: float = 4.0
+    psi_min: float = 0.01
+    psi_scale: Optional[float] = None
+    search_translation: float = 0.03
+    search_rotation: float = float(np.radians(30.0))
+    pso_particles: int = 24
+    pso_iter: int = 25
+    clearance_margin: float = 0.002
+    clearance_scale: float = 0.001
+    min_weight: float = 1e-3        # models whose normalised weight is below this are not search starts
+    threads: int = 1
+
+    def __post_init__(self):
+        if self.method not in METHODS:
+            raise ValueError(f"method: one of {', '.join(METHODS)}; got {self.method!r}")
+        for name in ("translation_scale", "rotation_scale", "search_translation", "search_rotation",
+                     "clearance_scale"):
+            v = getattr(self, name)
+            if not (np.isfinite(v) and v > 0):
+                raise ValueError(f"{name}: must be positive, got {v}")
+        if not 0 <= self.psi_min <= 1:
+            raise ValueError(f"psi_min: must lie in [0, 1], got {self.psi_min}")
+        if self.pso_particles < 2 or self.pso_iter < 1:
+            raise ValueError("pso_particles: at least 2, pso_iter: at least 1")
+
+    def density(self):
+        d = _task.PoseDensity()
+        d.kind = {"laplace": _task.DensityKind.laplace, "regularised": _task.DensityKind.regularised,
+                  "gaussian": _task.DensityKind.gaussian, "baseline": _task.DensityKind.laplace}[self.method]
+        d.translation_scale, d.rotation_scale = self.translation_scale, self.rotation_scale
+        d.wide_weight, d.wide_factor = self.wide_weight, self.wide_factor
+        d.validate()
+        return d
+
+
+@dataclass
+class CategoryPlan:
+    """The chosen grasp: hand pose (4x4, scene frame) and spread; J there (with the clearance
+    factor: ``objective``; without: ``mixture``); the per-model weights phi (normalised) and
+    contributions to J; the component that dominates J and its model; the search start."""
+
+    pose: np.ndarray
+    spread: float
+    method: str
+    objective: float
+    mixture: float
+    weights: dict
+    contributions: dict
+    dominant_model: Optional[str]
+    dominant_grasp: int
+    start_model: Optional[str]
+    evaluations: int = 0
+    intrusion: float = 0.0
+    reason: str = ""
+    extra: dict = field(default_factory=dict)
+
+    @property
+    def ok(self) -> bool:
+        return not self.reason
+
+
+def psi(epsilon, scale: float, floor: float) -> np.ndarray:
+    """Stability weight of task grasps from their epsilon: 1 - exp(-q / scale) for q > 0, else floor."""
+    q = np.asarray(epsilon, dtype=float)
+    return np.where(q > 0, np.maximum(1.0 - np.exp(-np.maximum(q, 0) / scale), floor), floor)
+
+
+def normalised_weights(registrations: Sequence[Registration]) -> np.ndarray:
+    """phi(delta_i) normalised over the models that registered (0 for the others)."""
+    phi = np.array([r.phi if r.success else 0.0 for r in registrations], dtype=float)
+    s = phi.sum()
+    return phi / s if s > 0 else phi
+
+
+class CategoryPlanner:
+    """Eq. 4.1 for one scene: the mixture of the mapped task grasps, searched in C++ batches."""
+
+    def __init__(self, hand: Hand, task_grasps: Sequence[TaskGrasp], registrations: Sequence[Registration],
+                 cloud=None, settings: Optional[CategorySettings] = None, seed: int = 0):
+        self.hand = hand if isinstance(hand, Hand) else Hand.load(hand)
+        self.settings = settings or CategorySettings()
+        self.registrations = list(registrations)
+        if not self.registrations:
+            raise ValueError("registrations: need at least one registered model")
+        names = [r.model for r in self.registrations]
+        self.grasps = [g for g in task_grasps if g.model in names]
+        self.cloud = np.zeros((0, 3)) if cloud is None else np.ascontiguousarray(np.asarray(cloud, float))
+        if self.cloud.ndim != 2 or self.cloud.shape[1] != 3 or not np.isfinite(self.cloud).all():
+            raise ValueError(f"cloud: expected finite (N, 3) points, got shape {self.cloud.shape}")
+        self.seed = int(seed)
+        self.weights = normalised_weights(self.registrations)
+        self._build_mixture()
+
+    # ---- the mixture ----------------------------------------------------------------------------
+    def _build_mixture(self) -> None:
+        s = self.settings
+        index = {r.model: i for i, r in enumerate(self.registrations)}
+        eps = np.array([g.epsilon for g in self.grasps], dtype=float)
+        pos = eps[eps > 0]
+        scale = s.psi_scale if s.psi_scale is not None else (float(np.median(pos)) if len(pos) else 0.1)
+        self.psi = psi(eps, scale, s.psi_min)
+        self.model_of = np.array([index[g.model] for g in self.grasps], dtype=int)
+        self.component_weight = self.psi * self.weights[self.model_of] if len(self.grasps) else np.zeros(0)
+        self.mapped = np.array([self.registrations[i].transform @ g.pose for i, g in zip(self.model_of, self.grasps)])
+        self.mixture = None
+        if len(self.grasps) and self.component_weight.sum() > 0:
+            self.mixture = _task.GraspMixture(self.mapped, self.component_weight, self.model_of.tolist(),
+                                              len(self.registrations))
+
+    def _reason(self) -> str:
+        if not self.grasps:
+            return "no demonstrated grasps for the registered models"
+        if not any(r.success for r in self.registrations):
+            return "no model registered"
+        if self.mixture is None:
+            return "every task grasp has zero weight"
+        return ""
+
+    # ---- objective --------------------------------------------------------------------------------
+    def _penalised(self, reference: np.ndarray, X: np.ndarray, spread: float, density) -> np.ndarray:
+        s = self.settings
+        J = self.mixture.evaluate_local(reference, X, density, s.threads)
+        d = self.intrusion(_task.poses_from_local(reference, X), spread)
+        return J * np.exp(-d / s.clearance_scale)
+
+    def intrusion(self, poses: np.ndarray, spread: float) -> np.ndarray:
+        """Deepest intrusion (m) of the table or the cloud into the open hand at each pose (N, 4, 4)."""
+        opts = _task.ClearanceOptions()
+        opts.margin = self.settings.clearance_margin
+        q = self.hand.open_joints(spread)
+        c = _task.hand_clearance(self.hand.core, q, np.asarray(poses, float), self.cloud, opts, self.settings.threads)
+        return np.maximum(np.asarray(c.table), np.asarray(c.cloud))
+
+    def evaluate(self, poses) -> _core.task.MixtureValues:
+        """J (without the clearance factor) and per-model shares at hand poses (N, 4, 4)."""
+        return self.mixture.evaluate(np.asarray(poses, float), self.settings.density(), True, self.settings.threads)
+
+    # ---- planning ---------------------------------------------------------------------------------
+    def starts(self) -> List[int]:
+        """One start per model with weight above min_weight: its mapped grasp of highest psi x phi."""
+        out = []
+        for i in range(len(self.registrations)):
+            idx = np.flatnonzero((self.model_of == i) & (self.component_weight > 0))
+            if len(idx) and self.weights[i] >= self.settings.min_weight:
+                out.append(int(idx[np.argmax(self.component_weight[idx])]))
+        return out
+
+    def plan(self) -> CategoryPlan:
+        reason = self._reason()
+        if reason:
+            return self._empty(reason)
+        if self.settings.method == "baseline":
+            return self._baseline()
+        s = self.settings
+        density = s.density()
+        box = np.array([s.search_translation] * 3 + [s.search_rotation] * 3)
+        best, best_val, best_start, nfev = None, -np.inf, None, 0
+        rng = np.random.default_rng(self.seed)
+        for c in self.starts():
+            ref, spread = self.mapped[c], self.grasps[c].spread
+            init = rng.uniform(-box, box, (s.pso_particles, 6))
+            init[0] = 0.0  # the mapped grasp itself
+            r = optim.pso(lambda X: -self._penalised(ref, X, spread, density), (-box, box),
+                          n_particles=s.pso_particles, max_iter=s.pso_iter, seed=int(rng.integers(2**31)), init=init)
+            nfev += r.nfev
+            if -r.fun > best_val:
+                best_val, best_start = -r.fun, c
+                best = _task.poses_from_local(ref, r.x[None, :])[0]
+        return self._result(best, best_val, best_start, nfev)
+
+    def _baseline(self) -> CategoryPlan:
+        i = int(np.argmax(self.weights))
+        idx = np.flatnonzero(self.model_of == i)
+        if not len(idx):
+            return self._empty(f"the best-fitting model {self.registrations[i].model} has no task grasp")
+        c = int(idx[np.argmax(self.psi[idx])])
+        return self._result(self.mapped[c], None, c, 0)
+
+    def _result(self, pose: np.ndarray, objective: Optional[float], start: Optional[int], nfev: int) -> CategoryPlan:
+        v = self.evaluate(pose[None])
+        dom = int(v.dominant[0])
+        comp = dom if dom >= 0 else start
+        spread = float(self.grasps[comp].spread)
+        d = float(self.intrusion(pose[None], spread)[0])
+        mix = float(v.value[0])
+        names = [r.model for r in self.registrations]
+        return CategoryPlan(
+            pose=pose, spread=spread, method=self.settings.method,
+            objective=mix * float(np.exp(-d / self.settings.clearance_scale)) if objective is None else float(objective),
+            mixture=mix, weights=dict(zip(names, self.weights.tolist())),
+            contributions=dict(zip(names, np.asarray(v.per_model)[0].tolist())),
+            dominant_model=names[self.model_of[comp]], dominant_grasp=comp,
+            start_model=None if start is None else names[self.model_of[start]], evaluations=nfev, intrusion=d)
+
+    def _empty(self, reason: str) -> CategoryPlan:
+        names = [r.model for r in self.registrations]
+        return CategoryPlan(pose=np.full((4, 4), np.nan), spread=float("nan"), method=self.settings.method,
+                            objective=0.0, mixture=0.0, weights=dict(zip(names, self.weights.tolist())),
+                            contributions={n: 0.0 for n in names}, dominant_model=None, dominant_grasp=-1,
+                            start_model=None, reason=reason)

@@ -1,0 +1,80 @@
+"""The category planner (Eq. 4.1) on synthetic task grasps and registrations with known answers."""
+import numpy as np
+import pytest
+
+from bayesgrasp.hand import Hand
+from bayesgrasp.planners.category import (CategoryPlanner, CategorySettings, Registration, TaskGrasp, psi)
+
+
+def rz(yaw, t=(0, 0, 0)):
+    T = np.eye(4)
+    c, s = np.cos(yaw), np.sin(yaw)
+    T[:2, :2] = [[c, -s], [s, c]]
+    T[:3, 3] = t
+    return T
+
+
+HAND = Hand.load("barrett_bh8")
+# a palm-down grasp 30 cm above the model's origin: far from the table, nothing else around
+TOP = Hand.top_grasp_pose(0.0, 0.0, 0.0, 0.3)
+
+
+def grasp(model, pose, eps=0.2, spread=0.5):
+    return TaskGrasp(model=model, task="top", pose=pose, spread=spread, epsilon=eps, lifted=True)
+
+
+@pytest.mark.parametrize("method", ["laplace", "regularised", "gaussian"])
+def test_one_grasp_one_model_the_optimum_is_the_mapped_grasp(method):
+    T = rz(0.4, (0.1, -0.05, 0.0))
+    p = CategoryPlanner(HAND, [grasp("a", TOP)], [Registration("a", T, phi=0.7)],
+                        settings=CategorySettings(method=method), seed=1).plan()
+    assert p.ok and p.dominant_model == "a" and p.start_model == "a"
+    np.testing.assert_allclose(p.pose, T @ TOP, atol=1e-9)   # PSO starts there and cannot beat J = psi * 1
+    assert p.mixture == pytest.approx(psi(0.2, 0.2, 0.01))    # the one weight is normalised to 1
+    assert p.weights == {"a": 1.0} and p.contributions["a"] == pytest.approx(p.mixture)
+    assert p.spread == 0.5 and p.intrusion == 0.0
+
+
+def test_weights_split_the_mixture_and_the_baseline_takes_the_best_fitting_model():
+    # two models whose registrations disagree by 2 cm: Laplace's optimum sits on the heavier one
+    Ta, Tb = rz(0.0), rz(0.0, (0.02, 0.0, 0.0))
+    regs = [Registration("a", Ta, phi=0.3), Registration("b", Tb, phi=0.9)]
+    gs = [grasp("a", TOP, eps=0.3), grasp("b", TOP, eps=0.3)]
+    plan = CategoryPlanner(HAND, gs, regs, settings=CategorySettings(method="laplace"), seed=2).plan()
+    assert plan.weights["a"] == pytest.approx(0.25) and plan.weights["b"] == pytest.approx(0.75)
+    np.testing.assert_allclose(plan.pose[:3, 3], (Tb @ TOP)[:3, 3], atol=2e-3)
+    assert plan.dominant_model == "b"
+    assert sum(plan.contributions.values()) == pytest.approx(plan.mixture)
+    base = CategoryPlanner(HAND, gs, regs, settings=CategorySettings(method="baseline")).plan()
+    np.testing.assert_allclose(base.pose, Tb @ TOP, atol=1e-12)
+    assert base.evaluations == 0 and base.dominant_model == "b"
+
+
+def test_an_obstacle_in_the_hand_pushes_the_grasp_away():
+    # a cloud point at the palm box's centre of the mapped grasp (30 mm behind the palm face)
+    T = rz(0.0)
+    G = T @ TOP
+    point = (G @ np.array([0.0, 0.0, -0.03, 1.0]))[:3]
+    p = CategoryPlanner(HAND, [grasp("a", TOP)], [Registration("a", T, phi=1.0)], cloud=point[None],
+                        settings=CategorySettings(method="regularised"), seed=3)
+    assert p.intrusion(G[None], 0.5)[0] > 0.02
+    plan = p.plan()
+    assert plan.intrusion == 0.0 and np.linalg.norm(plan.pose[:3, 3] - G[:3, 3]) > 0.01
+
+
+def test_no_grasp_results_name_the_reason():
+    T = rz(0.0)
+    none = CategoryPlanner(HAND, [grasp("a", TOP)], [Registration("a", T, phi=0.0, success=False)]).plan()
+    assert not none.ok and "no model registered" in none.reason and np.isnan(none.pose).all()
+    other = CategoryPlanner(HAND, [grasp("z", TOP)], [Registration("a", T, phi=1.0)]).plan()
+    assert "no demonstrated grasps" in other.reason
+    with pytest.raises(ValueError, match="registrations"):
+        CategoryPlanner(HAND, [grasp("a", TOP)], [])
+    with pytest.raises(ValueError, match="method"):
+        CategorySettings(method="uniform")
+    with pytest.raises(ValueError, match="cloud"):
+        CategoryPlanner(HAND, [grasp("a", TOP)], [Registration("a", T, phi=1.0)], cloud=np.full((2, 3), np.nan))
+
+
+def test_psi_by_hand():
+    np.testing.assert_allclose(psi([0.0, -0.1, 0.1, 0.2], 0.1, 0.01), [0.01, 0.01, 1 - np.exp(-1), 1 - np.exp(-2)])
