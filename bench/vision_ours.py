@@ -1,8 +1,8 @@
 """Our registration on the benchmark views, one model per call (the view's own model), single
 thread. With --registrar 1 (the default) the models are prepared once in a
-bayesgrasp._core.vision.Registrar before the timed calls (downsampled cloud, normals, FPFH, k-d
-trees), as bench/vision_open3d.py --model-cache 1 does for Open3D, and each timed call does only the
-per-view work; --registrar 0 times one-shot register_models calls that prepare the model inside.
+bayesgrasp._core.vision.Registrar before the timed calls (radius grid over the dense samples,
+downsampled cloud, normals, FPFH), as bench/vision_open3d.py --model-cache 1 does for Open3D, and each
+timed call does only the per-view work; --registrar 0 times one-shot register_models calls that prepare the model inside.
 --pcl-features 1 uses PCL's normal and FPFH estimators instead of ours (same definitions).
 Usage: python bench/vision_ours.py [--up-prior 0|1] [--registrar 0|1] [--pcl-features 0|1]
 Writes bench/results/vision_ours[_noprior][_oneshot].json (or --out)."""
@@ -33,9 +33,11 @@ def main():
         views = views[:a.limit]
     V = _core.vision
     samples = [(m["points"], m["normals"]) for m in models]
+    options = V.RegistrationOptions(voxel=voxel, threads=1)
+    options.up_prior.enabled = bool(a.up_prior)
+    options.features.estimator = V.FeatureEstimator.Pcl if a.pcl_features else V.FeatureEstimator.Ours
     t0 = time.perf_counter()
-    reg = V.Registrar(samples, voxel=voxel, up_prior=bool(a.up_prior), threads=1,
-                                pcl_features=bool(a.pcl_features)) if a.registrar else None
+    reg = V.Registrar(options, samples) if a.registrar else None
     t_prepare = time.perf_counter() - t0
     rows = []
     for i, v in enumerate(views):
@@ -44,13 +46,12 @@ def main():
         if reg is not None:
             r = reg.register(v["points"], seed=i, viewpoint=v["eye"], models=[v["model"]])[0]
         else:
-            r = V.register_models(v["points"], [samples[v["model"]]], voxel=voxel, seed=i, viewpoint=v["eye"],
-                                  up_prior=bool(a.up_prior), threads=1, pcl_features=bool(a.pcl_features))[0]
+            r = V.register_models(v["points"], [samples[v["model"]]], options, seed=i, viewpoint=v["eye"])[0]
         dt = time.perf_counter() - t0
-        rot, tr = errors(np.asarray(r["transform"]), v["T_true"], m["axis"])
+        rot, tr = errors(np.asarray(r.transform), v["T_true"], m["axis"])
         rows.append(dict(view=i, model=m["name"], time=dt, rot_deg=rot, trans_m=tr,
-                         success=bool(r["success"]) and rot < 10 and tr < 0.01, fitness=r["fitness"],
-                         time_features=r["time_features"], time_global=r["time_global"], time_icp=r["time_icp"]))
+                         success=r.success and rot < 10 and tr < 0.01, fitness=r.fitness,
+                         time_features=r.time_features, time_global=r.time_global, time_icp=r.time_icp))
     name = "ours (" + ("PCL" if a.pcl_features else "own") + " FPFH + seeded RANSAC " + ("4-DOF, up prior" if a.up_prior else "6-DOF, no prior") + " + ICP" \
         + (", models prepared once)" if a.registrar else ", one-shot)")
     s = summarise(name, rows)

@@ -1,5 +1,6 @@
-// Bindings for cpp/bayesgrasp/geometry: mesh checks and mass properties.
+// Bindings for cpp/bayesgrasp/geometry: mesh checks, mass properties and surface sampling.
 #include "bayesgrasp/geometry/mesh.hpp"
+#include "bayesgrasp/geometry/surface_sampling.hpp"
 #include "validate.hpp"
 
 namespace bayesgrasp::bind {
@@ -35,6 +36,27 @@ Returns:
     dict with ``volume`` (m^3, negative if faces are wound inwards), ``mass`` (kg),
     ``com`` (3,) centre of mass and ``inertia`` (3, 3) inertia tensor about the centre
     of mass (kg m^2), in the mesh frame.)doc");
+
+  py::class_<SurfaceSamples>(m, "SurfaceSamples", "Points and unit outward normals sampled on a surface.")
+      .def_readonly("points", &SurfaceSamples::points, "points : ndarray (N, 3)\n    sample positions, m")
+      .def_readonly("normals", &SurfaceSamples::normals,
+                    "normals : ndarray (N, 3)\n    unit outward normal of the face each sample lies on")
+      .def("__len__", [](const SurfaceSamples& s) { return s.points.rows(); });
+
+  m.def(
+      "sample_surface",
+      [](const DArray& vertices, const IArray& faces, int n, std::uint64_t seed) {
+        const TriMesh mesh = bind::mesh(vertices, faces);
+        py::gil_scoped_release release;
+        return sample_surface(mesh, n, seed);
+      },
+      py::arg("vertices"), py::arg("faces"), py::arg("n"), py::arg("seed") = 0,
+      "n points sampled uniformly (area-weighted) on a mesh surface, with the faces' unit normals "
+      "(SurfaceSamples). Seeded. ValueError for n <= 0 or a mesh without area.");
+
+  m.def(
+      "surface_area", [](const DArray& vertices, const IArray& faces) { return surface_area(bind::mesh(vertices, faces)); },
+      py::arg("vertices"), py::arg("faces"), "Total area of a triangle mesh (m^2).");
 }
 
 }  // namespace bayesgrasp::bind

@@ -1,13 +1,17 @@
 // Bindings for the vision concept: simulated depth camera, table segmentation, registration.
-// Thin: arguments are validated here (ValueError naming the argument), work is done in C++
-// with the GIL released.
+// Thin: the bindings check shapes and convert; the core validates values (std::invalid_argument
+// naming the argument becomes ValueError); work is done in C++ with the GIL released.
 #include <pybind11/eigen.h>
+#include <pybind11/native_enum.h>
 #include <pybind11/numpy.h>
 #include <pybind11/pybind11.h>
 #include <pybind11/stl.h>
 
+#include <algorithm>
+#include <memory>
 #include <optional>
 
+#include "bayesgrasp/geometry/surface_sampling.hpp"
 #include "bayesgrasp/vision/camera.hpp"
 #include "bayesgrasp/vision/registration.hpp"
 #include "bayesgrasp/vision/segmentation.hpp"
@@ -72,92 +76,294 @@ py::array_t<double> points_out(const Points& P) {
   return out;
 }
 
-py::dict result_dict(const RegistrationResult& r) {
-  py::dict d;
-  d["success"] = r.success;
-  d["reason"] = r.reason;
-  py::array_t<double> T({4, 4});
-  Eigen::Map<Eigen::Matrix<double, 4, 4, Eigen::RowMajor>>(T.mutable_data()) = r.transform;
-  d["transform"] = T;
-  d["fitness"] = r.fitness;
-  d["rmse"] = r.rmse;
-  d["delta"] = r.delta;
-  d["phi"] = r.phi;
-  d["weight"] = r.weight;
-  d["up_cos"] = r.up_cos;
-  d["cost"] = r.cost;
-  d["scene_points"] = r.scene_points;
-  d["model_points"] = r.model_points;
-  d["ransac_iterations"] = r.ransac_iterations;
-  d["time_features"] = r.time_features;
-  d["time_global"] = r.time_global;
-  d["time_icp"] = r.time_icp;
-  return d;
-}
-
-RegistrationParams params_arg(double voxel, bool up_prior, bool upright, const DArray& up, double max_tilt_deg,
-                              int restarts, int ransac_iterations, int hypotheses, int icp_iterations,
-                              int feature_neighbours, double normal_radius, double feature_radius,
-                              double inlier_distance, double icp_distance, double weight_sigma, int min_scene_points,
-                              int threads, bool reverse_matches, bool hellinger, bool pcl_features) {
-  RegistrationParams p;
-  p.voxel = positive(voxel, "voxel");
-  p.use_up_prior = up_prior;
-  p.upright = upright;
-  p.up = vector(up, "up", 3);
-  if (!(p.up.norm() > 0)) throw py::value_error("up: must be non-zero");
-  p.max_tilt = positive(max_tilt_deg, "max_tilt_deg") * 3.14159265358979323846 / 180.0;
-  auto pos_int = [](int v, const char* name) {
-    if (v < 1) throw py::value_error(std::string(name) + ": must be positive");
-    return v;
-  };
-  p.restarts = pos_int(restarts, "restarts");
-  p.ransac_iterations = pos_int(ransac_iterations, "ransac_iterations");
-  p.hypotheses = pos_int(hypotheses, "hypotheses");
-  if (icp_iterations < 0) throw py::value_error("icp_iterations: must be non-negative");
-  p.icp_iterations = icp_iterations;
-  p.feature_neighbours = pos_int(feature_neighbours, "feature_neighbours");
-  p.normal_radius = positive(normal_radius, "normal_radius");
-  p.feature_radius = positive(feature_radius, "feature_radius");
-  p.inlier_distance = positive(inlier_distance, "inlier_distance");
-  p.icp_distance = positive(icp_distance, "icp_distance");
-  p.weight_sigma = positive(weight_sigma, "weight_sigma");
-  p.min_scene_points = pos_int(min_scene_points, "min_scene_points");
-  if (threads < 0) throw py::value_error("threads: must be non-negative");
-  p.threads = threads;
-  p.reverse_matches = reverse_matches;
-  p.hellinger = hellinger;
-  p.pcl_features = pcl_features;
-  return p;
-}
-
-std::vector<ModelCloud> models_arg(const py::list& models, bool allow_empty = false) {
+// ---- registration: inputs
+std::vector<ModelCloud> models_arg(const py::list& models) {
   std::vector<ModelCloud> ms;
   for (std::size_t i = 0; i < models.size(); ++i) {
     const std::string name = "models[" + std::to_string(i) + "]";
-    const py::tuple t = pair_at(models, i, name, "points, normals");
     ModelCloud mc;
-    mc.surface.points = points_arg(t[0].cast<DArray>(), (name + " points").c_str(), false);
-    mc.surface.normals = points_arg(t[1].cast<DArray>(), (name + " normals").c_str(), false);
+    if (py::isinstance<SurfaceSamples>(models[i])) {
+      mc.surface = models[i].cast<SurfaceSamples>();
+    } else {
+      const py::tuple t = pair_at(models, i, name, "points, normals");
+      mc.surface.points = points_arg(t[0].cast<DArray>(), (name + " points").c_str(), false);
+      mc.surface.normals = points_arg(t[1].cast<DArray>(), (name + " normals").c_str(), false);
+    }
     if (mc.surface.points.rows() != mc.surface.normals.rows())
       throw py::value_error(name + ": points and normals differ in length");
     ms.push_back(std::move(mc));
   }
-  if (ms.empty() && !allow_empty) throw py::value_error("models: is empty");
   return ms;
 }
 
-Points scene_arg(const DArray& cloud) {
-  Points S = points_arg(cloud, "cloud", true);
-  bool any_finite = false;
-  for (Eigen::Index i = 0; i < S.rows() && !any_finite; ++i) any_finite = S.row(i).allFinite();
-  if (!any_finite) throw py::value_error("cloud: has no finite points");
-  return S;
-}
-
+// The viewpoint's shape; the core checks that it is finite.
 std::optional<Vec3> viewpoint_arg(const py::object& viewpoint) {
   if (viewpoint.is_none()) return std::nullopt;
-  return Vec3(vector(viewpoint.cast<DArray>(), "viewpoint", 3));
+  const DArray a = viewpoint.cast<DArray>();
+  if (a.ndim() != 1 || a.shape(0) != 3)
+    throw py::value_error("viewpoint: expected shape (3,), got " + shape_str(a));
+  return Vec3(a.data()[0], a.data()[1], a.data()[2]);
+}
+
+std::optional<std::vector<int>> indices_arg(const py::object& models) {
+  if (models.is_none()) return std::nullopt;
+  try {
+    return models.cast<std::vector<int>>();
+  } catch (const py::cast_error&) {
+    throw py::value_error("models: expected a sequence of model indices");
+  }
+}
+
+// ---- registration: option classes with a "name : type\n    description" docstring per field,
+// a keyword constructor (unknown keywords are a ValueError naming them), __repr__ and copies.
+template <typename C>
+class OptionClass {
+ public:
+  OptionClass(py::module_& m, const char* name, const char* doc) : cls_(m, name, doc), name_(name) {}
+
+  template <typename T>
+  OptionClass& field(const char* name, T C::*member, const char* type, const char* doc) {
+    cls_.def_readwrite(name, member, (std::string(name) + " : " + type + "\n    " + doc).c_str());
+    fields_->push_back(name);
+    return *this;
+  }
+
+  void finish() {
+    const auto fields = fields_;
+    const std::string cname = name_;
+    cls_.def(py::init([fields, cname](const py::kwargs& kw) {
+               py::object self = py::cast(C{});
+               for (const auto& item : kw) {
+                 const std::string key = py::str(item.first);
+                 if (std::find(fields->begin(), fields->end(), key) == fields->end())
+                   throw py::value_error(key + ": not a field of " + cname);
+                 self.attr(key.c_str()) = item.second;
+               }
+               return self.cast<C>();
+             }),
+             ("Defaults, with any field given by keyword: " + cname + "(name=value, ...).").c_str())
+        .def("__repr__",
+             [fields, cname](const py::object& self) {
+               std::string s = cname + "(";
+               for (std::size_t i = 0; i < fields->size(); ++i)
+                 s += (i ? ", " : "") + (*fields)[i] + "=" + std::string(py::repr(self.attr((*fields)[i].c_str())));
+               return s + ")";
+             })
+        .def("__copy__", [](const C& c) { return C(c); })
+        .def("__deepcopy__", [](const C& c, const py::object&) { return C(c); }, py::arg("memo"));
+  }
+
+  py::class_<C>& cls() { return cls_; }
+
+ private:
+  py::class_<C> cls_;
+  std::string name_;
+  std::shared_ptr<std::vector<std::string>> fields_ = std::make_shared<std::vector<std::string>>();
+};
+
+void bind_options(py::module_& m) {
+  py::native_enum<FeatureEstimator>(m, "FeatureEstimator", "enum.Enum",
+                                    "Which normal and FPFH estimator prepares the clouds for matching.")
+      .value("Ours", FeatureEstimator::Ours, "one shared radius-grid search per point, each pair computed once")
+      .value("Pcl", FeatureEstimator::Pcl, "PCL's NormalEstimationOMP + FPFHEstimationOMP (same definitions)")
+      .finalize();
+
+  OptionClass<FeatureOptions> features(m, "FeatureOptions", "Normals and FPFH descriptors.");
+  features.field("normal_radius", &FeatureOptions::normal_radius, "float", "x voxel: PCA neighbourhood of a normal")
+      .field("feature_radius", &FeatureOptions::feature_radius, "float", "x voxel: FPFH neighbourhood")
+      .field("estimator", &FeatureOptions::estimator, "FeatureEstimator", "ours or PCL's")
+      .finish();
+
+  OptionClass<CorrespondenceOptions> corr(m, "CorrespondenceOptions", "Feature correspondences scene <-> model.");
+  corr.field("neighbours", &CorrespondenceOptions::neighbours, "int", "per scene feature: its k nearest model features")
+      .field("reverse", &CorrespondenceOptions::reverse, "bool", "also each model feature's nearest scene feature")
+      .field("hellinger", &CorrespondenceOptions::hellinger, "bool",
+             "compare sqrt(histograms) (Hellinger distance) instead of raw L2")
+      .finish();
+
+  OptionClass<RansacOptions> ransac(m, "RansacOptions", "The seeded RANSAC over correspondences and its hypotheses.");
+  ransac.field("iterations", &RansacOptions::iterations, "int", "maximum per restart")
+      .field("min_iterations", &RansacOptions::min_iterations, "int", "per restart, whatever the confidence bound says")
+      .field("confidence", &RansacOptions::confidence, "float", "of the adaptive stopping bound, in (0, 1)")
+      .field("edge_similarity", &RansacOptions::edge_similarity, "float",
+             "pre-rejection: corresponding edge lengths agree to this ratio, in (0, 1)")
+      .field("max_normal_angle", &RansacOptions::max_normal_angle, "float",
+             "pre-rejection: matched normals agree within this angle (rad)")
+      .field("restarts", &RansacOptions::restarts, "int", "independent runs (seeds derived from the call's seed)")
+      .field("candidates", &RansacOptions::candidates, "int", "distinct hypotheses kept per restart (by consensus)")
+      .field("hypotheses", &RansacOptions::hypotheses, "int",
+             "best candidates over all restarts (by fitting error) refined by a coarse ICP")
+      .finish();
+
+  OptionClass<IcpOptions> icp(m, "IcpOptions", "Point-to-plane ICP against the model's dense surface samples.");
+  icp.field("distance", &IcpOptions::distance, "float", "x voxel: correspondence distance")
+      .field("iterations", &IcpOptions::iterations, "int", "full ICP of the chosen hypothesis")
+      .field("tolerance", &IcpOptions::tolerance, "float", "stop when the update is below this (rad, m)")
+      .field("coarse_points", &IcpOptions::coarse_points, "int", "scene subsample for the coarse ICP of every hypothesis")
+      .field("coarse_iterations", &IcpOptions::coarse_iterations, "int", "iterations of the coarse ICP")
+      .finish();
+
+  OptionClass<UpPrior> up(m, "UpPrior",
+                          "A model resting on the table keeps its +z (model frame) near `up` (cloud frame).");
+  up.field("enabled", &UpPrior::enabled, "bool", "False: 6-DOF search, no tilt limit, no up penalty")
+      .field("upright", &UpPrior::upright, "bool",
+             "4-DOF hypotheses (yaw about up + translation, 2 correspondences); else 6-DOF with a tilt limit")
+      .field("up", &UpPrior::up, "ndarray (3,)", "the table normal in the cloud's frame")
+      .field("max_tilt", &UpPrior::max_tilt, "float", "rad: 6-DOF hypotheses tilting the model's up more are rejected")
+      .field("weight", &UpPrior::weight, "float", "selection cost += weight (1 - cos tilt) / 2")
+      .finish();
+
+  OptionClass<RegistrationOptions> reg(m, "RegistrationOptions",
+                                       "Options of the registration, one struct per step; radii and distances are "
+                                       "multiples of voxel. validate() checks them (ValueError naming the field).");
+  reg.field("voxel", &RegistrationOptions::voxel, "float", "m: downsampling leaf, the unit of every radius and distance")
+      .field("inlier_distance", &RegistrationOptions::inlier_distance, "float",
+             "x voxel: RANSAC inliers, fitness, RMSE and the cut-off tau of delta")
+      .field("weight_sigma", &RegistrationOptions::weight_sigma, "float", "x voxel: sigma of phi(delta)")
+      .field("min_scene_points", &RegistrationOptions::min_scene_points, "int",
+             "scene points with normals after downsampling below which every model fails (TooFewScenePoints)")
+      .field("model_samples", &RegistrationOptions::model_samples, "int",
+             "points sampled per model mesh; 0: area / (voxel/3)^2, clamped to [2000, 200000]")
+      .field("threads", &RegistrationOptions::threads, "int", "over models and scene features; 0 = all cores")
+      .field("features", &RegistrationOptions::features, "FeatureOptions", "normals and FPFH")
+      .field("correspondences", &RegistrationOptions::correspondences, "CorrespondenceOptions", "feature matching")
+      .field("ransac", &RegistrationOptions::ransac, "RansacOptions", "global registration")
+      .field("icp", &RegistrationOptions::icp, "IcpOptions", "local refinement")
+      .field("up_prior", &RegistrationOptions::up_prior, "UpPrior", "upright models on a table")
+      .finish();
+  reg.cls().def("validate", [](const RegistrationOptions& o) { validate(o); },
+                "Raises ValueError naming the first bad field.");
+}
+
+// ---- registration: results
+template <typename C, typename T>
+void readonly(py::class_<C>& cls, const char* name, T C::*member, const char* type, const char* doc) {
+  cls.def_readonly(name, member, (std::string(name) + " : " + type + "\n    " + doc).c_str());
+}
+
+void bind_results(py::module_& m) {
+  py::native_enum<RegistrationStatus>(m, "RegistrationStatus", "enum.Enum", "Why a model did or did not register.")
+      .value("Ok", RegistrationStatus::Ok)
+      .value("NoSurface", RegistrationStatus::NoSurface, "the model has no surface points")
+      .value("InvalidModel", RegistrationStatus::InvalidModel, "its points or normals are not finite")
+      .value("TooFewModelPoints", RegistrationStatus::TooFewModelPoints,
+             "fewer than 3 model points with normals after downsampling")
+      .value("TooFewScenePoints", RegistrationStatus::TooFewScenePoints,
+             "fewer than min_scene_points scene points with normals after downsampling")
+      .value("NoHypothesis", RegistrationStatus::NoHypothesis, "RANSAC found no transform")
+      .value("NonFiniteTransform", RegistrationStatus::NonFiniteTransform, "the refinement diverged")
+      .finalize();
+
+  py::class_<RegistrationResult> r(m, "RegistrationResult", "One model's registration against a cloud.");
+  readonly(r, "status", &RegistrationResult::status, "RegistrationStatus", "Ok, or why the model did not register");
+  readonly(r, "reason", &RegistrationResult::reason, "str", "human-readable, when status is not Ok");
+  readonly(r, "transform", &RegistrationResult::transform, "ndarray (4, 4)",
+           "model frame -> cloud frame (identity when status is not Ok)");
+  readonly(r, "fitness", &RegistrationResult::fitness, "float",
+           "fraction of downsampled cloud points within the inlier distance");
+  readonly(r, "rmse", &RegistrationResult::rmse, "float", "RMS distance of those inliers, m");
+  readonly(r, "delta", &RegistrationResult::delta, "float",
+           "fitting error sqrt(mean min(d_i, tau)^2), m (Eq. 4.1's delta_i)");
+  readonly(r, "phi", &RegistrationResult::phi, "float",
+           "phi(delta) = exp(-delta^2 / (2 sigma^2)), sigma = weight_sigma voxels, unnormalised");
+  readonly(r, "up_cos", &RegistrationResult::up_cos, "float", "cos of the angle between the model's +z and `up`");
+  readonly(r, "cost", &RegistrationResult::cost, "float", "selection cost of the chosen hypothesis");
+  readonly(r, "scene_points", &RegistrationResult::scene_points, "int", "cloud points after downsampling");
+  readonly(r, "model_points", &RegistrationResult::model_points, "int", "model points after downsampling");
+  readonly(r, "ransac_iterations", &RegistrationResult::ransac_iterations, "int", "total over restarts");
+  readonly(r, "time_features", &RegistrationResult::time_features, "float",
+           "s: the cloud's features (register_models: plus the model's preparation)");
+  readonly(r, "time_global", &RegistrationResult::time_global, "float", "s: correspondences and RANSAC");
+  readonly(r, "time_icp", &RegistrationResult::time_icp, "float", "s: hypothesis choice, ICP and fit measures");
+  r.def_property_readonly("success", &RegistrationResult::success, "success : bool\n    status is Ok");
+  r.def("__repr__", [](const RegistrationResult& x) {
+    return "RegistrationResult(status=" + std::string(py::str(py::cast(x.status))) + ", delta=" +
+           std::to_string(x.delta) + ", phi=" + std::to_string(x.phi) + ", fitness=" + std::to_string(x.fitness) + ")";
+  });
+
+  py::class_<PreparedModelInfo> info(m, "PreparedModelInfo", "A model's preparation in a Registrar.");
+  readonly(info, "status", &PreparedModelInfo::status, "RegistrationStatus",
+           "Ok, NoSurface, InvalidModel or TooFewModelPoints");
+  readonly(info, "reason", &PreparedModelInfo::reason, "str", "human-readable, when status is not Ok");
+  readonly(info, "points", &PreparedModelInfo::points, "int", "points after downsampling");
+  readonly(info, "time", &PreparedModelInfo::time, "float", "s spent preparing it");
+  info.def_property_readonly("ok", &PreparedModelInfo::ok, "ok : bool\n    status is Ok");
+}
+
+// ---- registration: calls
+void bind_registration(py::module_& m) {
+  bind_options(m);
+  bind_results(m);
+
+  m.def(
+      "register_models",
+      [](const DArray& cloud, const py::list& models, const RegistrationOptions& options, std::uint64_t seed,
+         const py::object& viewpoint) {
+        const Points S = points_arg(cloud, "cloud", true);
+        const std::vector<ModelCloud> ms = models_arg(models);
+        const std::optional<Vec3> vp = viewpoint_arg(viewpoint);
+        py::gil_scoped_release release;
+        return register_models(S, ms, options, seed, vp);
+      },
+      py::arg("cloud"), py::arg("models"), py::arg("options") = RegistrationOptions(), py::arg("seed") = 0,
+      py::arg("viewpoint") = py::none(),
+      "Registers a partial cloud (N, 3; NaN rows dropped) against models [(points (M,3), outward normals "
+      "(M,3)) or SurfaceSamples, ...] (see model_from_mesh). One shot: the models are prepared (downsampled, "
+      "normals, FPFH) inside the call; use Registrar to prepare them once for many clouds. `viewpoint`: the "
+      "camera centre (cloud normals point towards it). Returns one RegistrationResult per model; "
+      "time_features includes the model's preparation.");
+
+  py::class_<Registrar>(m, "Registrar",
+                        "Object models prepared once (radius grid over the dense samples, downsampled cloud, "
+                        "normals, FPFH) and registered against any number of partial clouds. Same options, seed "
+                        "and viewpoint: the same result as register_models.")
+      .def(py::init([](const RegistrationOptions& options, const py::list& models) {
+             const std::vector<ModelCloud> ms = models_arg(models);
+             auto r = std::make_unique<Registrar>(options);
+             py::gil_scoped_release release;
+             r->add_models(ms);
+             return r;
+           }),
+           py::arg("options") = RegistrationOptions(), py::arg("models") = py::list(),
+           "Validates the options and prepares the models (see add_models).")
+      .def(
+          "add_models",
+          [](Registrar& r, const py::list& models) {
+            const std::vector<ModelCloud> ms = models_arg(models);
+            py::gil_scoped_release release;
+            return r.add_models(ms);
+          },
+          py::arg("models"),
+          "Prepares and appends models [(points (M,3), outward normals (M,3)) or SurfaceSamples, ...]; returns "
+          "the index of the first. A model that cannot be prepared is kept with a failed status.")
+      .def(
+          "register",
+          [](const Registrar& r, const DArray& cloud, std::uint64_t seed, const py::object& viewpoint,
+             const py::object& models) {
+            const Points S = points_arg(cloud, "cloud", true);
+            const std::optional<Vec3> vp = viewpoint_arg(viewpoint);
+            const std::optional<std::vector<int>> idx = indices_arg(models);
+            py::gil_scoped_release release;
+            return idx ? r.register_scene(S, seed, vp, *idx) : r.register_scene(S, seed, vp);
+          },
+          py::arg("cloud"), py::arg("seed") = 0, py::arg("viewpoint") = py::none(), py::arg("models") = py::none(),
+          "Registers a partial cloud (N, 3; NaN rows dropped) against the prepared models (`models`: indices, "
+          "None for all). Returns one RegistrationResult per model (time_features: the cloud's features only).")
+      .def("__len__", &Registrar::size)
+      .def_property_readonly("options", [](const Registrar& r) { return r.options(); },
+                             "options : RegistrationOptions\n    a copy of the options (fixed at construction)")
+      .def("model_info", &Registrar::model_info, py::arg("i"), "PreparedModelInfo of model i.");
+
+  m.def(
+      "model_from_mesh",
+      [](const DArray& vertices, const IArray& faces, const RegistrationOptions& options, std::uint64_t seed) {
+        const TriMesh M = mesh(vertices, faces, "mesh");
+        py::gil_scoped_release release;
+        return model_from_mesh(M, options, seed).surface;
+      },
+      py::arg("vertices"), py::arg("faces"), py::arg("options") = RegistrationOptions(), py::arg("seed") = 0,
+      "Surface samples of a mesh for registration: options.model_samples points (0: area / (voxel/3)^2, "
+      "clamped to [2000, 200000]), a SurfaceSamples. ValueError if the mesh has no area.");
 }
 
 }  // namespace
@@ -304,174 +510,7 @@ void bind_vision(py::module_& m) {
       "(normal oriented along `up`), points between min_height and max_height above it, Euclidean "
       "clusters. Returns {'plane': (a, b, c, d), 'plane_inliers': rows, 'clusters': [rows, ...] largest first}.");
 
-  m.def(
-      "sample_surface",
-      [](const DArray& V, const IArray& F, int n, std::uint64_t seed) {
-        const TriMesh M = mesh(V, F, "mesh");
-        if (n <= 0) throw py::value_error("n: must be positive");
-        SurfaceSamples s;
-        try {
-          py::gil_scoped_release release;
-          s = sample_surface(M, n, seed);
-        } catch (const std::invalid_argument& e) {
-          throw py::value_error(std::string("mesh: ") + e.what());
-        }
-        return py::make_tuple(points_out(s.points), points_out(s.normals));
-      },
-      py::arg("vertices"), py::arg("faces"), py::arg("n"), py::arg("seed") = 0,
-      "n points sampled uniformly (area-weighted) on a mesh surface, with the faces' unit normals: (points, normals).");
-
-  m.def("surface_area", [](const DArray& V, const IArray& F) { return surface_area(mesh(V, F, "mesh")); },
-        py::arg("vertices"), py::arg("faces"), "Total area of a triangle mesh (m^2).");
-
-  m.def(
-      "register_models",
-      [](const DArray& scene, const py::list& models, double voxel, std::uint64_t seed, bool up_prior, bool upright,
-         const DArray& up, double max_tilt_deg, py::object viewpoint, int restarts, int ransac_iterations,
-         int hypotheses, int icp_iterations, int feature_neighbours, double normal_radius, double feature_radius,
-         double inlier_distance, double icp_distance, double weight_sigma, int min_scene_points, int threads,
-         bool reverse_matches, bool hellinger, bool pcl_features) {
-        const Points S = scene_arg(scene);
-        RegistrationParams p = params_arg(voxel, up_prior, upright, up, max_tilt_deg, restarts, ransac_iterations,
-                                          hypotheses, icp_iterations, feature_neighbours, normal_radius,
-                                          feature_radius, inlier_distance, icp_distance, weight_sigma,
-                                          min_scene_points, threads, reverse_matches, hellinger, pcl_features);
-        p.seed = seed;
-        const std::optional<Vec3> vp = viewpoint_arg(viewpoint);
-        p.has_viewpoint = vp.has_value();
-        if (vp) p.viewpoint = *vp;
-        const std::vector<ModelCloud> ms = models_arg(models);
-        std::vector<RegistrationResult> res;
-        {
-          py::gil_scoped_release release;
-          res = register_models(S, ms, p);
-        }
-        py::list out;
-        for (const auto& r : res) out.append(result_dict(r));
-        return out;
-      },
-      py::arg("cloud"), py::arg("models"), py::arg("voxel") = 0.005, py::arg("seed") = 0, py::arg("up_prior") = true,
-      py::arg("upright") = true, py::arg("up") = Eigen::Vector3d::UnitZ(), py::arg("max_tilt_deg") = 60.0,
-      py::arg("viewpoint") = py::none(), py::arg("restarts") = 3, py::arg("ransac_iterations") = 20000,
-      py::arg("hypotheses") = 4, py::arg("icp_iterations") = 30, py::arg("feature_neighbours") = 2,
-      py::arg("normal_radius") = 2.0, py::arg("feature_radius") = 5.0, py::arg("inlier_distance") = 1.5,
-      py::arg("icp_distance") = 1.5, py::arg("weight_sigma") = 0.5, py::arg("min_scene_points") = 30,
-      py::arg("threads") = 0, py::arg("reverse_matches") = true, py::arg("hellinger") = true,
-      py::arg("pcl_features") = false,
-      "Registers a partial cloud (N, 3; NaN rows dropped) against models [(points (M,3), outward normals "
-      "(M,3)), ...] (surface samples; see model_from_mesh). Radii and distances are multiples of `voxel`. "
-      "One shot: the models are prepared (downsampled, normals, FPFH) inside the call; use Registrar to "
-      "prepare them once for many clouds. Returns one dict per model: success, reason, transform (4x4 "
-      "model->scene), fitness, rmse, delta, phi = exp(-delta^2 / (2 (weight_sigma voxel)^2)), weight (phi "
-      "normalised over successful models), up_cos, cost, scene_points, model_points, ransac_iterations, "
-      "time_features/global/icp (s; time_features includes the model's preparation).");
-
-  py::class_<Registrar>(m, "Registrar",
-                        "Object models prepared once (dense k-d tree, downsampled cloud, normals, FPFH) and "
-                        "registered against any number of partial clouds. Same parameters, seed and viewpoint: "
-                        "the same result as register_models.")
-      .def(py::init([](const py::list& models, double voxel, bool up_prior, bool upright, const DArray& up,
-                       double max_tilt_deg, int restarts, int ransac_iterations, int hypotheses, int icp_iterations,
-                       int feature_neighbours, double normal_radius, double feature_radius, double inlier_distance,
-                       double icp_distance, double weight_sigma, int min_scene_points, int threads,
-                       bool reverse_matches, bool hellinger, bool pcl_features) {
-             const RegistrationParams p = params_arg(voxel, up_prior, upright, up, max_tilt_deg, restarts,
-                                                     ransac_iterations, hypotheses, icp_iterations,
-                                                     feature_neighbours, normal_radius, feature_radius,
-                                                     inlier_distance, icp_distance, weight_sigma, min_scene_points,
-                                                     threads, reverse_matches, hellinger, pcl_features);
-             const std::vector<ModelCloud> ms = models_arg(models, true);
-             auto r = std::make_unique<Registrar>(p);
-             {
-               py::gil_scoped_release release;
-               r->add_models(ms);
-             }
-             return r;
-           }),
-           py::arg("models"), py::arg("voxel") = 0.005, py::arg("up_prior") = true, py::arg("upright") = true,
-           py::arg("up") = Eigen::Vector3d::UnitZ(), py::arg("max_tilt_deg") = 60.0, py::arg("restarts") = 3,
-           py::arg("ransac_iterations") = 20000, py::arg("hypotheses") = 4, py::arg("icp_iterations") = 30,
-           py::arg("feature_neighbours") = 2, py::arg("normal_radius") = 2.0, py::arg("feature_radius") = 5.0,
-           py::arg("inlier_distance") = 1.5, py::arg("icp_distance") = 1.5, py::arg("weight_sigma") = 0.5,
-           py::arg("min_scene_points") = 30, py::arg("threads") = 0, py::arg("reverse_matches") = true,
-           py::arg("hellinger") = true, py::arg("pcl_features") = false,
-           "Prepares the models [(points (M,3), outward normals (M,3)), ...] (may be empty; see add_models) "
-           "with the parameters of register_models.")
-      .def(
-          "add_models",
-          [](Registrar& r, const py::list& models) {
-            const std::vector<ModelCloud> ms = models_arg(models);
-            py::gil_scoped_release release;
-            return r.add_models(ms);
-          },
-          py::arg("models"), "Prepares and appends models; returns the index of the first.")
-      .def(
-          "register",
-          [](const Registrar& r, const DArray& cloud, std::uint64_t seed, py::object viewpoint, py::object models) {
-            const Points S = scene_arg(cloud);
-            const std::optional<Vec3> vp = viewpoint_arg(viewpoint);
-            std::vector<int> idx;
-            if (!models.is_none()) {
-              try {
-                idx = models.cast<std::vector<int>>();
-              } catch (const py::cast_error&) {
-                throw py::value_error("models: expected a sequence of model indices");
-              }
-              if (idx.empty()) throw py::value_error("models: is empty");
-              for (int i : idx)
-                if (i < 0 || i >= r.size())
-                  throw py::value_error("models: index " + std::to_string(i) + " out of range [0, " +
-                                        std::to_string(r.size()) + ")");
-            }
-            if (r.size() == 0) throw py::value_error("models: the registrar has no models");
-            std::vector<RegistrationResult> res;
-            {
-              py::gil_scoped_release release;
-              res = r.register_scene(S, seed, vp, idx);
-            }
-            py::list out;
-            for (const auto& x : res) out.append(result_dict(x));
-            return out;
-          },
-          py::arg("cloud"), py::arg("seed") = 0, py::arg("viewpoint") = py::none(), py::arg("models") = py::none(),
-          "Registers a partial cloud (N, 3; NaN rows dropped) against the prepared models (`models`: indices, "
-          "None for all). Returns one dict per model as register_models does (time_features: the cloud's "
-          "features only); weights are normalised over the models of the call.")
-      .def("__len__", &Registrar::size)
-      .def_property_readonly("voxel", [](const Registrar& r) { return r.params().voxel; })
-      .def(
-          "model_info",
-          [](const Registrar& r, int i) {
-            if (i < 0 || i >= r.size()) throw py::value_error("i: model index out of range");
-            py::dict d;
-            d["ok"] = r.model_ok(i);
-            d["reason"] = r.model_reason(i);
-            d["model_points"] = r.model_points(i);
-            d["time"] = r.model_time(i);
-            return d;
-          },
-          py::arg("i"), "{'ok', 'reason', 'model_points' (after downsampling), 'time' (s to prepare)} of model i.");
-
-  m.def(
-      "model_from_mesh",
-      [](const DArray& V, const IArray& F, double voxel, std::uint64_t seed, int samples) {
-        const TriMesh M = mesh(V, F, "mesh");
-        RegistrationParams p;
-        p.voxel = positive(voxel, "voxel");
-        if (samples < 0) throw py::value_error("samples: must be non-negative");
-        p.model_samples = samples;
-        ModelCloud mc;
-        try {
-          py::gil_scoped_release release;
-          mc = model_from_mesh(M, p, seed);
-        } catch (const std::invalid_argument& e) {
-          throw py::value_error(std::string("mesh: ") + e.what());
-        }
-        return py::make_tuple(points_out(mc.surface.points), points_out(mc.surface.normals));
-      },
-      py::arg("vertices"), py::arg("faces"), py::arg("voxel") = 0.005, py::arg("seed") = 0, py::arg("samples") = 0,
-      "Surface samples of a mesh for registration: `samples` points (0: area / (voxel/3)^2, clamped to "
-      "[2000, 200000]); returns (points, normals). ValueError if the mesh has no area.");
+  bind_registration(m);
 
   m.def(
       "rotation_error",

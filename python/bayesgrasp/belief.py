@@ -263,3 +263,22 @@ def _single_core_model(gp):
     if models is not None and len(models) == 1 and isinstance(models[0], _core.gp.GaussianProcess):
         return models[0]
     return None
+
+
+def shape_weights(phi, success) -> np.ndarray:
+    """Weights of the models of one registration call (Eq. 4.1's phi(delta_i), normalised).
+
+    ``phi``: (M,) phi(delta_i) of each model; ``success``: (M,) whether model i registered.
+    Returns (M,) float64: ``phi_i / sum_j phi_j`` over the models that registered (summed in model
+    order), 0 for the others. If no model registered, or every registered phi is 0, every weight
+    is 0 (never NaN): there is then no shape evidence to weight by. ValueError for mismatched
+    lengths or a registered phi that is negative or not finite."""
+    p = np.asarray(phi, dtype=np.float64).ravel()
+    ok = np.asarray(success, dtype=bool).ravel()
+    if p.shape != ok.shape:
+        raise ValueError(f"phi, success: lengths differ ({p.size} vs {ok.size})")
+    if not np.all(np.isfinite(p[ok])) or np.any(p[ok] < 0):
+        raise ValueError("phi: must be finite and >= 0 for the models that registered")
+    w = np.where(ok, p, 0.0)
+    total = float(np.cumsum(w)[-1]) if w.size else 0.0
+    return w / total if total > 0 else np.zeros_like(w)

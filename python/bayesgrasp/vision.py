@@ -6,6 +6,9 @@ structured-light noise model, PCL's plane RANSAC and Euclidean clustering, and a
 pipeline of voxel downsampling (PCL), normals and FPFH features, a seeded RANSAC over feature
 correspondences, point-to-plane ICP, and a hypothesis choice that penalises upside-down fits.
 To register many clouds against the same models, prepare the models once in a :class:`Registrar`.
+The registration's settings are a :class:`RegistrationOptions` (one option class per step:
+``features``, ``correspondences``, ``ransac``, ``icp``, ``up_prior``); :func:`register` and
+:class:`Registrar` take one, and the flat keywords listed in :func:`registration_options`.
 
 >>> from bayesgrasp.vision import Camera, segment_table, register
 >>> cam = Camera.looking_at(eye=(0.5, -0.5, 0.5), target=(0, 0, 0.05))
@@ -13,8 +16,11 @@ To register many clouds against the same models, prepare the models once in a :c
 >>> seg = segment_table(cloud)                                 # clusters, largest first
 >>> results = register(seg.cluster_points[0], [model_a, model_b], viewpoint=cam.eye)
 >>> results[0].transform, results[0].fitness, results[0].weight
->>> reg = Registrar([model_a, model_b])                        # models prepared once
+>>> opts = RegistrationOptions(voxel=0.004)
+>>> opts.ransac.restarts = 6
+>>> reg = Registrar([model_a, model_b], opts)                  # models prepared once
 >>> results = reg.register(seg.cluster_points[0], viewpoint=cam.eye)
+>>> [r.status for r in results]                                # RegistrationStatus.Ok, ...
 
 Conventions: metres; world frame z up with the table top at z = 0; camera frame x right, y down,
 z forward; depth images hold the camera-frame z (NaN where nothing is measured).
@@ -22,33 +28,48 @@ z forward; depth images hold the camera-frame z (NaN where nothing is measured).
 Fitting error and weight (Eq. 4.1's phi(delta)): ``delta = sqrt(mean_i min(d_i, tau)^2)`` over
 the downsampled scene points, ``d_i`` the distance to the registered model surface and
 ``tau = 1.5 voxel``; ``phi = exp(-delta^2 / (2 sigma^2))`` with ``sigma = 0.5 voxel`` (unnormalised);
-``weight = phi / sum(phi)`` over the models of one call that registered successfully.
+``weight = phi / sum(phi)`` over the models of one call that registered successfully
+(:func:`bayesgrasp.belief.shape_weights`).
 
 By default registration assumes the cloud is in the world frame (z up) and the models rest upright
 on the table in their own frame (+z up, as the built-in objects do): hypotheses are searched over
 yaw and translation, refined in 6 DOF by ICP, and upside-down fits are penalised. Pass
-``up_prior=False`` for arbitrary orientations (6-DOF search, no penalty), or ``up=`` the table
-normal in the cloud's frame.
+``up_prior=False`` (``options.up_prior.enabled = False``) for arbitrary orientations (6-DOF
+search, no penalty), or ``up=`` the table normal in the cloud's frame.
+
+A model that cannot be registered gives a result with ``success=False``, a
+:class:`RegistrationStatus` (``NoSurface``, ``TooFewScenePoints``, ``NoHypothesis``, ...) and a
+human-readable ``reason``; bad input (an empty cloud, no models, bad options) is a ``ValueError``.
 """
 from __future__ import annotations
 
 import json
 import math
 from dataclasses import dataclass, field
-from typing import Any, List, Optional, Sequence, Tuple, Union
+from typing import Any, Callable, Dict, List, Optional, Sequence, Tuple, Union
 
 import numpy as np
 
+from bayesgrasp import _core as _bgcore
+from bayesgrasp.belief import shape_weights
+
 __all__ = [
     "Camera", "SegmentationResult", "RegistrationResult", "Registrar", "segment_table", "register",
-    "model_samples", "rotation_error", "register_command", "as_cloud", "as_mesh",
+    "model_samples", "rotation_error", "register_command", "as_cloud", "as_mesh", "registration_options",
+    "RegistrationOptions", "FeatureOptions", "CorrespondenceOptions", "RansacOptions", "IcpOptions", "UpPrior",
+    "FeatureEstimator", "RegistrationStatus",
 ]
 
+_v = _bgcore.vision
 
-def _core():
-    from bayesgrasp import _core
-
-    return _core.vision
+RegistrationOptions = _v.RegistrationOptions
+FeatureOptions = _v.FeatureOptions
+CorrespondenceOptions = _v.CorrespondenceOptions
+RansacOptions = _v.RansacOptions
+IcpOptions = _v.IcpOptions
+UpPrior = _v.UpPrior
+FeatureEstimator = _v.FeatureEstimator
+RegistrationStatus = _v.RegistrationStatus
 
 
 # ---------------------------------------------------------------------------------------------
@@ -112,7 +133,7 @@ class Camera:
     @classmethod
     def looking_at(cls, eye, target, up=(0.0, 0.0, 1.0), **intrinsics) -> "Camera":
         """A camera at ``eye`` looking at ``target`` (world frame), image up towards ``up``."""
-        pose = _core().look_at(np.asarray(eye, float), np.asarray(target, float), np.asarray(up, float))
+        pose = _v.look_at(np.asarray(eye, float), np.asarray(target, float), np.asarray(up, float))
         return cls(pose=np.asarray(pose), **intrinsics)
 
     @property
@@ -139,7 +160,7 @@ class Camera:
         kw = dict(table=bool(table), table_z=float(tb.get("z", 0.0)),
                   table_center=np.asarray(tb.get("center", (0.0, 0.0)), float),
                   table_half_extents=np.asarray(tb.get("half_extents", (0.5, 0.5)), float))
-        depth, label = _core().render(ms, self.pose, width=int(self.width), height=int(self.height), **self._intr(),
+        depth, label = _v.render(ms, self.pose, width=int(self.width), height=int(self.height), **self._intr(),
                                       noise=bool(noise), seed=int(seed), **kw, **noise_params)
         return np.asarray(depth), np.asarray(label)
 
@@ -149,7 +170,7 @@ class Camera:
         depth = np.asarray(depth, dtype=np.float64)
         if depth.shape != (self.height, self.width):
             raise ValueError(f"depth: expected shape ({self.height}, {self.width}), got {depth.shape}")
-        P = np.asarray(_core().depth_to_points(depth, self.pose, **self._intr(), world=world, organised=organised))
+        P = np.asarray(_v.depth_to_points(depth, self.pose, **self._intr(), world=world, organised=organised))
         return P.reshape(self.height, self.width, 3) if organised else P
 
     def capture(self, meshes: Sequence, table: Union[bool, dict] = False, noise: bool = True, seed: int = 0,
@@ -175,7 +196,7 @@ def segment_table(cloud, plane_threshold: float = 0.006, min_height: float = 0.0
     clusters of those (largest first). ``cloud``: (N, 3), organised (H, W, 3) or an Open3D cloud;
     NaN rows are ignored. ValueError if fewer than 3 finite points or no plane."""
     P = as_cloud(cloud)
-    r = _core().segment_table(P, plane_threshold=plane_threshold, plane_iterations=plane_iterations,
+    r = _v.segment_table(P, plane_threshold=plane_threshold, plane_iterations=plane_iterations,
                               min_height=min_height, max_height=max_height, cluster_tolerance=cluster_tolerance,
                               min_cluster_size=min_cluster_size, up=np.asarray(up, float))
     clusters = [np.asarray(c, dtype=np.int64) for c in r["clusters"]]
@@ -184,6 +205,69 @@ def segment_table(cloud, plane_threshold: float = 0.006, min_height: float = 0.0
 
 
 # ---------------------------------------------------------------------------------------------
+# registration options
+def _set(path: str, convert: Optional[Callable] = None):
+    """A keyword's setter: assigns the (converted) value to the field at a dotted path."""
+    *parents, name = path.split(".")
+
+    def assign(options, value):
+        target = options
+        for p in parents:
+            target = getattr(target, p)
+        setattr(target, name, convert(value) if convert else value)
+
+    return assign
+
+
+# The flat keywords of register() and Registrar(), each mapped to its field.
+_KEYWORDS: Dict[str, Callable] = {
+    "voxel": _set("voxel"),
+    "inlier_distance": _set("inlier_distance"),
+    "weight_sigma": _set("weight_sigma"),
+    "min_scene_points": _set("min_scene_points"),
+    "threads": _set("threads"),
+    "normal_radius": _set("features.normal_radius"),
+    "feature_radius": _set("features.feature_radius"),
+    "pcl_features": _set("features.estimator", lambda b: FeatureEstimator.Pcl if b else FeatureEstimator.Ours),
+    "feature_neighbours": _set("correspondences.neighbours"),
+    "reverse_matches": _set("correspondences.reverse"),
+    "hellinger": _set("correspondences.hellinger"),
+    "restarts": _set("ransac.restarts"),
+    "ransac_iterations": _set("ransac.iterations"),
+    "hypotheses": _set("ransac.hypotheses"),
+    "icp_iterations": _set("icp.iterations"),
+    "icp_distance": _set("icp.distance"),
+    "up_prior": _set("up_prior.enabled"),
+    "upright": _set("up_prior.upright"),
+    "up": _set("up_prior.up", lambda u: np.asarray(u, float)),
+    "max_tilt_deg": _set("up_prior.max_tilt", lambda d: float(d) * math.pi / 180.0),
+}
+
+
+def registration_options(options: Optional[RegistrationOptions] = None, **keywords) -> RegistrationOptions:
+    """A validated copy of ``options`` (default: ``RegistrationOptions()``) with the flat keywords
+    applied: voxel, inlier_distance, weight_sigma, min_scene_points, threads (fields of
+    RegistrationOptions); normal_radius, feature_radius, pcl_features (``features``; pcl_features
+    True selects ``FeatureEstimator.Pcl``); feature_neighbours, reverse_matches, hellinger
+    (``correspondences``); restarts, ransac_iterations, hypotheses (``ransac``); icp_iterations,
+    icp_distance (``icp``); up_prior, upright, up, max_tilt_deg (``up_prior``: enabled, upright, up,
+    max_tilt in radians). Every other field is set on the options object itself. ValueError for an
+    unknown keyword (naming it) or a bad value (naming the field)."""
+    if options is None:
+        options = RegistrationOptions()
+    elif not isinstance(options, RegistrationOptions):
+        raise ValueError(f"options: expected a RegistrationOptions, got {type(options).__name__}")
+    out = options.__copy__()
+    for key, value in keywords.items():
+        if key not in _KEYWORDS:
+            raise ValueError(f"{key}: unknown registration parameter (known: {', '.join(sorted(_KEYWORDS))})")
+        _KEYWORDS[key](out, value)
+    out.validate()
+    return out
+
+
+# ---------------------------------------------------------------------------------------------
+# registration
 @dataclass
 class RegistrationResult:
     """One model's registration. ``transform`` maps model coordinates to the cloud's frame."""
@@ -191,11 +275,11 @@ class RegistrationResult:
     success: bool
     reason: str
     transform: np.ndarray
-    fitness: float      # fraction of downsampled scene points within 1.5 voxel of the model
+    fitness: float      # fraction of downsampled scene points within the inlier distance of the model
     rmse: float         # RMS distance of those inliers (m)
     delta: float        # fitting error (m), see the module docstring
     phi: float          # exp(-delta^2 / (2 sigma^2)), unnormalised
-    weight: float       # phi normalised over the successful models of the call
+    weight: float       # phi normalised over the successful models of the call (belief.shape_weights)
     up_cos: float       # cos of the angle between the model's +z in the scene and `up`
     scene_points: int
     model_points: int
@@ -203,6 +287,9 @@ class RegistrationResult:
     time_global: float
     time_icp: float
     model: Any = None   # the name or index of the model
+    status: Any = None  # RegistrationStatus: Ok, or why not
+    ransac_iterations: int = 0  # total over the RANSAC restarts
+    cost: float = 0.0   # selection cost of the chosen hypothesis (delta / tau + up penalty)
 
     def as_dict(self) -> dict:
         return {"model": self.model, "success": self.success, "reason": self.reason,
@@ -210,11 +297,26 @@ class RegistrationResult:
                 "delta": self.delta, "phi": self.phi, "weight": self.weight}
 
 
-def model_samples(model, voxel: float = 0.005, seed: int = 0, samples: int = 0) -> Tuple[np.ndarray, np.ndarray]:
-    """(points, outward normals) on a model's surface, for :func:`register`. ``model``: a mesh
-    ((V, F) or an object with .vertices/.faces): sampled uniformly, area-weighted, seeded; an
-    (N, 6) array of points and normals; a (points, normals) tuple of two (N, 3) arrays; or an
-    Open3D cloud with normals. ValueError if it has no surface."""
+def _results(raw: Sequence, names: Sequence) -> List[RegistrationResult]:
+    """Python results from the core's, with the shape weights over the models of the call."""
+    weights = shape_weights([r.phi for r in raw], [r.success for r in raw])
+    return [RegistrationResult(
+        success=bool(r.success), reason=r.reason, transform=np.array(r.transform), fitness=float(r.fitness),
+        rmse=float(r.rmse), delta=float(r.delta), phi=float(r.phi), weight=float(w), up_cos=float(r.up_cos),
+        scene_points=int(r.scene_points), model_points=int(r.model_points), time_features=float(r.time_features),
+        time_global=float(r.time_global), time_icp=float(r.time_icp), model=name, status=r.status,
+        ransac_iterations=int(r.ransac_iterations), cost=float(r.cost))
+        for r, w, name in zip(raw, weights, names)]
+
+
+def _mesh_samples(V: np.ndarray, F: np.ndarray, options: RegistrationOptions, seed: int) -> Tuple[np.ndarray, np.ndarray]:
+    s = _v.model_from_mesh(V, F, options, seed=int(seed))
+    return np.asarray(s.points), np.asarray(s.normals)
+
+
+def _samples_of(model) -> Optional[Tuple[np.ndarray, np.ndarray]]:
+    """(points, normals) if ``model`` is given as samples (Open3D cloud with normals, (N, 6) array,
+    (points, normals) tuple), else None (a mesh)."""
     if hasattr(model, "points") and hasattr(model, "normals") and not isinstance(model, np.ndarray):
         P, N = np.asarray(model.points, float), np.asarray(model.normals, float)
         if len(N) != len(P):
@@ -228,91 +330,110 @@ def model_samples(model, voxel: float = 0.005, seed: int = 0, samples: int = 0) 
     if isinstance(model, (tuple, list)) and len(model) == 2:
         A, B = np.asarray(model[0]), np.asarray(model[1])
         if A.ndim == 2 and B.ndim == 2 and A.shape[1] == 3 and B.shape[1] == 3 and np.issubdtype(B.dtype, np.floating) \
-                and len(A) == len(B) and not np.issubdtype(B.dtype, np.integer):
+                and len(A) == len(B):
             return np.ascontiguousarray(A, float), np.ascontiguousarray(B, float)
+    return None
+
+
+def model_samples(model, voxel: float = 0.005, seed: int = 0, samples: int = 0) -> Tuple[np.ndarray, np.ndarray]:
+    """(points, outward normals) on a model's surface, for :func:`register`. ``model``: a mesh
+    ((V, F) or an object with .vertices/.faces): sampled uniformly, area-weighted, seeded
+    (``samples`` points; 0: area / (voxel/3)^2, clamped to [2000, 200000]); an (N, 6) array of
+    points and normals; a (points, normals) tuple of two (N, 3) arrays; or an Open3D cloud with
+    normals. ValueError if it has no surface."""
+    given = _samples_of(model)
+    if given is not None:
+        return given
     V, F = as_mesh(model, "model")
-    P, N = _core().model_from_mesh(V, F, voxel=float(voxel), seed=int(seed), samples=int(samples))
-    return np.asarray(P), np.asarray(N)
+    return _mesh_samples(V, F, RegistrationOptions(voxel=float(voxel), model_samples=int(samples)), seed)
 
 
-def _check_cloud(cloud) -> np.ndarray:
-    P = as_cloud(cloud)
-    if len(P) == 0:
-        raise ValueError("cloud: is empty")
-    if not np.isfinite(P).all(axis=1).any():
-        raise ValueError("cloud: has no finite points")
-    return P
+def _model_clouds(models: Sequence, options: RegistrationOptions, model_seed: int) -> List[Tuple[np.ndarray, np.ndarray]]:
+    """Surface samples of each model (mesh i seeded with model_seed + i, options.model_samples
+    points). A mesh without area gives no samples: the core reports it as NoSurface."""
+    out = []
+    for i, m in enumerate(models):
+        try:
+            given = _samples_of(m)
+            if given is None:
+                V, F = as_mesh(m, "model")
+                has_area = _bgcore.geometry.surface_area(V, F) > 0
+                given = _mesh_samples(V, F, options, model_seed + i) if has_area else (np.zeros((0, 3)),) * 2
+        except ValueError as e:
+            raise ValueError(f"models[{i}]: {e}") from None
+        out.append(given)
+    return out
 
 
-def _result(r: dict, model, reason: Optional[str] = None, extra_feature_time: float = 0.0) -> RegistrationResult:
-    return RegistrationResult(
-        success=bool(r["success"]), reason=r["reason"] if reason is None else reason,
-        transform=np.asarray(r["transform"]), fitness=float(r["fitness"]), rmse=float(r["rmse"]),
-        delta=float(r["delta"]), phi=float(r["phi"]), weight=float(r["weight"]), up_cos=float(r["up_cos"]),
-        scene_points=int(r["scene_points"]), model_points=int(r["model_points"]),
-        time_features=float(r["time_features"]) + extra_feature_time, time_global=float(r["time_global"]),
-        time_icp=float(r["time_icp"]), model=model)
+def _model_names(names: Optional[Sequence], n: int) -> list:
+    if names is None:
+        return list(range(n))
+    names = list(names)
+    if len(names) != n:
+        raise ValueError(f"names: expected {n} names, got {len(names)}")
+    return names
+
+
+def _viewpoint(viewpoint) -> Optional[np.ndarray]:
+    return None if viewpoint is None else np.asarray(viewpoint, float)
 
 
 class Registrar:
     """Object models prepared once, partial clouds registered against them many times.
 
-    Preparing a model (downsampling, normals, FPFH features, k-d trees) does not depend on the
-    cloud, so it is done here once per model; :meth:`register` does only the per-cloud work. With
-    the same parameters, seed and viewpoint, ``Registrar(models).register(cloud)`` gives exactly the
-    transforms, fits and weights of ``register(cloud, models)``.
+    Preparing a model (a radius grid over its dense surface samples, downsampling, normals, FPFH
+    features) does not depend on the cloud, so it is done here once per model; :meth:`register`
+    does only the per-cloud work. With the same options, seed and viewpoint,
+    ``Registrar(models).register(cloud)`` gives exactly the transforms, fits and weights of
+    ``register(cloud, models)``.
 
-    >>> reg = Registrar([mug_a, mug_b, mug_c], names=["a", "b", "c"])
+    >>> reg = Registrar([mug_a, mug_b, mug_c], names=["a", "b", "c"], restarts=6)
     >>> for cloud, eye in views:
     ...     results = reg.register(cloud, viewpoint=eye)        # all models
     ...     best = reg.register(cloud, viewpoint=eye, models=["b"])[0]
 
     Args:
         models: meshes or surface samples (see :func:`model_samples`).
-        voxel, up_prior, up, upright, model_seed, params: as for :func:`register` (fixed for the
-            registrar's life; ``params`` without ``seed`` and ``viewpoint``, which are per call).
+        options: a :class:`RegistrationOptions` (fixed for the registrar's life).
         names: a name per model (else the index), used in the results and by ``models=`` of
             :meth:`register`.
+        model_seed: seeds the surface sampling of the meshes (model i: model_seed + i).
+        keywords: flat option keywords (see :func:`registration_options`), applied over ``options``;
+            ``seed`` and ``viewpoint`` are given per call, to :meth:`register`.
     """
 
-    def __init__(self, models: Sequence, voxel: float = 0.005, up_prior: bool = True, up=(0.0, 0.0, 1.0),
-                 upright: bool = True, model_seed: int = 0, names: Optional[Sequence] = None, **params):
-        if not isinstance(voxel, (int, float)) or not (voxel > 0) or not math.isfinite(voxel):
-            raise ValueError(f"voxel: must be positive and finite, got {voxel}")
+    def __init__(self, models: Sequence, options: Optional[RegistrationOptions] = None, *,
+                 names: Optional[Sequence] = None, model_seed: int = 0, **keywords):
         for k in ("seed", "viewpoint"):
-            if k in params:
+            if k in keywords:
                 raise ValueError(f"{k}: is given per call, to Registrar.register")
+        options = registration_options(options, **keywords)
         models = list(models)
         if not models:
             raise ValueError("models: is empty")
-        if names is not None:
-            names = list(names)
-            if len(names) != len(models):
-                raise ValueError(f"names: expected {len(models)} names, got {len(names)}")
-        self.names = names if names is not None else list(range(len(models)))
-        samples, self._failed = [], {}
-        for i, m in enumerate(models):
-            try:
-                samples.append(model_samples(m, voxel=voxel, seed=model_seed + i))
-            except ValueError as e:
-                if "no surface" not in str(e) and "no area" not in str(e):
-                    raise ValueError(f"models[{i}]: {e}") from None
-                self._failed[i] = f"model has no surface ({e})"
-                samples.append((np.zeros((0, 3)), np.zeros((0, 3))))
-        self.voxel = float(voxel)
-        self._core = _core().Registrar(samples, voxel=float(voxel), up_prior=bool(up_prior), upright=bool(upright),
-                                       up=np.asarray(up, float), **params)
+        self.names = _model_names(names, len(models))
+        self._core = _v.Registrar(options)
+        self._core.add_models(_model_clouds(models, options, model_seed))
 
     def __len__(self) -> int:
         return len(self._core)
 
-    def preparation_time(self, i: int) -> float:
-        """Seconds spent preparing model ``i`` (downsampling, normals, FPFH, k-d trees)."""
-        return float(self._core.model_info(int(i))["time"])
+    @property
+    def options(self) -> RegistrationOptions:
+        """A copy of the registrar's options."""
+        return self._core.options
 
-    def _indices(self, models) -> List[int]:
+    @property
+    def voxel(self) -> float:
+        return self._core.options.voxel
+
+    def preparation_time(self, i: int) -> float:
+        """Seconds spent preparing model ``i`` (radius grid, downsampling, normals, FPFH)."""
+        return float(self._core.model_info(int(i)).time)
+
+    def _indices(self, models) -> Optional[List[int]]:
         if models is None:
-            return list(range(len(self.names)))
+            return None
         if isinstance(models, (str, int, np.integer)):
             models = [models]
         out = []
@@ -332,50 +453,50 @@ class Registrar:
         None for all), in parallel. ``seed``: RANSAC seed; ``viewpoint``: the camera centre in the
         cloud's frame. Returns one :class:`RegistrationResult` per model asked for, with weights
         normalised over those; ``time_features`` is the cloud's feature time only."""
-        P = _check_cloud(cloud)
+        P = as_cloud(cloud)
         idx = self._indices(models)
-        vp = None if viewpoint is None else np.asarray(viewpoint, float)
-        raw = self._core.register(P, seed=int(seed), viewpoint=vp, models=idx)
-        return [_result(r, self.names[i], self._failed.get(i)) for i, r in zip(idx, raw)]
+        raw = self._core.register(P, seed=int(seed), viewpoint=_viewpoint(viewpoint), models=idx)
+        return _results(raw, self.names if idx is None else [self.names[i] for i in idx])
 
 
-def register(cloud, models: Sequence, voxel: float = 0.005, seed: int = 0, viewpoint=None, up_prior: bool = True,
-             up=(0.0, 0.0, 1.0), upright: bool = True, model_seed: int = 0, names: Optional[Sequence] = None,
-             **params) -> List[RegistrationResult]:
-    """Registers a partial cloud against every model in one parallel call (a one-shot
-    :class:`Registrar`; to register many clouds against the same models, make one Registrar).
+def register(cloud, models: Sequence, options: Optional[RegistrationOptions] = None, *, seed: int = 0,
+             viewpoint=None, model_seed: int = 0, names: Optional[Sequence] = None,
+             **keywords) -> List[RegistrationResult]:
+    """Registers a partial cloud against every model in one parallel call (one shot; to register
+    many clouds against the same models, make one :class:`Registrar`).
 
     Args:
         cloud: (N, 3) / organised (H, W, 3) array or Open3D cloud; NaN rows are dropped.
         models: meshes or surface samples (see :func:`model_samples`).
-        voxel: the one size every radius and threshold scales from (m).
+        options: a :class:`RegistrationOptions`; every radius and threshold scales from its voxel (m).
         seed: RANSAC seed (same seed, same result); ``model_seed`` seeds the surface sampling.
         viewpoint: the camera centre in the cloud's frame (scene normals point towards it); without
             it they point away from the cloud's centroid.
-        up_prior, up, upright: see the module docstring.
-        params: restarts, ransac_iterations, hypotheses, icp_iterations, feature_neighbours,
-            normal_radius, feature_radius, inlier_distance, icp_distance (multiples of voxel),
-            weight_sigma (x voxel), max_tilt_deg, min_scene_points, threads, pcl_features (PCL's
-            normal and FPFH estimators instead of ours: same definitions, slower).
+        names: a name per model (else the index), in the results.
+        keywords: flat option keywords applied over ``options`` (see :func:`registration_options`):
+            voxel, up_prior, up, upright, restarts, ransac_iterations, hypotheses, icp_iterations,
+            feature_neighbours, normal_radius, feature_radius, inlier_distance, icp_distance,
+            weight_sigma, max_tilt_deg, min_scene_points, threads, reverse_matches, hellinger,
+            pcl_features (PCL's normal and FPFH estimators instead of ours: same definitions, slower).
 
     Returns one :class:`RegistrationResult` per model, in order (``time_features`` includes the
     model's preparation). A model with no surface, or a cloud with too few points for the features,
-    gives ``success=False`` with a ``reason`` (the transform is then the identity). ValueError for an
-    empty or all-NaN cloud, no models, or bad parameters.
+    gives ``success=False`` with a ``status`` and a ``reason`` (the transform is then the identity).
+    ValueError for an empty or all-NaN cloud, no models, or bad options.
     """
-    P = _check_cloud(cloud)
-    reg = Registrar(models, voxel=voxel, up_prior=up_prior, up=up, upright=upright, model_seed=model_seed,
-                    names=names, **params)
-    res = reg.register(P, seed=seed, viewpoint=viewpoint)
-    for i, r in enumerate(res):
-        r.time_features += reg.preparation_time(i)
-    return res
+    options = registration_options(options, **keywords)
+    models = list(models)
+    names = _model_names(names, len(models))
+    P = as_cloud(cloud)
+    raw = _v.register_models(P, _model_clouds(models, options, model_seed), options, seed=int(seed),
+                             viewpoint=_viewpoint(viewpoint))
+    return _results(raw, names)
 
 
 def rotation_error(Ra, Rb, axis=None) -> float:
     """Angle (rad) between two rotations; with ``axis`` (model frame), rotation about it is ignored."""
     ax = None if axis is None else np.asarray(axis, float)
-    return float(_core().rotation_error(np.asarray(Ra, float), np.asarray(Rb, float), ax))
+    return float(_v.rotation_error(np.asarray(Ra, float), np.asarray(Rb, float), ax))
 
 
 # ---------------------------------------------------------------------------------------------
@@ -440,43 +561,8 @@ def register_command(scene_object, pose, models, json_out: bool = False, png: Op
             for row in r.transform:
                 print_fn("      [" + " ".join(f"{v: .4f}" for v in row) + "]")
     if png:
+        from bayesgrasp.viz import plot_registrations
+
         plot_registrations(part, model_objs, res, png)
     return doc
 
-
-def plot_registrations(cloud: np.ndarray, models: Sequence, results: Sequence[RegistrationResult], path: str,
-                       max_points: int = 4000) -> None:
-    """A PNG with one 3-D panel per model: the model's surface samples (grey) moved by the
-    registration, and the partial cloud (red) over them."""
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
-    n = len(results)
-    cols = min(n, 3)
-    rows = (n + cols - 1) // cols
-    fig = plt.figure(figsize=(4.2 * cols, 4.2 * rows))
-    rng = np.random.default_rng(0)
-    C = np.asarray(cloud)[np.isfinite(cloud).all(axis=1)]
-    if len(C) > max_points:
-        C = C[rng.choice(len(C), max_points, replace=False)]
-    for k, (m, r) in enumerate(zip(models, results)):
-        ax = fig.add_subplot(rows, cols, k + 1, projection="3d")
-        P, _ = model_samples(m, samples=3000)
-        P = P @ r.transform[:3, :3].T + r.transform[:3, 3]
-        ax.scatter(P[:, 0], P[:, 1], P[:, 2], s=1, c="0.6", alpha=0.5)
-        ax.scatter(C[:, 0], C[:, 1], C[:, 2], s=1, c="tab:red")
-        title = f"{r.model}\n" + (f"fit {r.fitness:.2f}  rmse {r.rmse * 1e3:.1f} mm  w {r.weight:.2f}"
-                                  if r.success else f"failed: {r.reason[:40]}")
-        ax.set_title(title, fontsize=9)
-        allp = np.vstack([P, C])
-        mid, half = allp.mean(axis=0), (allp.max(axis=0) - allp.min(axis=0)).max() / 2
-        ax.set_xlim(mid[0] - half, mid[0] + half)
-        ax.set_ylim(mid[1] - half, mid[1] + half)
-        ax.set_zlim(mid[2] - half, mid[2] + half)
-        ax.set_xlabel("x")
-        ax.set_ylabel("y")
-    fig.tight_layout()
-    fig.savefig(path, dpi=110)
-    plt.close(fig)

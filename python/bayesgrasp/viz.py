@@ -260,3 +260,38 @@ def plot_scene(scene, path=None, title: Optional[str] = None, extra: Optional[Ca
     if path is None:
         return fig, ax
     return save_figure(fig, path)
+
+
+def plot_registrations(cloud: np.ndarray, models: Sequence, results: Sequence, path, max_points: int = 4000) -> None:
+    """A PNG with one 3-D panel per model: the model's surface samples (grey) moved by the
+    registration, and the partial cloud (red) over them. ``results``: the
+    :class:`bayesgrasp.vision.RegistrationResult` of each model, in order."""
+    from bayesgrasp.vision import model_samples
+
+    n = len(results)
+    cols = min(n, 3)
+    rows = (n + cols - 1) // cols
+    fig = plt.figure(figsize=(4.2 * cols, 4.2 * rows))
+    rng = np.random.default_rng(0)
+    C = np.asarray(cloud)[np.isfinite(cloud).all(axis=1)]
+    if len(C) > max_points:
+        C = C[rng.choice(len(C), max_points, replace=False)]
+    for k, (m, r) in enumerate(zip(models, results)):
+        ax = fig.add_subplot(rows, cols, k + 1, projection="3d")
+        P, _ = model_samples(m, samples=3000)
+        P = P @ r.transform[:3, :3].T + r.transform[:3, 3]
+        ax.scatter(P[:, 0], P[:, 1], P[:, 2], s=1, c="0.6", alpha=0.5)
+        ax.scatter(C[:, 0], C[:, 1], C[:, 2], s=1, c="tab:red")
+        title = f"{r.model}\n" + (f"fit {r.fitness:.2f}  rmse {r.rmse * 1e3:.1f} mm  w {r.weight:.2f}"
+                                  if r.success else f"failed: {r.reason[:40]}")
+        ax.set_title(title, fontsize=9)
+        allp = np.vstack([P, C])
+        mid, half = allp.mean(axis=0), (allp.max(axis=0) - allp.min(axis=0)).max() / 2
+        ax.set_xlim(mid[0] - half, mid[0] + half)
+        ax.set_ylim(mid[1] - half, mid[1] + half)
+        ax.set_zlim(mid[2] - half, mid[2] + half)
+        ax.set_xlabel("x")
+        ax.set_ylabel("y")
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+    plt.close(fig)

@@ -1,6 +1,7 @@
 #include <gtest/gtest.h>
 
 #include "bayesgrasp/geometry/mesh.hpp"
+#include "bayesgrasp/geometry/surface_sampling.hpp"
 
 using namespace bayesgrasp;
 
@@ -60,4 +61,44 @@ TEST(Geometry, PlanarPoseAndMatrix) {
   Eigen::Matrix4d bad = T.matrix();
   bad(0, 0) = 2.0;
   EXPECT_THROW(pose_from_matrix(bad), std::invalid_argument);
+}
+
+TEST(Geometry, SurfaceSamplesAreUniformOnTheSurface) {
+  // Box 0.1 x 0.2 x 0.3: every sample on a face with that face's outward normal, and the fraction
+  // of samples on each face pair equal to its area share.
+  const double a = 0.1, b = 0.2, c = 0.3;
+  const TriMesh m = box(a, b, c);
+  EXPECT_NEAR(surface_area(m), 2 * (a * b + b * c + a * c), 1e-12);
+  const int n = 20000;
+  const SurfaceSamples s = sample_surface(m, n, 3);
+  ASSERT_EQ(s.points.rows(), n);
+  ASSERT_EQ(s.normals.rows(), n);
+  const Vec3 extent(a, b, c);
+  int top_bottom = 0;
+  for (int i = 0; i < n; ++i) {
+    const Vec3 p = s.points.row(i).transpose(), nrm = s.normals.row(i).transpose();
+    EXPECT_NEAR(nrm.norm(), 1.0, 1e-12);
+    int axis;
+    nrm.cwiseAbs().maxCoeff(&axis);
+    EXPECT_NEAR(std::abs(nrm[axis]), 1.0, 1e-12);
+    EXPECT_NEAR(p[axis], nrm[axis] > 0 ? extent[axis] : 0.0, 1e-12);  // on the face the normal names
+    EXPECT_TRUE((p.array() >= -1e-12).all() && (p.array() <= extent.array() + 1e-12).all());
+    top_bottom += axis == 2;
+  }
+  EXPECT_NEAR(top_bottom / double(n), a * b / (a * b + b * c + a * c), 0.01);  // 3 sigma ~ 0.008
+  const SurfaceSamples same = sample_surface(m, n, 3), other = sample_surface(m, n, 4);
+  EXPECT_TRUE(s.points == same.points);  // seeded
+  EXPECT_FALSE(s.points == other.points);
+}
+
+TEST(Geometry, SurfaceSamplingRejectsBadInput) {
+  TriMesh flat;  // zero area
+  flat.V.resize(3, 3);
+  flat.V << 0, 0, 0, 1, 0, 0, 2, 0, 0;
+  flat.F.resize(1, 3);
+  flat.F << 0, 1, 2;
+  EXPECT_EQ(surface_area(flat), 0.0);
+  EXPECT_THROW(sample_surface(flat, 10, 0), std::invalid_argument);
+  EXPECT_THROW(sample_surface(box(1, 1, 1), 0, 0), std::invalid_argument);
+  EXPECT_THROW(sample_surface(TriMesh{}, 10, 0), std::invalid_argument);
 }

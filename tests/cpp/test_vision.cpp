@@ -1,8 +1,10 @@
 // Tests of the vision concept: ray-cast depth against analytic depth, noise model, segmentation,
-// registration of known transforms, bad inputs and determinism.
+// registration of known transforms, typed failures, options, bad inputs and determinism. The
+// registration's steps against brute-force oracles: test_vision_steps.cpp.
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <random>
 #include <vector>
 
 #include "bayesgrasp/vision/camera.hpp"
@@ -37,6 +39,16 @@ TriMesh prism(const std::vector<Eigen::Vector2d>& poly, const std::vector<std::a
   m.F.resize(static_cast<Eigen::Index>(F.size()), 3);
   for (std::size_t f = 0; f < F.size(); ++f) m.F.row(static_cast<Eigen::Index>(f)) << F[f][0], F[f][1], F[f][2];
   return m;
+}
+
+// The square [-h, h]^2 at z = 0, facing +z.
+TriMesh square(double h) {
+  TriMesh quad;
+  quad.V.resize(4, 3);
+  quad.V << -h, -h, 0, h, -h, 0, h, h, 0, -h, h, 0;
+  quad.F.resize(2, 3);
+  quad.F << 0, 1, 2, 0, 2, 3;
+  return quad;
 }
 
 TriMesh box(double a, double b, double c) {  // [-a/2, a/2] x [-b/2, b/2] x [0, c]
@@ -105,11 +117,7 @@ TEST(VisionCamera, LookAtConvention) {
 TEST(VisionCamera, PlaneDepthMatchesAnalytic) {
   // A large quad z = 0 seen from (0.3, -0.6, 0.8) looking at the origin; depth of pixel (u, v) is
   // z_c = -o_z / d_z with d = R ((u - cx)/fx, (v - cy)/fy, 1).
-  TriMesh quad;
-  quad.V.resize(4, 3);
-  quad.V << -5, -5, 0, 5, -5, 0, 5, 5, 0, -5, 5, 0;
-  quad.F.resize(2, 3);
-  quad.F << 0, 1, 2, 0, 2, 3;
+  const TriMesh quad = square(5);
   Intrinsics K;
   const Iso3 cam = look_at(Vec3(0.3, -0.6, 0.8), Vec3::Zero());
   const RenderResult r = render(K, cam, {quad}, Table{}, no_noise());
@@ -170,11 +178,7 @@ TEST(VisionCamera, SphereDepthMatchesAnalytic) {
 TEST(VisionCamera, NoiseModelStatistics) {
   // A plane facing the camera at 1.5 m: mean depth unbiased, spread ~ sigma(z) plus
   // quantisation (step z^2 s / (f B)), dropping only at the border (edges of the quad).
-  TriMesh quad;
-  quad.V.resize(4, 3);
-  quad.V << -5, -5, 0, 5, -5, 0, 5, 5, 0, -5, 5, 0;
-  quad.F.resize(2, 3);
-  quad.F << 0, 1, 2, 0, 2, 3;
+  const TriMesh quad = square(5);
   Intrinsics K;
   const Iso3 cam = look_at(Vec3(0, 0, 1.5), Vec3(0, 0.001, 0), Vec3::UnitY());
   NoiseModel nm;
@@ -205,11 +209,7 @@ TEST(VisionCamera, NoiseModelStatistics) {
 
 TEST(VisionCamera, GrazingPixelsAreDropped) {
   // A plane seen at 85 degrees of incidence everywhere is dropped (max incidence 78 degrees).
-  TriMesh quad;
-  quad.V.resize(4, 3);
-  quad.V << -50, -50, 0, 50, -50, 0, 50, 50, 0, -50, 50, 0;
-  quad.F.resize(2, 3);
-  quad.F << 0, 1, 2, 0, 2, 3;
+  const TriMesh quad = square(50);
   Intrinsics K;
   K.width = K.height = 3;
   K.cx = K.cy = 1;
@@ -230,27 +230,6 @@ TEST(VisionCamera, SeesNothing) {
   const Points org = depth_to_points(K, r.depth, cam, true, true);
   EXPECT_EQ(org.rows(), K.width * K.height);
   EXPECT_TRUE(org.array().isNaN().all());
-}
-
-TEST(VisionSampling, AreaWeightedUniform) {
-  // Box 0.1 x 0.2 x 0.3: the fraction of samples on each face pair equals its area share.
-  const TriMesh b = box(0.1, 0.2, 0.3);
-  EXPECT_NEAR(surface_area(b), 2 * (0.02 + 0.03 + 0.06), 1e-12);
-  const SurfaceSamples s = sample_surface(b, 20000, 3);
-  int top_bottom = 0;
-  for (int i = 0; i < s.points.rows(); ++i) {
-    if (std::abs(s.normals(i, 2)) > 0.5) ++top_bottom;
-    EXPECT_NEAR(s.normals.row(i).norm(), 1.0, 1e-12);
-  }
-  EXPECT_NEAR(top_bottom / 20000.0, 0.02 / 0.11, 0.01);  // 3 sigma ~ 0.008
-  const SurfaceSamples s2 = sample_surface(b, 20000, 3);
-  EXPECT_TRUE(s.points.isApprox(s2.points));
-  TriMesh flat;  // zero area
-  flat.V.resize(3, 3);
-  flat.V << 0, 0, 0, 1, 0, 0, 2, 0, 0;
-  flat.F.resize(1, 3);
-  flat.F << 0, 1, 2;
-  EXPECT_THROW(sample_surface(flat, 10, 0), std::invalid_argument);
 }
 
 TEST(VisionSegmentation, TwoObjectsOnTable) {
@@ -291,12 +270,29 @@ TEST(VisionSegmentation, TwoObjectsOnTable) {
   EXPECT_THROW(segment_table(Points(0, 3)), std::invalid_argument);
 }
 
+// ---- registration
+namespace {
+constexpr double kSigma = 0.5 * 0.005;  // default weight_sigma x voxel
+
+// The block seen from `eye` at planar pose T, noisy, seeded.
+Points block_view(const Iso3& T, const Vec3& eye, std::uint64_t seed) {
+  return view(l_block(), T, eye, T * Vec3(0.05, 0.04, 0.03), true, seed);
+}
+
+// n points along a vertical line at the centre of a voxel column, jittered by less than 1 mm.
+Points needle(int n) {
+  Points P(n, 3);
+  std::mt19937_64 rng(3);
+  std::uniform_real_distribution<double> u(-0.0009, 0.0009);
+  for (int i = 0; i < n; ++i) P.row(i) << 0.0025 + u(rng), 0.0025 + u(rng), 0.2 * i / n;
+  return P;
+}
+}  // namespace
+
 TEST(VisionRegistration, RecoversKnownTransformOfAsymmetricBlock) {
-  const TriMesh L = l_block();
-  RegistrationParams p;
-  p.seed = 5;
-  p.restarts = 6;  // the block's flat faces give few distinctive FPFH matches: search longer
-  const ModelCloud model = model_from_mesh(L, p, 11);
+  RegistrationOptions o;
+  o.ransac.restarts = 6;  // the block's flat faces give few distinctive FPFH matches: search longer
+  const ModelCloud model = model_from_mesh(l_block(), o, 11);
   struct Case {
     double x, y, yaw;
     Vec3 eye;
@@ -304,41 +300,37 @@ TEST(VisionRegistration, RecoversKnownTransformOfAsymmetricBlock) {
   for (const Case& c : {Case{0.05, 0.02, 0.7, Vec3(0.4, -0.6, 0.55)}, Case{-0.1, 0.1, 2.5, Vec3(-0.5, -0.5, 0.6)},
                         Case{0.0, 0.0, -2.0, Vec3(0.1, 0.7, 0.5)}}) {
     const Iso3 T = planar_pose(c.x, c.y, c.yaw);
-    const Points scene = view(L, T, c.eye, T * Vec3(0.05, 0.04, 0.03), true, 3);
-    p.has_viewpoint = true;
-    p.viewpoint = c.eye;
-    const auto res = register_models(scene, {model}, p);
+    const auto res = register_models(block_view(T, c.eye, 3), {model}, o, 5, c.eye);
     ASSERT_EQ(res.size(), 1u);
-    ASSERT_TRUE(res[0].success) << res[0].reason;
+    ASSERT_TRUE(res[0].success()) << res[0].reason;
+    EXPECT_EQ(res[0].status, RegistrationStatus::Ok);
     const Iso3 E(res[0].transform);
     EXPECT_LT(rotation_error(E.linear(), T.linear()) * 180 / kPi, 5.0) << "yaw " << c.yaw;
     EXPECT_LT((E.translation() - T.translation()).norm(), 0.005) << "yaw " << c.yaw;
     EXPECT_GT(res[0].fitness, 0.9);
     EXPECT_LT(res[0].rmse, 0.004);
-    EXPECT_NEAR(res[0].weight, 1.0, 1e-12);
+    EXPECT_NEAR(res[0].phi, std::exp(-res[0].delta * res[0].delta / (2 * kSigma * kSigma)), 1e-12);
+    EXPECT_GT(res[0].up_cos, std::cos(5 * kPi / 180));
   }
 }
 
-TEST(VisionRegistration, WeightsPreferTheRightModelAndSameSeedSameResult) {
-  const TriMesh L = l_block();
-  const TriMesh B = box(0.05, 0.05, 0.2);
-  RegistrationParams p;
-  p.seed = 2;
+TEST(VisionRegistration, PhiPrefersTheRightModelAndSameSeedSameResult) {
+  RegistrationOptions o;
   const Iso3 T = planar_pose(0.02, -0.03, 0.4);
   const Vec3 eye(0.5, -0.5, 0.5);
-  p.has_viewpoint = true;
-  p.viewpoint = eye;
-  const Points scene = view(L, T, eye, T * Vec3(0.05, 0.04, 0.03), true, 9);
-  const std::vector<ModelCloud> models = {model_from_mesh(B, p, 1), model_from_mesh(L, p, 2)};
-  const auto r1 = register_models(scene, models, p);
-  const auto r2 = register_models(scene, models, p);
-  ASSERT_TRUE(r1[1].success);
-  EXPECT_GT(r1[1].weight, r1[0].weight);
-  if (r1[0].success) EXPECT_LT(r1[1].delta, r1[0].delta);  // else its weight is 0
-  EXPECT_NEAR(r1[0].weight + r1[1].weight, 1.0, 1e-12);
+  const Points scene = block_view(T, eye, 9);
+  const std::vector<ModelCloud> models = {model_from_mesh(box(0.05, 0.05, 0.2), o, 1), model_from_mesh(l_block(), o, 2)};
+  const auto r1 = register_models(scene, models, o, 2, eye);
+  const auto r2 = register_models(scene, models, o, 2, eye);
+  ASSERT_TRUE(r1[1].success());
+  if (r1[0].success()) {  // else the belief gives it weight 0
+    EXPECT_GT(r1[1].phi, r1[0].phi);
+    EXPECT_LT(r1[1].delta, r1[0].delta);
+  }
   for (int i = 0; i < 2; ++i) {
     EXPECT_TRUE(r1[i].transform == r2[i].transform);
     EXPECT_EQ(r1[i].fitness, r2[i].fitness);
+    EXPECT_EQ(r1[i].phi, r2[i].phi);
   }
 }
 
@@ -351,40 +343,163 @@ TEST(VisionRegistration, RotationErrorAboutSymmetryAxis) {
 }
 
 TEST(VisionRegistration, BadInputs) {
-  RegistrationParams p;
-  const ModelCloud m = model_from_mesh(box(0.1, 0.1, 0.1), p, 0);
-  EXPECT_THROW(register_models(Points(0, 3), {m}, p), std::invalid_argument);
+  RegistrationOptions o;
+  const ModelCloud m = model_from_mesh(box(0.1, 0.1, 0.1), o, 0);
+  EXPECT_THROW(register_models(Points(0, 3), {m}, o), std::invalid_argument);
   Points nanpts = Points::Constant(10, 3, std::numeric_limits<double>::quiet_NaN());
-  EXPECT_THROW(register_models(nanpts, {m}, p), std::invalid_argument);
-  EXPECT_THROW(register_models(Points::Random(100, 3), {}, p), std::invalid_argument);
-  // A handful of points: explicit failure with a reason.
-  const Points few = Points::Random(10, 3) * 0.05;
-  const auto r = register_models(few, {m}, p);
-  EXPECT_FALSE(r[0].success);
-  EXPECT_NE(r[0].reason.find("at least"), std::string::npos);
-  EXPECT_TRUE(r[0].transform.isIdentity());
-  // A model without surface: explicit failure for that model only.
-  const Points scene = view(box(0.1, 0.1, 0.1), Iso3::Identity(), Vec3(0.4, -0.4, 0.4), Vec3(0, 0, 0.05), false, 0);
-  const auto r2 = register_models(scene, {ModelCloud{}, m}, p);
-  EXPECT_FALSE(r2[0].success);
-  EXPECT_NE(r2[0].reason.find("no surface"), std::string::npos);
-  EXPECT_TRUE(r2[1].success);
-  EXPECT_EQ(r2[0].weight, 0.0);
-  RegistrationParams bad = p;
+  EXPECT_THROW(register_models(nanpts, {m}, o), std::invalid_argument);
+  EXPECT_THROW(register_models(Points::Random(100, 3), {}, o), std::invalid_argument);
+  RegistrationOptions bad = o;
   bad.voxel = -1;
+  const Points scene = view(box(0.1, 0.1, 0.1), Iso3::Identity(), Vec3(0.4, -0.4, 0.4), Vec3(0, 0, 0.05), false, 0);
   EXPECT_THROW(register_models(scene, {m}, bad), std::invalid_argument);
+  EXPECT_THROW(register_models(scene, {m}, o, 0, Vec3(0, std::nan(""), 0)), std::invalid_argument);
+  TriMesh flat;  // zero area
+  flat.V.resize(3, 3);
+  flat.V << 0, 0, 0, 1, 0, 0, 2, 0, 0;
+  flat.F.resize(1, 3);
+  flat.F << 0, 1, 2;
+  EXPECT_THROW(model_from_mesh(flat, o, 0), std::invalid_argument);
+  EXPECT_THROW(model_from_mesh(box(0.1, 0.1, 0.1), bad, 0), std::invalid_argument);
+}
+
+TEST(VisionRegistration, TypedFailures) {
+  RegistrationOptions o;
+  const ModelCloud good = model_from_mesh(box(0.1, 0.1, 0.1), o, 0);
+  const Points scene = view(box(0.1, 0.1, 0.1), Iso3::Identity(), Vec3(0.4, -0.4, 0.4), Vec3(0, 0, 0.05), false, 0);
+  // A handful of scene points: every model fails alike, with the identity.
+  const auto few = register_models(Points::Random(10, 3) * 0.05, {good}, o);
+  EXPECT_EQ(few[0].status, RegistrationStatus::TooFewScenePoints);
+  EXPECT_FALSE(few[0].success());
+  EXPECT_NE(few[0].reason.find("at least"), std::string::npos);
+  EXPECT_TRUE(few[0].transform.isIdentity());
+  // Models that cannot be prepared fail alone: no surface, NaN, two points far apart (no normals).
+  ModelCloud nan_model = good;
+  nan_model.surface.points(3, 1) = std::numeric_limits<double>::quiet_NaN();
+  ModelCloud two{{Points(2, 3), Points(2, 3)}};
+  two.surface.points << 0, 0, 0, 0.1, 0, 0;
+  two.surface.normals << 0, 0, 1, 0, 0, 1;
+  const auto r = register_models(scene, {ModelCloud{}, nan_model, two, good}, o);
+  EXPECT_EQ(r[0].status, RegistrationStatus::NoSurface);
+  EXPECT_EQ(r[1].status, RegistrationStatus::InvalidModel);
+  EXPECT_EQ(r[2].status, RegistrationStatus::TooFewModelPoints);
+  EXPECT_EQ(r[2].model_points, 0);
+  for (int i = 0; i < 3; ++i) {
+    EXPECT_FALSE(r[i].success());
+    EXPECT_FALSE(r[i].reason.empty());
+    EXPECT_TRUE(r[i].transform.isIdentity());
+    EXPECT_EQ(r[i].phi, 0.0);
+  }
+  EXPECT_TRUE(r[3].success()) << r[3].reason;
+  EXPECT_TRUE(r[3].reason.empty());
+  // A vertical needle: every pair of its points is closer than 2 voxels horizontally, so the
+  // 4-DOF RANSAC rejects every sample.
+  const auto none = register_models(needle(400), {good}, o);
+  EXPECT_GE(none[0].scene_points, o.min_scene_points);
+  EXPECT_EQ(none[0].status, RegistrationStatus::NoHypothesis);
+  EXPECT_GT(none[0].ransac_iterations, 0);
+  EXPECT_TRUE(none[0].transform.isIdentity());
+}
+
+TEST(VisionRegistration, OptionsAreValidatedNamingTheField) {
+  const auto field_named = [](RegistrationOptions o, const std::string& name) {
+    try {
+      validate(o);
+    } catch (const std::invalid_argument& e) {
+      return std::string(e.what()).rfind(name + ":", 0) == 0;
+    }
+    return false;
+  };
+  RegistrationOptions o;
+  EXPECT_NO_THROW(validate(o));
+  struct Bad {
+    const char* name;
+    void (*set)(RegistrationOptions&);
+  };
+  const Bad cases[] = {
+      {"voxel", [](RegistrationOptions& x) { x.voxel = 0; }},
+      {"voxel", [](RegistrationOptions& x) { x.voxel = std::numeric_limits<double>::infinity(); }},
+      {"inlier_distance", [](RegistrationOptions& x) { x.inlier_distance = -1; }},
+      {"weight_sigma", [](RegistrationOptions& x) { x.weight_sigma = std::nan(""); }},
+      {"min_scene_points", [](RegistrationOptions& x) { x.min_scene_points = 0; }},
+      {"model_samples", [](RegistrationOptions& x) { x.model_samples = -1; }},
+      {"threads", [](RegistrationOptions& x) { x.threads = -2; }},
+      {"features.normal_radius", [](RegistrationOptions& x) { x.features.normal_radius = 0; }},
+      {"features.feature_radius", [](RegistrationOptions& x) { x.features.feature_radius = -5; }},
+      {"correspondences.neighbours", [](RegistrationOptions& x) { x.correspondences.neighbours = 0; }},
+      {"ransac.iterations", [](RegistrationOptions& x) { x.ransac.iterations = 0; }},
+      {"ransac.min_iterations", [](RegistrationOptions& x) { x.ransac.min_iterations = -1; }},
+      {"ransac.confidence", [](RegistrationOptions& x) { x.ransac.confidence = 1.0; }},
+      {"ransac.edge_similarity", [](RegistrationOptions& x) { x.ransac.edge_similarity = 0.0; }},
+      {"ransac.max_normal_angle", [](RegistrationOptions& x) { x.ransac.max_normal_angle = 0.0; }},
+      {"ransac.restarts", [](RegistrationOptions& x) { x.ransac.restarts = 0; }},
+      {"ransac.candidates", [](RegistrationOptions& x) { x.ransac.candidates = 0; }},
+      {"ransac.hypotheses", [](RegistrationOptions& x) { x.ransac.hypotheses = 0; }},
+      {"icp.distance", [](RegistrationOptions& x) { x.icp.distance = 0; }},
+      {"icp.iterations", [](RegistrationOptions& x) { x.icp.iterations = -1; }},
+      {"icp.tolerance", [](RegistrationOptions& x) { x.icp.tolerance = -1e-6; }},
+      {"icp.coarse_points", [](RegistrationOptions& x) { x.icp.coarse_points = 0; }},
+      {"icp.coarse_iterations", [](RegistrationOptions& x) { x.icp.coarse_iterations = -1; }},
+      {"up_prior.up", [](RegistrationOptions& x) { x.up_prior.up = Vec3::Zero(); }},
+      {"up_prior.up", [](RegistrationOptions& x) { x.up_prior.up = Vec3(0, std::nan(""), 1); }},
+      {"up_prior.max_tilt", [](RegistrationOptions& x) { x.up_prior.max_tilt = 0; }},
+      {"up_prior.weight", [](RegistrationOptions& x) { x.up_prior.weight = -1; }},
+  };
+  for (const Bad& b : cases) {
+    RegistrationOptions x;
+    b.set(x);
+    EXPECT_TRUE(field_named(x, b.name)) << b.name;
+    EXPECT_THROW(Registrar{x}, std::invalid_argument) << b.name;
+  }
+  // Without the prior a zero up is unused (the up cosine is then taken against +z).
+  RegistrationOptions no_prior;
+  no_prior.up_prior.enabled = false;
+  no_prior.up_prior.up = Vec3::Zero();
+  EXPECT_NO_THROW(validate(no_prior));
+}
+
+TEST(VisionRegistration, OptionsTakeEffect) {
+  // Each step's options reach it: results change as the options predict.
+  const Iso3 T = planar_pose(0.05, 0.02, 0.7);
+  const Vec3 eye(0.4, -0.6, 0.55);
+  const Points scene = block_view(T, eye, 3);
+  RegistrationOptions base;
+  base.ransac.restarts = 6;
+  const ModelCloud m = model_from_mesh(l_block(), base, 11);
+  const RegistrationResult ref = register_models(scene, {m}, base, 5, eye)[0];
+  ASSERT_TRUE(ref.success()) << ref.reason;
+  RegistrationOptions o = base;
+  o.weight_sigma = 1.0;  // phi of the same fit with twice the sigma
+  const RegistrationResult wide = register_models(scene, {m}, o, 5, eye)[0];
+  EXPECT_EQ(wide.delta, ref.delta);
+  EXPECT_NEAR(wide.phi, std::exp(-ref.delta * ref.delta / (2 * 4 * kSigma * kSigma)), 1e-12);
+  o = base;
+  o.ransac.restarts = 2;
+  o.ransac.iterations = 7;
+  o.ransac.min_iterations = 0;
+  EXPECT_LE(register_models(scene, {m}, o, 5, eye)[0].ransac_iterations, 14);
+  o = base;
+  o.min_scene_points = ref.scene_points + 1;
+  EXPECT_EQ(register_models(scene, {m}, o, 5, eye)[0].status, RegistrationStatus::TooFewScenePoints);
+  o = base;
+  o.model_samples = 300;
+  EXPECT_EQ(model_from_mesh(l_block(), o, 11).surface.points.rows(), 300);
+  o = base;
+  o.voxel = 0.008;  // coarser: fewer downsampled points
+  EXPECT_LT(register_models(scene, {m}, o, 5, eye)[0].scene_points, ref.scene_points);
+  o = base;
+  o.icp.iterations = 0;  // the coarse hypothesis unrefined
+  EXPECT_FALSE(register_models(scene, {m}, o, 5, eye)[0].transform == ref.transform);
 }
 
 TEST(VisionRegistrar, ReusedAcrossScenesEqualsOneShot) {
-  const TriMesh L = l_block();
-  const TriMesh B = box(0.05, 0.05, 0.2);
-  RegistrationParams p;
-  const std::vector<ModelCloud> models = {model_from_mesh(B, p, 1), model_from_mesh(L, p, 2)};
-  Registrar reg(p);
+  RegistrationOptions o;
+  const std::vector<ModelCloud> models = {model_from_mesh(box(0.05, 0.05, 0.2), o, 1), model_from_mesh(l_block(), o, 2)};
+  Registrar reg(o);
   EXPECT_EQ(reg.add_models(models), 0);
   ASSERT_EQ(reg.size(), 2);
-  EXPECT_TRUE(reg.model_ok(0) && reg.model_ok(1));
-  EXPECT_GT(reg.model_points(1), 100);
+  EXPECT_TRUE(reg.model_info(0).ok() && reg.model_info(1).ok());
+  EXPECT_GT(reg.model_info(1).points, 100);
   struct Case {
     double x, y, yaw;
     Vec3 eye;
@@ -393,31 +508,27 @@ TEST(VisionRegistrar, ReusedAcrossScenesEqualsOneShot) {
   for (const Case& c : {Case{0.02, -0.03, 0.4, Vec3(0.5, -0.5, 0.5), 2}, Case{-0.05, 0.04, 2.2, Vec3(-0.4, -0.5, 0.6), 7},
                         Case{0.0, 0.0, -1.0, Vec3(0.2, 0.6, 0.5), 3}}) {
     const Iso3 T = planar_pose(c.x, c.y, c.yaw);
-    const Points scene = view(L, T, c.eye, T * Vec3(0.05, 0.04, 0.03), true, c.seed);
-    RegistrationParams q = p;
-    q.seed = c.seed;
-    q.has_viewpoint = true;
-    q.viewpoint = c.eye;
-    const auto one = register_models(scene, models, q);
+    const Points scene = block_view(T, c.eye, c.seed);
+    const auto one = register_models(scene, models, o, c.seed, c.eye);
     const auto all = reg.register_scene(scene, c.seed, c.eye);
     const auto only_l = reg.register_scene(scene, c.seed, c.eye, {1});
     ASSERT_EQ(all.size(), 2u);
     ASSERT_EQ(only_l.size(), 1u);
     for (int i = 0; i < 2; ++i) {
-      EXPECT_EQ(all[i].success, one[i].success);
+      EXPECT_EQ(all[i].status, one[i].status);
       EXPECT_TRUE(all[i].transform == one[i].transform) << "model " << i << " yaw " << c.yaw;
       EXPECT_EQ(all[i].fitness, one[i].fitness);
       EXPECT_EQ(all[i].delta, one[i].delta);
-      EXPECT_EQ(all[i].weight, one[i].weight);
+      EXPECT_EQ(all[i].phi, one[i].phi);
       EXPECT_EQ(all[i].ransac_iterations, one[i].ransac_iterations);
-      // Only the scene's features are timed per call; the one-shot call adds the model's.
-      EXPECT_GT(one[i].time_features, all[i].time_features - 1e-3);
+      for (double t : {one[i].time_features, one[i].time_global, one[i].time_icp, all[i].time_features})
+        EXPECT_TRUE(std::isfinite(t) && t >= 0);
     }
-    // One model alone: the same fit, its weight normalised over itself.
+    // One model alone: the same fit.
     EXPECT_TRUE(only_l[0].transform == all[1].transform);
     EXPECT_EQ(only_l[0].delta, all[1].delta);
-    EXPECT_NEAR(only_l[0].weight, 1.0, 1e-12);
-    ASSERT_TRUE(all[1].success) << all[1].reason;
+    EXPECT_EQ(only_l[0].phi, all[1].phi);
+    ASSERT_TRUE(all[1].success()) << all[1].reason;
     const Iso3 E(all[1].transform);
     EXPECT_LT(rotation_error(E.linear(), T.linear()) * 180 / kPi, 5.0) << "yaw " << c.yaw;
     EXPECT_LT((E.translation() - T.translation()).norm(), 0.005) << "yaw " << c.yaw;
@@ -425,22 +536,21 @@ TEST(VisionRegistrar, ReusedAcrossScenesEqualsOneShot) {
 }
 
 TEST(VisionRegistrar, OwnFeaturesMatchPclsInQuality) {
-  // Our normals + FPFH and PCL's (pcl_features) follow the same definitions: both recover the
-  // block's pose.
-  const TriMesh L = l_block();
-  RegistrationParams p;
-  p.restarts = 6;
-  const ModelCloud m = model_from_mesh(L, p, 11);
+  // Our normals + FPFH and PCL's follow the same definitions: both recover the block's pose.
+  RegistrationOptions o;
+  o.ransac.restarts = 6;
+  const ModelCloud m = model_from_mesh(l_block(), o, 11);
   const Iso3 T = planar_pose(0.05, 0.02, 0.7);
   const Vec3 eye(0.4, -0.6, 0.55);
-  const Points scene = view(L, T, eye, T * Vec3(0.05, 0.04, 0.03), true, 3);
-  for (bool pcl : {false, true}) {
-    RegistrationParams q = p;
-    q.pcl_features = pcl;
+  const Points scene = block_view(T, eye, 3);
+  for (FeatureEstimator estimator : {FeatureEstimator::Ours, FeatureEstimator::Pcl}) {
+    RegistrationOptions q = o;
+    q.features.estimator = estimator;
     Registrar reg(q);
     reg.add_models({m});
     const auto r = reg.register_scene(scene, 5, eye);
-    ASSERT_TRUE(r[0].success) << r[0].reason;
+    const bool pcl = estimator == FeatureEstimator::Pcl;
+    ASSERT_TRUE(r[0].success()) << r[0].reason;
     const Iso3 E(r[0].transform);
     EXPECT_LT(rotation_error(E.linear(), T.linear()) * 180 / kPi, 5.0) << "pcl " << pcl;
     EXPECT_LT((E.translation() - T.translation()).norm(), 0.005) << "pcl " << pcl;
@@ -448,64 +558,61 @@ TEST(VisionRegistrar, OwnFeaturesMatchPclsInQuality) {
 }
 
 TEST(VisionRegistrar, BadInputs) {
-  RegistrationParams p;
-  RegistrationParams bad = p;
+  RegistrationOptions o;
+  RegistrationOptions bad = o;
   bad.voxel = 0;
   EXPECT_THROW(Registrar{bad}, std::invalid_argument);
-  Registrar reg(p);
+  Registrar reg(o);
   const Points scene = view(box(0.1, 0.1, 0.1), Iso3::Identity(), Vec3(0.4, -0.4, 0.4), Vec3(0, 0, 0.05), false, 0);
   EXPECT_THROW(reg.register_scene(scene, 0), std::invalid_argument);  // no models yet
   Points nanpts = Points::Constant(10, 3, std::numeric_limits<double>::quiet_NaN());
-  Points halfnan = model_from_mesh(box(0.1, 0.1, 0.1), p, 0).surface.points;
+  Points halfnan = model_from_mesh(box(0.1, 0.1, 0.1), o, 0).surface.points;
   halfnan(3, 1) = std::numeric_limits<double>::quiet_NaN();
-  ModelCloud nanmodel{{halfnan, model_from_mesh(box(0.1, 0.1, 0.1), p, 0).surface.normals}};
-  EXPECT_EQ(reg.add_models({model_from_mesh(box(0.1, 0.1, 0.1), p, 0), ModelCloud{}, nanmodel}), 0);
-  EXPECT_EQ(reg.add_models({model_from_mesh(box(0.1, 0.1, 0.1), p, 4)}), 3);
-  EXPECT_TRUE(reg.model_ok(0));
-  EXPECT_FALSE(reg.model_ok(1));
-  EXPECT_NE(reg.model_reason(1).find("no surface"), std::string::npos);
-  EXPECT_FALSE(reg.model_ok(2));
-  EXPECT_NE(reg.model_reason(2).find("NaN"), std::string::npos);
-  EXPECT_THROW(reg.model_ok(4), std::invalid_argument);
+  ModelCloud nanmodel{{halfnan, model_from_mesh(box(0.1, 0.1, 0.1), o, 0).surface.normals}};
+  EXPECT_EQ(reg.add_models({model_from_mesh(box(0.1, 0.1, 0.1), o, 0), ModelCloud{}, nanmodel}), 0);
+  EXPECT_EQ(reg.add_models({model_from_mesh(box(0.1, 0.1, 0.1), o, 4)}), 3);
+  EXPECT_TRUE(reg.model_info(0).ok());
+  EXPECT_EQ(reg.model_info(1).status, RegistrationStatus::NoSurface);
+  EXPECT_EQ(reg.model_info(2).status, RegistrationStatus::InvalidModel);
+  EXPECT_THROW(reg.model_info(4), std::invalid_argument);
   EXPECT_THROW(reg.register_scene(scene, 0, std::nullopt, {0, 4}), std::invalid_argument);
   EXPECT_THROW(reg.register_scene(scene, 0, std::nullopt, {-1}), std::invalid_argument);
+  EXPECT_THROW(reg.register_scene(scene, 0, std::nullopt, std::vector<int>{}), std::invalid_argument);
   EXPECT_THROW(reg.register_scene(Points(0, 3), 0), std::invalid_argument);
   EXPECT_THROW(reg.register_scene(nanpts, 0), std::invalid_argument);
   EXPECT_THROW(reg.register_scene(scene, 0, Vec3(0, std::numeric_limits<double>::infinity(), 0)),
                std::invalid_argument);
   const auto r = reg.register_scene(scene, 0, Vec3(0.4, -0.4, 0.4));
   ASSERT_EQ(r.size(), 4u);
-  EXPECT_TRUE(r[0].success) << r[0].reason;
-  EXPECT_FALSE(r[1].success);
-  EXPECT_NE(r[1].reason.find("no surface"), std::string::npos);
+  EXPECT_TRUE(r[0].success()) << r[0].reason;
+  EXPECT_EQ(r[1].status, RegistrationStatus::NoSurface);
   EXPECT_TRUE(r[1].transform.isIdentity());
-  EXPECT_EQ(r[1].weight, 0.0);
-  EXPECT_FALSE(r[2].success);
-  EXPECT_TRUE(r[3].success);
-  EXPECT_NEAR(r[0].weight + r[3].weight, 1.0, 1e-12);
-  // Too few scene points: every model fails with the reason.
-  const auto few = reg.register_scene(Points::Random(10, 3) * 0.05, 0);
-  for (const auto& x : few) EXPECT_NE(x.reason.find("at least"), std::string::npos);
+  EXPECT_EQ(r[1].phi, 0.0);
+  EXPECT_EQ(r[2].status, RegistrationStatus::InvalidModel);
+  EXPECT_TRUE(r[3].success());
+  // Too few scene points: every model fails with the status.
+  for (const auto& x : reg.register_scene(Points::Random(10, 3) * 0.05, 0))
+    EXPECT_EQ(x.status, RegistrationStatus::TooFewScenePoints);
 }
 
 TEST(VisionRegistrar, ThreadCountDoesNotChangeTheResult) {
   // The features are computed pair-once on one thread and once per pair end on several; the
-  // RANSAC is seeded per model: the same result either way.
-  const TriMesh L = l_block();
+  // RANSAC is seeded per model: the same result either way (0 = all cores).
   const Iso3 T = planar_pose(0.01, 0.02, -0.6);
   const Vec3 eye(0.5, 0.4, 0.5);
-  const Points scene = view(L, T, eye, T * Vec3(0.05, 0.04, 0.03), true, 4);
+  const Points scene = block_view(T, eye, 4);
   std::vector<std::vector<RegistrationResult>> out;
-  for (int threads : {1, 2}) {
-    RegistrationParams p;
-    p.threads = threads;
-    Registrar reg(p);
-    reg.add_models({model_from_mesh(L, p, 2), model_from_mesh(box(0.05, 0.05, 0.2), p, 1)});
+  for (int threads : {1, 2, 0}) {
+    RegistrationOptions o;
+    o.threads = threads;
+    Registrar reg(o);
+    reg.add_models({model_from_mesh(l_block(), o, 2), model_from_mesh(box(0.05, 0.05, 0.2), o, 1)});
     out.push_back(reg.register_scene(scene, 9, eye));
   }
-  for (int i = 0; i < 2; ++i) {
-    EXPECT_TRUE(out[0][i].transform == out[1][i].transform) << "model " << i;
-    EXPECT_EQ(out[0][i].delta, out[1][i].delta);
-    EXPECT_EQ(out[0][i].model_points, out[1][i].model_points);
-  }
+  for (std::size_t t = 1; t < out.size(); ++t)
+    for (int i = 0; i < 2; ++i) {
+      EXPECT_TRUE(out[0][i].transform == out[t][i].transform) << "model " << i;
+      EXPECT_EQ(out[0][i].delta, out[t][i].delta);
+      EXPECT_EQ(out[0][i].model_points, out[t][i].model_points);
+    }
 }

@@ -1,13 +1,16 @@
 """Vision: camera vs analytic depth, segmentation of two objects, registration of known transforms
-(asymmetric and body of revolution), Open3D-like input, bad inputs, determinism, the CLI function."""
+(asymmetric and body of revolution), Open3D-like input, the option classes and keywords, typed
+failures, the shape weights, bad inputs, determinism, the CLI function."""
 import json
 import math
 
 import numpy as np
 import pytest
 
-from bayesgrasp import vision
-from bayesgrasp.vision import Camera, register, rotation_error, segment_table
+from bayesgrasp import _core, vision
+from bayesgrasp.belief import shape_weights
+from bayesgrasp.vision import (Camera, FeatureEstimator, RegistrationOptions, RegistrationStatus, register,
+                               registration_options, rotation_error, segment_table)
 
 
 def prism(poly, h):
@@ -162,7 +165,7 @@ def test_bad_inputs():
     with pytest.raises(ValueError, match="voxel"):
         register(np.random.default_rng(0).random((100, 3)), [L], voxel=-1)
     few = register(np.random.default_rng(0).random((10, 3)) * 0.05, [L])[0]
-    assert not few.success and "at least" in few.reason
+    assert not few.success and "at least" in few.reason and few.status == RegistrationStatus.TooFewScenePoints
     np.testing.assert_array_equal(few.transform, np.eye(4))
     # A model with no surface fails alone, with its reason.
     flat = (np.array([[0, 0, 0], [1, 0, 0], [2, 0, 0.0]]), np.array([[0, 1, 2]]))
@@ -170,7 +173,8 @@ def test_bad_inputs():
     cloud = cam.capture([L], seed=1)
     r = register(cloud, [flat, L], viewpoint=cam.eye)
     assert not r[0].success and "no surface" in r[0].reason and r[0].weight == 0
-    assert r[1].success
+    assert r[0].status == RegistrationStatus.NoSurface
+    assert r[1].success and r[1].status == RegistrationStatus.Ok and r[1].weight == 1.0
     # A camera that sees nothing gives an empty cloud, which registration rejects.
     up = Camera.looking_at(eye=(0, 0, 1), target=(0, 0.001, 2), up=(0, 1, 0))
     empty = up.capture([L], table=True)
@@ -203,7 +207,7 @@ def test_register_command_json_and_png(tmp_path, capsys):
 def test_registrar_reused_across_clouds_equals_one_shot():
     L, cyl = l_block(), cylinder(0.04, 0.12)
     reg = vision.Registrar([cyl, L], names=["cyl", "L"], restarts=6)  # flat faces: search longer
-    assert len(reg) == 2 and reg.preparation_time(1) > 0
+    assert len(reg) == 2 and reg.options.ransac.restarts == 6
     for k, (yaw, eye, seed) in enumerate([(0.3, (0.5, -0.4, 0.5), 7), (2.0, (-0.4, -0.5, 0.6), 3)]):
         T = planar(0.01 * k, -0.02, yaw)
         V, F = moved(L, T)
@@ -215,8 +219,9 @@ def test_registrar_reused_across_clouds_equals_one_shot():
         for a, b in zip(once, again):
             assert a.success == b.success
             np.testing.assert_array_equal(a.transform, b.transform)
-            assert a.delta == b.delta and a.weight == b.weight
-            assert a.time_features >= b.time_features - 1e-3  # one shot includes the model's preparation
+            assert a.delta == b.delta and a.phi == b.phi and a.weight == b.weight and a.status == b.status
+            for t in (a.time_features, a.time_global, a.time_icp, b.time_features, reg.preparation_time(1)):
+                assert math.isfinite(t) and t >= 0
         only = reg.register(cloud, viewpoint=cam.eye, seed=seed, models=["L"])
         assert len(only) == 1 and only[0].model == "L" and only[0].weight == pytest.approx(1.0)
         np.testing.assert_array_equal(only[0].transform, again[1].transform)
@@ -242,6 +247,7 @@ def test_registrar_bad_inputs():
     cloud = cam.capture([L], seed=1)
     r = reg.register(cloud, viewpoint=cam.eye)
     assert not r[0].success and "no surface" in r[0].reason and r[0].weight == 0
+    assert r[0].status == RegistrationStatus.NoSurface
     assert r[1].success
     with pytest.raises(ValueError, match="models"):
         reg.register(cloud, models=["mug"])
@@ -267,4 +273,185 @@ def test_registrar_bad_inputs():
     with pytest.raises(ValueError, match="i"):
         core.model_info(9)
     assert core.add_models([(np.zeros((0, 3)), np.zeros((0, 3)))]) == 2
-    assert not core.model_info(2)["ok"] and "no surface" in core.model_info(2)["reason"]
+    info = core.model_info(2)
+    assert not info.ok and info.status == RegistrationStatus.NoSurface and "no surface" in info.reason
+    assert core.model_info(1).ok and core.model_info(1).points > 100
+
+
+# ---- options, keywords, typed results, shape weights
+def _option_classes():
+    V = _core.vision
+    return [V.RegistrationOptions, V.FeatureOptions, V.CorrespondenceOptions, V.RansacOptions, V.IcpOptions, V.UpPrior]
+
+
+def _fields(cls):
+    return [n for n, v in vars(cls).items() if isinstance(v, property)]
+
+
+# A non-default valid value for every field of every option class (nested classes by path).
+_NEW_VALUES = {
+    "voxel": 0.004, "inlier_distance": 1.7, "weight_sigma": 0.6, "min_scene_points": 25, "model_samples": 5000,
+    "threads": 1,
+    "features.normal_radius": 2.5, "features.feature_radius": 4.5, "features.estimator": FeatureEstimator.Pcl,
+    "correspondences.neighbours": 3, "correspondences.reverse": False, "correspondences.hellinger": False,
+    "ransac.iterations": 9000, "ransac.min_iterations": 300, "ransac.confidence": 0.99, "ransac.edge_similarity": 0.8,
+    "ransac.max_normal_angle": 0.7, "ransac.restarts": 5, "ransac.candidates": 8, "ransac.hypotheses": 3,
+    "icp.distance": 1.2, "icp.iterations": 20, "icp.tolerance": 1e-6, "icp.coarse_points": 150,
+    "icp.coarse_iterations": 5,
+    "up_prior.enabled": False, "up_prior.upright": False, "up_prior.up": (0.0, 0.1, 1.0), "up_prior.max_tilt": 0.8,
+    "up_prior.weight": 2.0,
+}
+
+
+def _get(options, path):
+    for p in path.split("."):
+        options = getattr(options, p)
+    return options
+
+
+def test_option_classes_document_every_field():
+    for cls in _option_classes():
+        fields = _fields(cls)
+        assert fields, cls
+        for f in fields:
+            doc = getattr(cls, f).__doc__
+            assert doc.startswith(f"{f} : ") and "\n    " in doc, (cls.__name__, f, doc)
+
+
+def test_every_option_field_is_settable_and_reaches_the_core():
+    nested = {"features", "correspondences", "ransac", "icp", "up_prior"}
+    paths = [f for f in _fields(RegistrationOptions) if f not in nested]
+    for name, cls in [("features", _core.vision.FeatureOptions), ("correspondences", _core.vision.CorrespondenceOptions),
+                      ("ransac", _core.vision.RansacOptions), ("icp", _core.vision.IcpOptions),
+                      ("up_prior", _core.vision.UpPrior)]:
+        paths += [f"{name}.{f}" for f in _fields(cls)]
+    assert sorted(paths) == sorted(_NEW_VALUES)  # every field has a test value
+    o = RegistrationOptions()
+    for path, value in _NEW_VALUES.items():
+        *parents, last = path.split(".")
+        target = o
+        for p in parents:
+            target = getattr(target, p)
+        assert not np.array_equal(np.asarray(getattr(target, last)), np.asarray(value)), path  # not the default
+        setattr(target, last, value)
+    reg = vision.Registrar([l_block()], o)  # the C++ registrar holds a copy
+    for path, value in _NEW_VALUES.items():
+        np.testing.assert_array_equal(np.asarray(_get(reg.options, path)), np.asarray(value), err_msg=path)
+    # Keyword construction, copies, repr.
+    r = _core.vision.RansacOptions(restarts=7, candidates=4)
+    assert (r.restarts, r.candidates, r.iterations) == (7, 4, 20000)
+    with pytest.raises(ValueError, match="restart"):
+        _core.vision.RansacOptions(restart=7)
+    c = o.__copy__()
+    c.ransac.restarts = 1
+    assert o.ransac.restarts == 5 and "restarts=5" in repr(o)
+
+
+def test_option_fields_take_effect():
+    L = l_block()
+    T = planar(0.03, -0.02, 0.7)
+    V, F = moved(L, T)
+    cam = Camera.looking_at(eye=(0.4, -0.6, 0.55), target=V.mean(axis=0))
+    cloud = cam.capture([(V, F)], seed=2)
+    base = RegistrationOptions()
+    ref = register(cloud, [L], base, viewpoint=cam.eye, seed=1)[0]
+    assert ref.success
+    o = base.__copy__()
+    o.weight_sigma = 1.0  # the same fit, phi with twice the sigma
+    r = register(cloud, [L], o, viewpoint=cam.eye, seed=1)[0]
+    assert r.delta == ref.delta and r.phi == pytest.approx(math.exp(-ref.delta ** 2 / (2 * 0.005 ** 2)), rel=1e-12)
+    o = base.__copy__()
+    o.ransac.restarts, o.ransac.iterations, o.ransac.min_iterations = 2, 6, 0
+    assert register(cloud, [L], o, viewpoint=cam.eye, seed=1)[0].ransac_iterations <= 12
+    o = base.__copy__()
+    o.min_scene_points = ref.scene_points + 1
+    assert register(cloud, [L], o, viewpoint=cam.eye)[0].status == RegistrationStatus.TooFewScenePoints
+    o = base.__copy__()
+    o.model_samples = 20  # the Registrar samples meshes with options.model_samples
+    assert register(cloud, [L], o, viewpoint=cam.eye)[0].model_points < 20
+    o = base.__copy__()
+    o.icp.iterations = 0
+    assert not np.array_equal(register(cloud, [L], o, viewpoint=cam.eye, seed=1)[0].transform, ref.transform)
+    o = base.__copy__()
+    o.features.estimator = FeatureEstimator.Pcl
+    r = register(cloud, [L], o, viewpoint=cam.eye, seed=1)[0]
+    assert r.success and math.degrees(rotation_error(r.transform[:3, :3], T[:3, :3])) < 5
+
+
+def test_keywords_map_to_fields():
+    cases = {
+        "voxel": (0.004, "voxel", 0.004), "inlier_distance": (2.0, "inlier_distance", 2.0),
+        "weight_sigma": (0.7, "weight_sigma", 0.7), "min_scene_points": (12, "min_scene_points", 12),
+        "threads": (1, "threads", 1), "normal_radius": (2.5, "features.normal_radius", 2.5),
+        "feature_radius": (4.0, "features.feature_radius", 4.0),
+        "pcl_features": (True, "features.estimator", FeatureEstimator.Pcl),
+        "feature_neighbours": (3, "correspondences.neighbours", 3),
+        "reverse_matches": (False, "correspondences.reverse", False),
+        "hellinger": (False, "correspondences.hellinger", False), "restarts": (6, "ransac.restarts", 6),
+        "ransac_iterations": (500, "ransac.iterations", 500), "hypotheses": (2, "ransac.hypotheses", 2),
+        "icp_iterations": (12, "icp.iterations", 12), "icp_distance": (1.1, "icp.distance", 1.1),
+        "up_prior": (False, "up_prior.enabled", False), "upright": (False, "up_prior.upright", False),
+        "up": ((0, 0, 2.0), "up_prior.up", (0, 0, 2.0)), "max_tilt_deg": (30.0, "up_prior.max_tilt", math.pi / 6),
+    }
+    for kw, (value, path, want) in cases.items():
+        got = _get(registration_options(**{kw: value}), path)
+        if isinstance(want, FeatureEstimator):
+            assert got == want, kw
+        else:
+            np.testing.assert_allclose(np.asarray(got, float), np.asarray(want, float), rtol=1e-15, err_msg=kw)
+    assert registration_options(pcl_features=False).features.estimator == FeatureEstimator.Ours
+    # Keywords apply over a given options object, which is not changed.
+    o = RegistrationOptions(voxel=0.006)
+    k = registration_options(o, restarts=4)
+    assert (k.voxel, k.ransac.restarts, o.ransac.restarts) == (0.006, 4, 3)
+    with pytest.raises(ValueError, match="bogus"):
+        registration_options(bogus=1)
+    with pytest.raises(ValueError, match="bogus"):
+        register(np.zeros((10, 3)), [l_block()], bogus=1)
+    with pytest.raises(ValueError, match="bogus"):
+        vision.Registrar([l_block()], bogus=1)
+    with pytest.raises(ValueError, match="ransac.confidence"):
+        registration_options(RegistrationOptions(ransac=_core.vision.RansacOptions(confidence=2.0)))
+    with pytest.raises(ValueError, match="options"):
+        registration_options(0.005)
+    with pytest.raises(ValueError, match="threads"):
+        vision.Registrar([l_block()], threads=-1)
+    with pytest.raises(ValueError, match="up_prior.max_tilt"):
+        registration_options(max_tilt_deg=0)
+
+
+def test_typed_failures_and_model_info():
+    L = l_block()
+    cam = Camera.looking_at(eye=(0.4, -0.4, 0.4), target=(0.05, 0.05, 0.03))
+    cloud = cam.capture([L], seed=1)
+    two = (np.array([[0, 0, 0], [0.1, 0, 0.0]]), np.array([[0, 0, 1], [0, 0, 1.0]]))
+    r = register(cloud, [two, L], viewpoint=cam.eye)
+    assert r[0].status == RegistrationStatus.TooFewModelPoints and not r[0].success and r[0].weight == 0
+    assert r[1].status == RegistrationStatus.Ok and r[1].reason == ""
+    # A vertical needle: no pair of its points is 2 voxels apart horizontally, no upright hypothesis.
+    z = np.linspace(0, 0.2, 400)
+    jitter = np.random.default_rng(3).uniform(-0.0009, 0.0009, (400, 2))
+    needle = np.column_stack([0.0025 + jitter, z])
+    n = register(needle, [L])[0]
+    assert n.status == RegistrationStatus.NoHypothesis and not n.success
+    np.testing.assert_array_equal(n.transform, np.eye(4))
+    raw = _core.vision.register_models(cloud, [two], _core.vision.RegistrationOptions())[0]
+    assert isinstance(raw, _core.vision.RegistrationResult) and raw.status == RegistrationStatus.TooFewModelPoints
+    assert raw.transform.shape == (4, 4) and not raw.success
+    assert set(RegistrationStatus.__members__) == {"Ok", "NoSurface", "InvalidModel", "TooFewModelPoints",
+                                                   "TooFewScenePoints", "NoHypothesis", "NonFiniteTransform"}
+
+
+def test_shape_weights():
+    w = shape_weights([0.5, 0.2, 0.3, 0.9], [True, True, True, False])
+    np.testing.assert_allclose(w, [0.5, 0.2, 0.3, 0.0], rtol=1e-15)  # sum of the registered phi is 1
+    np.testing.assert_array_equal(shape_weights([0.2, 0.6], [True, True]), np.array([0.2, 0.6]) / 0.8)
+    np.testing.assert_array_equal(shape_weights([0.0, 0.0], [True, True]), [0.0, 0.0])  # no evidence: all zero
+    np.testing.assert_array_equal(shape_weights([0.7, np.nan], [False, False]), [0.0, 0.0])
+    assert shape_weights([], []).shape == (0,)
+    with pytest.raises(ValueError, match="phi"):
+        shape_weights([0.1, 0.2], [True])
+    with pytest.raises(ValueError, match="phi"):
+        shape_weights([-0.1, 0.2], [True, True])
+    with pytest.raises(ValueError, match="phi"):
+        shape_weights([np.inf, 0.2], [True, True])

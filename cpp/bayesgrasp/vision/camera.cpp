@@ -5,6 +5,8 @@
 #include <numeric>
 #include <stdexcept>
 
+#include "bayesgrasp/common/random.hpp"
+
 namespace bayesgrasp::vision {
 
 void validate_intrinsics(const Intrinsics& K) {
@@ -201,36 +203,24 @@ bool RayCaster::intersect(const Vec3& o, const Vec3& d, Hit& hit, double tmin, d
 }
 
 // ---------------------------------------------------------------------------------------
-namespace {
-inline std::uint64_t splitmix64(std::uint64_t x) {
-  x += 0x9E3779B97F4A7C15ull;
-  x = (x ^ (x >> 30)) * 0xBF58476D1CE4E5B9ull;
-  x = (x ^ (x >> 27)) * 0x94D049BB133111EBull;
-  return x ^ (x >> 31);
-}
-// Uniform in (0, 1) from (seed, pixel, stream).
-inline double uniform(std::uint64_t seed, std::uint64_t pixel, std::uint64_t stream) {
-  const std::uint64_t h = splitmix64(splitmix64(seed ^ 0x5851F42D4C957F2Dull) ^ (pixel * 4 + stream));
-  return (static_cast<double>(h >> 11) + 0.5) * (1.0 / 9007199254740992.0);
-}
-}  // namespace
-
 RenderResult render(const Intrinsics& K, const Iso3& pose, const std::vector<TriMesh>& meshes,
                     const Table& table, const NoiseModel& noise) {
   const RayCaster caster(meshes);
   return render(K, pose, caster, table, noise);
 }
 
-RenderResult render(const Intrinsics& K, const Iso3& pose, const RayCaster& caster, const Table& table,
-                    const NoiseModel& noise) {
-  validate_intrinsics(K);
-  if (!pose.matrix().allFinite()) throw std::invalid_argument("camera pose must be finite");
+namespace {
+// Uniform in (0, 1) from (seed, pixel, stream).
+double uniform(std::uint64_t seed, std::uint64_t pixel, std::uint64_t stream) {
+  const std::uint64_t h = mix_seed(mix_seed(seed ^ 0x5851F42D4C957F2Dull) ^ (pixel * 4 + stream));
+  return (static_cast<double>(h >> 11) + 0.5) * (1.0 / 9007199254740992.0);
+}
+
+// Noise-free depth, labels and |cos| of the incidence angle per pixel: the nearest of the meshes'
+// hits and the table rectangle.
+void cast_rays(const Intrinsics& K, const Iso3& pose, const RayCaster& caster, const Table& table, RenderResult& out,
+               DepthImage& cosang) {
   const int W = K.width, H = K.height;
-  const double nan = std::numeric_limits<double>::quiet_NaN();
-  RenderResult out;
-  out.depth = DepthImage::Constant(H, W, nan);
-  out.label = decltype(out.label)::Constant(H, W, -1);
-  DepthImage cosang = DepthImage::Zero(H, W);
   const Mat3 R = pose.linear();
   const Vec3 o = pose.translation();
 #pragma omp parallel for schedule(dynamic, 4)
@@ -265,10 +255,14 @@ RenderResult render(const Intrinsics& K, const Iso3& pose, const RayCaster& cast
       }
     }
   }
-  if (!noise.enabled) return out;
+}
 
-  // Dropping (incidence, edges, range) is decided on the noise-free image, then noise is added.
-  const DepthImage clean = out.depth;
+// The noise model on a noise-free depth image: dropping (incidence, edges, range) is decided on
+// the noise-free image, then axial noise and disparity quantisation are applied.
+void add_noise(const Intrinsics& K, const NoiseModel& noise, const DepthImage& cosang, DepthImage& depth) {
+  const int W = K.width, H = K.height;
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  const DepthImage clean = depth;
   const double cos_max = std::cos(noise.max_incidence);
   const double fB = K.fx * noise.baseline;
 #pragma omp parallel for schedule(static)
@@ -290,7 +284,7 @@ RenderResult render(const Intrinsics& K, const Iso3& pose, const RayCaster& cast
         if (edge && uniform(noise.seed, pix, 0) < noise.edge_drop_prob) drop = true;
       }
       if (drop) {
-        out.depth(v, u) = nan;
+        depth(v, u) = nan;
         continue;
       }
       const double sigma = noise.sigma_a + noise.sigma_b * (z - noise.sigma_z0) * (z - noise.sigma_z0);
@@ -302,9 +296,22 @@ RenderResult render(const Intrinsics& K, const Iso3& pose, const RayCaster& cast
         const double q = std::round(disp / noise.disparity_step) * noise.disparity_step;
         zn = q > 0 ? fB / q : nan;
       }
-      out.depth(v, u) = zn;
+      depth(v, u) = zn;
     }
   }
+}
+}  // namespace
+
+RenderResult render(const Intrinsics& K, const Iso3& pose, const RayCaster& caster, const Table& table,
+                    const NoiseModel& noise) {
+  validate_intrinsics(K);
+  if (!pose.matrix().allFinite()) throw std::invalid_argument("camera pose must be finite");
+  RenderResult out;
+  out.depth = DepthImage::Constant(K.height, K.width, std::numeric_limits<double>::quiet_NaN());
+  out.label = decltype(out.label)::Constant(K.height, K.width, -1);
+  DepthImage cosang = DepthImage::Zero(K.height, K.width);
+  cast_rays(K, pose, caster, table, out, cosang);
+  if (noise.enabled) add_noise(K, noise, cosang, out.depth);
   return out;
 }
 
