@@ -43,7 +43,6 @@ human-readable ``reason``; bad input (an empty cloud, no models, bad options) is
 """
 from __future__ import annotations
 
-import json
 import math
 from dataclasses import dataclass, field
 from typing import Any, Callable, Dict, List, Optional, Sequence, Tuple, Union
@@ -55,7 +54,7 @@ from bayesgrasp.belief import shape_weights
 
 __all__ = [
     "Camera", "SegmentationResult", "RegistrationResult", "Registrar", "segment_table", "register",
-    "model_samples", "rotation_error", "register_command", "as_cloud", "as_mesh", "registration_options",
+    "model_samples", "rotation_error", "as_cloud", "as_mesh", "registration_options",
     "RegistrationOptions", "FeatureOptions", "CorrespondenceOptions", "RansacOptions", "IcpOptions", "UpPrior",
     "FeatureEstimator", "RegistrationStatus",
 ]
@@ -497,72 +496,3 @@ def rotation_error(Ra, Rb, axis=None) -> float:
     """Angle (rad) between two rotations; with ``axis`` (model frame), rotation about it is ignored."""
     ax = None if axis is None else np.asarray(axis, float)
     return float(_v.rotation_error(np.asarray(Ra, float), np.asarray(Rb, float), ax))
-
-
-# ---------------------------------------------------------------------------------------------
-def _load(name_or_path):
-    from bayesgrasp.objects import load_object
-
-    return load_object(name_or_path)
-
-
-def register_command(scene_object, pose, models, json_out: bool = False, png: Optional[str] = None,
-                     voxel: float = 0.005, seed: int = 0, eye=(0.45, -0.45, 0.45), print_fn=print) -> dict:
-    """``bayesgrasp register``: places ``scene_object`` (built-in name or mesh path) on the table at
-    ``pose`` = (x, y, yaw) (or "X,Y,YAW"), renders one noisy view from ``eye`` (relative to the
-    object, looking at it), segments the table, registers the largest cluster against each of
-    ``models`` and prints transform, fitness, RMSE and weight per model (``json_out``: one JSON
-    document ``{"models": [{"model", "transform", "fitness", "rmse", "weight"}, ...]}``).
-    Writes a PNG of the partial cloud over each registered model to ``png`` if given. Returns the
-    JSON-able dict (with extra keys ``success``, ``reason``, ``delta``, ``phi``)."""
-    if isinstance(pose, str):
-        try:
-            pose = [float(v) for v in pose.split(",")]
-        except ValueError:
-            raise ValueError(f"pose: expected X,Y,YAW, got {pose!r}") from None
-    pose = [float(v) for v in pose]
-    if len(pose) != 3 or not all(math.isfinite(v) for v in pose):
-        raise ValueError(f"pose: expected three finite numbers X,Y,YAW, got {pose}")
-    if isinstance(models, str):
-        models = [models]
-    if not models:
-        raise ValueError("models: give at least one model")
-    obj = _load(scene_object)
-    x, y, yaw = pose
-    c, s = math.cos(yaw), math.sin(yaw)
-    T = np.array([[c, -s, 0, x], [s, c, 0, y], [0, 0, 1, 0], [0, 0, 0, 1.0]])
-    V = obj.vertices @ T[:3, :3].T + T[:3, 3]
-    centre = V.mean(axis=0)
-    cam = Camera.looking_at(eye=centre + np.asarray(eye, float), target=centre)
-    cloud = cam.capture([(V, obj.faces)], table={"z": 0.0, "center": (x, y), "half_extents": (0.6, 0.6)},
-                        seed=seed)
-    if len(cloud) == 0:
-        raise ValueError("the camera sees nothing: move the object or the camera")
-    seg = segment_table(cloud)
-    if not seg.clusters:
-        raise ValueError("no object found above the table")
-    part = seg.cluster_points[0]
-    model_objs = [_load(m) for m in models]
-    names = [str(m) for m in models]
-    res = register(part, model_objs, voxel=voxel, seed=seed, viewpoint=cam.eye, names=names)
-    doc = {"scene_object": str(scene_object), "pose": pose, "scene_points": int(len(part)),
-           "models": [r.as_dict() for r in res]}
-    if json_out:
-        print_fn(json.dumps(doc, indent=2))
-    else:
-        print_fn(f"scene object {scene_object} at x={x:.3f} y={y:.3f} yaw={yaw:.3f}: "
-                 f"{len(part)} points in the largest cluster")
-        for r in res:
-            if not r.success:
-                print_fn(f"  {r.model}: registration failed: {r.reason}")
-                continue
-            print_fn(f"  {r.model}: fitness {r.fitness:.3f}  rmse {r.rmse * 1000:.2f} mm  "
-                     f"delta {r.delta * 1000:.2f} mm  weight {r.weight:.3f}")
-            for row in r.transform:
-                print_fn("      [" + " ".join(f"{v: .4f}" for v in row) + "]")
-    if png:
-        from bayesgrasp.viz import plot_registrations
-
-        plot_registrations(part, model_objs, res, png)
-    return doc
-

@@ -57,6 +57,7 @@ def test_grasp_relative_to_the_object_pose_is_invariant():
     (["experiment", "pub2", "--objects", "no_such_thing"], "neither a built-in"),
     (["experiment", "pub2", "--out", "/proc/forbidden/dir"], "--out"),
     (["experiment", "pub2", "--no-lift"], "--success epsilon"),
+    (["register", "--scene-object", "cube", "--pose", "1,2", "--models", "cube"], "--pose"),
 ])
 def test_bad_input_gives_a_message_and_exit_status_2(args, needle, capsys):
     assert main(args) == 2
@@ -132,3 +133,31 @@ def test_negative_lone_numbers_and_option_like_values_are_left_to_argparse():
     assert join_negative_values(["plan", "--seed", "-1"]) == ["plan", "--seed=-1"]
     assert join_negative_values(["grasp", "--top", "--json"]) == ["grasp", "--top", "--json"]
     assert join_negative_values(["grasp", "--top=-1,0,0"]) == ["grasp", "--top=-1,0,0"]
+
+
+def test_register_json_and_png(tmp_path, capsys):
+    png = tmp_path / "reg.png"
+    assert main(["register", "--scene-object", "cube", "--pose", "0.05,0.0,0.4", "--models", "cube", "cylinder",
+                 "--json", "--png", str(png)]) == 0
+    out = capsys.readouterr().out
+    doc = json.loads(out[:out.rindex("}") + 1])
+    assert [m["model"] for m in doc["models"]] == ["cube", "cylinder"]
+    for m in doc["models"]:
+        assert set(m) >= {"model", "transform", "fitness", "rmse", "weight"}
+        assert np.asarray(m["transform"]).shape == (4, 4)
+    assert doc["models"][0]["weight"] > doc["models"][1]["weight"]
+    assert png.exists() and png.stat().st_size > 1000
+
+
+def test_captured_view_of_an_object_sees_only_that_object():
+    from bayesgrasp.objects.views import capture_view
+
+    v = capture_view("cube", (0.05, 0.0, 0.4), seed=1)
+    half = World.single("cube").object.extent / 2
+    assert len(v.object_points) > 100 and len(v.cloud) > len(v.object_points)
+    # the segmented points lie on the cube (noise of a few mm), the table is gone
+    c, s = np.cos(-0.4), np.sin(-0.4)
+    p = (v.object_points - [0.05, 0.0, 0.0]) @ np.array([[c, -s, 0], [s, c, 0], [0, 0, 1]]).T
+    assert np.all(np.abs(p[:, :2]) < half[:2] + 0.006) and np.all(p[:, 2] > 0.003)
+    with pytest.raises(ValueError, match="pose"):
+        capture_view("cube", (1.0, 2.0))

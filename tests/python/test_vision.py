@@ -189,21 +189,6 @@ def test_bad_inputs():
         Camera.looking_at(eye=(0, 0, 1), target=(0, 0, 0))  # view parallel to up
 
 
-def test_register_command_json_and_png(tmp_path, capsys):
-    pytest.importorskip("bayesgrasp.objects.library")
-    png = tmp_path / "reg.png"
-    doc = vision.register_command("cube", "0.05,0.0,0.4", ["cube", "cylinder"], json_out=True, png=str(png))
-    printed = json.loads(capsys.readouterr().out)
-    assert [m["model"] for m in printed["models"]] == ["cube", "cylinder"]
-    for m in printed["models"]:
-        assert set(m) >= {"model", "transform", "fitness", "rmse", "weight"}
-        assert np.asarray(m["transform"]).shape == (4, 4)
-    assert doc["models"][0]["weight"] > doc["models"][1]["weight"]
-    assert png.exists() and png.stat().st_size > 1000
-    with pytest.raises(ValueError, match="pose"):
-        vision.register_command("cube", "1,2", ["cube"])
-
-
 def test_registrar_reused_across_clouds_equals_one_shot():
     L, cyl = l_block(), cylinder(0.04, 0.12)
     reg = vision.Registrar([cyl, L], names=["cyl", "L"], restarts=6)  # flat faces: search longer
