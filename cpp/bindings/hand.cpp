@@ -18,21 +18,9 @@ py::array_t<double> poses_array(const std::vector<Iso3>& poses) {
   return out;
 }
 
-py::array_t<double> matrix4(const Iso3& T) {
-  py::array_t<double> out({4, 4});
-  auto o = out.mutable_unchecked<2>();
-  for (int r = 0; r < 4; ++r)
-    for (int c = 0; c < 4; ++c) o(r, c) = T.matrix()(r, c);
-  return out;
-}
-
 Eigen::VectorXd joints_arg(const HandModel& h, const DArray& q) {
-  const Eigen::VectorXd v = vector(q, "q", h.num_joints());
-  try {
-    h.check_joints(v, 1e-9);
-  } catch (const std::invalid_argument& e) {
-    throw py::value_error(std::string("q: ") + e.what());
-  }
+  const Eigen::VectorXd v = vector(q, "q");
+  h.check_joints(v, 1e-9, "q");
   return v;
 }
 
@@ -41,18 +29,37 @@ Iso3 pose_or_identity(const py::object& p, const char* name) {
   return pose(p.cast<DArray>(), name);
 }
 
+/// One value per link.
 template <class F>
-auto wrap(F&& f) -> decltype(f()) {
-  try {
-    return f();
-  } catch (const std::invalid_argument& e) {
-    throw py::value_error(e.what());
-  }
+auto per_link(const HandModel& h, F&& value) {
+  std::vector<decltype(value(h.links()[0]))> out;
+  for (const Link& l : h.links()) out.push_back(value(l));
+  return out;
+}
+
+void bind_shape(py::module_& m) {
+  py::class_<Shape>(m, "Shape", "A collision primitive of a hand link, in the link frame.")
+      .def_property_readonly(
+          "type", [](const Shape& s) { return s.type == Shape::Type::Box ? "box" : "capsule"; },
+          "type : str\n    'box' or 'capsule'.")
+      .def_property_readonly(
+          "center", [](const Shape& s) { return Eigen::Vector3d(s.center); },
+          "center : numpy.ndarray (3,)\n    Box centre (box axes = link axes), m.")
+      .def_property_readonly(
+          "half_extents", [](const Shape& s) { return Eigen::Vector3d(s.half_extents); },
+          "half_extents : numpy.ndarray (3,)\n    Box half extents, m.")
+      .def_property_readonly(
+          "p0", [](const Shape& s) { return Eigen::Vector3d(s.p0); }, "p0 : numpy.ndarray (3,)\n    Capsule axis start, m.")
+      .def_property_readonly(
+          "p1", [](const Shape& s) { return Eigen::Vector3d(s.p1); }, "p1 : numpy.ndarray (3,)\n    Capsule axis end, m.")
+      .def_readonly("radius", &Shape::radius, "radius : float\n    Capsule radius, m.")
+      .def("__repr__", [](const Shape& s) { return std::string("<Shape ") + (s.type == Shape::Type::Box ? "box>" : "capsule>"); });
 }
 
 }  // namespace
 
 void bind_hand(py::module_& m) {
+  bind_shape(m);
   py::class_<HandModel>(m, "Hand", R"doc(A multi-fingered hand described by a JSON file.
 
 Frames: the hand frame has its origin at the centre of the palm face and +z along the
@@ -61,10 +68,10 @@ phalanx 1, ..., finger 1 phalanx 0, ...]; phalanx angles are relative to the pre
 phalanx. Each finger closes by one actuator parameter t: phalanx j follows
 offset_j + ratio_j * t, clamped to its limits (the coupling), with breakaway.)doc")
       .def_static(
-          "from_file", [](const std::string& path) { return wrap([&] { return HandModel::from_file(path); }); },
+          "from_file", [](const std::string& path) { return HandModel::from_file(path); },
           py::arg("path"), "Loads a hand file; ValueError naming the problem if it is missing or invalid.")
       .def_static(
-          "from_json", [](const std::string& text) { return wrap([&] { return HandModel::from_json(text); }); },
+          "from_json", [](const std::string& text) { return HandModel::from_json(text); },
           py::arg("text"), "Parses the JSON text of a hand file; ValueError naming the problem.")
       .def_property_readonly("name", &HandModel::name, "The hand's name.")
       .def_property_readonly("num_joints", &HandModel::num_joints, "Length of the joint vector q.")
@@ -72,28 +79,13 @@ offset_j + ratio_j * t, clamped to its limits (the coupling), with breakaway.)do
       .def_property_readonly("num_fingers", [](const HandModel& h) { return static_cast<int>(h.fingers().size()); },
                              "Number of fingers.")
       .def_property_readonly(
-          "link_names",
-          [](const HandModel& h) {
-            std::vector<std::string> n;
-            for (const Link& l : h.links()) n.push_back(l.name);
-            return n;
-          },
+          "link_names", [](const HandModel& h) { return per_link(h, [](const Link& l) { return l.name; }); },
           "Link names, e.g. 'palm', 'finger1/proximal'.")
       .def_property_readonly(
-          "link_fingers",
-          [](const HandModel& h) {
-            std::vector<int> n;
-            for (const Link& l : h.links()) n.push_back(l.finger);
-            return n;
-          },
+          "link_fingers", [](const HandModel& h) { return per_link(h, [](const Link& l) { return l.finger; }); },
           "Finger index of each link (-1 for the palm).")
       .def_property_readonly(
-          "link_phalanges",
-          [](const HandModel& h) {
-            std::vector<int> n;
-            for (const Link& l : h.links()) n.push_back(l.phalanx);
-            return n;
-          },
+          "link_phalanges", [](const HandModel& h) { return per_link(h, [](const Link& l) { return l.phalanx; }); },
           "Phalanx index of each link within its finger (-1 for palm and knuckles).")
       .def_property_readonly(
           "joint_names",
@@ -133,9 +125,7 @@ offset_j + ratio_j * t, clamped to its limits (the coupling), with breakaway.)do
       .def(
           "coupled_joints",
           [](const HandModel& h, double spread, const py::object& t) {
-            finite(spread, "spread");
-            if (spread < h.spread_lower() - 1e-12 || spread > h.spread_upper() + 1e-12)
-              throw py::value_error("spread: outside the hand's limits");
+            h.check_spread(spread);
             if (py::isinstance<py::float_>(t) || py::isinstance<py::int_>(t))
               return Eigen::VectorXd(h.coupled_joints(spread, finite(t.cast<double>(), "t")));
             const Eigen::VectorXd tv = vector(t.cast<DArray>(), "t", static_cast<py::ssize_t>(h.fingers().size()));
@@ -162,31 +152,8 @@ offset_j + ratio_j * t, clamped to its limits (the coupling), with breakaway.)do
           },
           py::arg("q"), py::arg("hand_pose") = py::none(), "(F, 3) fingertip positions (end of each last phalanx).")
       .def(
-          "link_shapes",
-          [](const HandModel& h) {
-            py::list out;
-            for (const Link& l : h.links()) {
-              py::list shapes;
-              for (const Shape& s : l.shapes) {
-                py::dict d;
-                if (s.type == Shape::Type::Box) {
-                  d["type"] = "box";
-                  d["center"] = Eigen::Vector3d(s.center);
-                  d["half_extents"] = Eigen::Vector3d(s.half_extents);
-                } else {
-                  d["type"] = "capsule";
-                  d["p0"] = Eigen::Vector3d(s.p0);
-                  d["p1"] = Eigen::Vector3d(s.p1);
-                  d["radius"] = s.radius;
-                }
-                shapes.append(d);
-              }
-              out.append(shapes);
-            }
-            return out;
-          },
-          R"doc(Per link, its collision shapes in the link frame: dicts with type 'box'
-(center, half_extents; box axes = link axes) or 'capsule' (p0, p1, radius).)doc")
+          "link_shapes", [](const HandModel& h) { return per_link(h, [](const Link& l) { return l.shapes; }); },
+          "Per link, its collision shapes (Shape) in the link frame.")
       .def_property_readonly(
           "spread_limits", [](const HandModel& h) { return std::make_pair(h.spread_lower(), h.spread_upper()); },
           "(lower, upper) spread limits (rad).")
@@ -194,7 +161,7 @@ offset_j + ratio_j * t, clamped to its limits (the coupling), with breakaway.)do
           "top_grasp_pose",
           [](double x, double y, double yaw, double z) {
             finite(x, "x"), finite(y, "y"), finite(yaw, "yaw"), finite(z, "z");
-            return matrix4(HandModel::top_grasp_pose(x, y, yaw, z));
+            return to_numpy(HandModel::top_grasp_pose(x, y, yaw, z));
           },
           py::arg("x"), py::arg("y"), py::arg("yaw"), py::arg("z"),
           "4x4 world pose of a palm-down hand at (x, y, yaw) with its palm face at height z.")

@@ -21,7 +21,7 @@ def grasp(args) -> int:
     top = _floats(args.top, 3, "--top")
     pose = _floats(args.object_pose, 3, "--object-pose")
     world = _world(args.object, pose, hand=args.hand, keep_origin=args.keep_origin)
-    g = world.grasp(*top, spread=args.spread, lift=not args.no_lift)
+    g = world.grasp(*top, spread=args.spread, lift=not args.no_lift).to_dict()
     out = {
         "object": args.object, "object_pose": pose, "top": top, "hand": world.hand.name,
         "joint_angles": [float(v) for v in g["joint_angles"]],

@@ -271,9 +271,9 @@ def choose_spread(world: World, settings: ModelSettings, say=lambda m: None) -> 
     table, scores = {}, []
     for sp in AUTO_SPREADS:
         b = world.grasp_batch(rel, spread=sp, threads=0)
-        ok = (np.asarray(b["epsilon"]) > settings.eps_stable) & ~np.asarray(b["collision_at_start"], dtype=bool)
+        ok = (np.asarray(b.epsilon) > settings.eps_stable) & ~np.asarray(b.collision_at_start, dtype=bool)
         idx = np.flatnonzero(ok)[:settings.n_pilot_lifts]
-        lifted = int(np.sum(world.grasp_batch(rel[idx], spread=sp, lift=True, threads=0)["lifted"])) if len(idx) else 0
+        lifted = int(np.sum(world.grasp_batch(rel[idx], spread=sp, lift=True, threads=0).lifted)) if len(idx) else 0
         frac = float(np.mean(ok))
         table[round(float(np.degrees(sp)))] = (frac, lifted, int(len(idx)))
         scores.append((frac * (lifted / len(idx) if len(idx) else 0.0), frac))
@@ -293,8 +293,8 @@ def simulate_training_data(world: World, settings: ModelSettings, seed_offset: i
                            rng.uniform(-np.pi, np.pi, n)])
     spread = settings.spread if spread is None else spread
     b = world.grasp_batch(rel, spread=spread, threads=0)
-    ok = ~np.asarray(b["collision_at_start"], dtype=bool)
-    return rel[ok], np.asarray(b["joint_angles"])[ok], np.asarray(b["epsilon"])[ok]
+    ok = ~np.asarray(b.collision_at_start, dtype=bool)
+    return rel[ok], np.asarray(b.joint_angles)[ok], np.asarray(b.epsilon)[ok]
 
 
 def build_models(obj: Union[str, ObjectModel], hand="barrett_bh8", settings: Optional[ModelSettings] = None,

@@ -101,19 +101,19 @@ def run_episode(obj: Union[str, ObjectModel], true_pose: Sequence[float], method
         plan = planner.plan()
         rel = relative_top_grasps(plan.action, true_pose)[0, 0]
         g = world.grasp_batch(rel[None, :], spread=models.spread)
-        eps = float(g["epsilon"][0])
+        eps = float(g.epsilon[0])
         stable = eps > eps_stable
         lifted = None
         if lift and stable:
-            lifted = bool(world.grasp_batch(rel[None, :], spread=models.spread, lift=True)["lifted"][0])
-        q = np.asarray(g["joint_angles"][0], dtype=float)[models.joint_index]
+            lifted = bool(world.grasp_batch(rel[None, :], spread=models.spread, lift=True).lifted[0])
+        q = np.asarray(g.joint_angles[0], dtype=float)[models.joint_index]
         if measurement_noise > 0:
             q = q + rng.normal(0.0, measurement_noise, q.shape)
         rec = {"attempt": k + 1, "kind": plan.kind, "action": plan.action.tolist(), "relative_grasp": rel.tolist(),
                "predicted_stability": float(plan.predicted_stability), "objective": float(plan.objective),
                "expected_entropy": plan.expected_entropy, "plan_seconds": plan.seconds,
                "evaluations": plan.evaluations, "epsilon": eps, "force_closure": eps > 0.0, "stable": bool(stable),
-               "lifted": lifted, "collision_at_start": bool(g["collision_at_start"][0]),
+               "lifted": lifted, "collision_at_start": bool(g.collision_at_start[0]),
                "joint_angles": q.tolist(), "belief_before": before}
         success = success or stable
         if not (stable and stop_when_stable):
