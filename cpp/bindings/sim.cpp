@@ -4,6 +4,8 @@
 // the core (std::invalid_argument becomes ValueError).
 #include <pybind11/stl.h>
 
+#include <type_traits>
+
 #include "bayesgrasp/sim/grasp_simulator.hpp"
 #include "validate.hpp"
 
@@ -38,25 +40,32 @@ py::array flag_matrix_view(const M& m, py::handle owner) {
 }
 
 void bind_contacts(py::module_& m) {
+  // a property returning the view of one Contact member
+  const auto column = [](auto member) {
+    return [member](const ContactArrays& c) {
+      if constexpr (std::is_same_v<decltype(c.first->*member), const Vec3&>)
+        return vec3_field_view(c.first, c.count, member, c.owner);
+      else
+        return field_view(c.first, c.count, member, c.owner);
+    };
+  };
   py::class_<ContactArrays>(m, "Contacts", R"doc(Contacts of a simulated grasp, as arrays (K rows).
 
 Normals are the object's outward surface normals (+z for the table): what bayesgrasp.quality
 consumes. Read-only views of the result they belong to.)doc")
-      .def_property_readonly(
-          "point", [](const ContactArrays& c) { return vec3_field_view(c.first, c.count, &Contact::point, c.owner); },
-          "point : numpy.ndarray (K, 3) float\n    Contact point on the object's (or the table's) surface, world frame (m).")
-      .def_property_readonly(
-          "normal", [](const ContactArrays& c) { return vec3_field_view(c.first, c.count, &Contact::normal, c.owner); },
-          "normal : numpy.ndarray (K, 3) float\n    Outward unit normal of the object (+z for the table), world frame.")
-      .def_property_readonly(
-          "link", [](const ContactArrays& c) { return field_view(c.first, c.count, &Contact::link, c.owner); },
-          "link : numpy.ndarray (K,) int32\n    Index of the hand link in contact (0 = palm).")
-      .def_property_readonly(
-          "penetration", [](const ContactArrays& c) { return field_view(c.first, c.count, &Contact::penetration, c.owner); },
-          "penetration : numpy.ndarray (K,) float\n    Depth of overlap (m, >= 0; 0 when touching within the tolerance).")
-      .def_property_readonly(
-          "on_table", [](const ContactArrays& c) { return field_view(c.first, c.count, &Contact::on_table, c.owner); },
-          "on_table : numpy.ndarray (K,) bool\n    The contact is with the table, not the object.")
+      .def_property_readonly("point", column(&Contact::point),
+                             "point : numpy.ndarray (K, 3) float\n    Contact point on the object's (or the table's) "
+                             "surface, world frame (m).")
+      .def_property_readonly("normal", column(&Contact::normal),
+                             "normal : numpy.ndarray (K, 3) float\n    Outward unit normal of the object (+z for the "
+                             "table), world frame.")
+      .def_property_readonly("link", column(&Contact::link),
+                             "link : numpy.ndarray (K,) int32\n    Index of the hand link in contact (0 = palm).")
+      .def_property_readonly("penetration", column(&Contact::penetration),
+                             "penetration : numpy.ndarray (K,) float\n    Depth of overlap (m, >= 0; 0 when touching "
+                             "within the tolerance).")
+      .def_property_readonly("on_table", column(&Contact::on_table),
+                             "on_table : numpy.ndarray (K,) bool\n    The contact is with the table, not the object.")
       .def("__len__", [](const ContactArrays& c) { return c.count; });
 
   py::class_<BatchContactArrays, ContactArrays>(m, "BatchContacts", R"doc(The contacts of a batch of grasps,

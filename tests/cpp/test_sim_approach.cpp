@@ -9,22 +9,12 @@
 #include "bayesgrasp/sim/approach.hpp"
 #include "bayesgrasp/sim/grasp_simulator.hpp"
 #include "bayesgrasp/sim/sim_scene.hpp"
+#include "physics_fixtures.hpp"
 
 using namespace bayesgrasp;
+using fixtures::box_mesh;
 
 namespace {
-
-const std::string kBarrett = std::string(BAYESGRASP_SOURCE_DIR) + "/python/bayesgrasp/data/hands/barrett_bh8.json";
-
-TriMesh box(const Vec3& lo, const Vec3& hi) {
-  TriMesh m;
-  m.V.resize(8, 3);
-  for (int i = 0; i < 8; ++i)
-    m.V.row(i) << ((i & 1) ? hi.x() : lo.x()), ((i & 2) ? hi.y() : lo.y()), ((i & 4) ? hi.z() : lo.z());
-  m.F.resize(12, 3);
-  m.F << 0, 2, 1, 1, 2, 3, 4, 5, 6, 5, 7, 6, 0, 1, 4, 1, 5, 4, 2, 6, 3, 3, 6, 7, 0, 4, 2, 2, 4, 6, 1, 3, 5, 3, 7, 5;
-  return m;
-}
 
 /// Hand pose whose approach axis (hand +z) is the world direction u, palm at p.
 Iso3 facing(const Vec3& u, const Vec3& p) {
@@ -52,9 +42,9 @@ double support(const HandModel& hand, const Iso3& H, const Eigen::VectorXd& q, c
 }  // namespace
 
 TEST(SimApproach, SidewaysApproachStopsAtTheWall) {
-  const HandModel hand = HandModel::from_file(kBarrett);
+  const HandModel hand = fixtures::barrett();
   // A wall x in [0, 0.2] standing on the table, far larger than the hand.
-  const GraspSimulator sim(hand, box(Vec3(0.0, -0.4, 0.0), Vec3(0.2, 0.4, 0.8)));
+  const GraspSimulator sim(hand, box_mesh(Vec3(0.0, -0.4, 0.0), Vec3(0.2, 0.4, 0.8)));
   const sim::SimScene& s = sim.scene();
   const double tol = s.options.contact_tolerance;
   const Eigen::VectorXd open = hand.coupled_joints(hand.spread_default(), 0.0);
@@ -75,8 +65,8 @@ TEST(SimApproach, SidewaysApproachStopsAtTheWall) {
 }
 
 TEST(SimApproach, ApproachStopsOnTheTableAndBacksOff) {
-  const HandModel hand = HandModel::from_file(kBarrett);
-  const GraspSimulator sim(hand, box(Vec3(1.0, 1.0, 0.0), Vec3(1.05, 1.05, 0.05)));  // far away
+  const HandModel hand = fixtures::barrett();
+  const GraspSimulator sim(hand, box_mesh(Vec3(1.0, 1.0, 0.0), Vec3(1.05, 1.05, 0.05)));  // far away
   const sim::SimScene& s = sim.scene();
   const Eigen::VectorXd open = hand.coupled_joints(0.3, 0.0);
   const double depth = sim::depth_below_palm(hand, s.links, open);
