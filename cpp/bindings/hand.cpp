@@ -56,18 +56,55 @@ void bind_shape(py::module_& m) {
       .def("__repr__", [](const Shape& s) { return std::string("<Shape ") + (s.type == Shape::Type::Box ? "box>" : "capsule>"); });
 }
 
+/// The joint vector, link poses, fingertips and collision shapes.
+void def_kinematics(py::class_<HandModel>& hand) {
+  hand      .def_property_readonly("spread_default", &HandModel::spread_default, "Default spread (rad).")
+      .def(
+          "coupled_joints",
+          [](const HandModel& h, double spread, const py::object& t) {
+            h.check_spread(spread);
+            if (py::isinstance<py::float_>(t) || py::isinstance<py::int_>(t))
+              return Eigen::VectorXd(h.coupled_joints(spread, finite(t.cast<double>(), "t")));
+            const Eigen::VectorXd tv = vector(t.cast<DArray>(), "t", static_cast<py::ssize_t>(h.fingers().size()));
+            return Eigen::VectorXd(h.coupled_joints(spread, tv));
+          },
+          py::arg("spread"), py::arg("t") = 0.0,
+          R"doc(Joint vector at the given spread with every finger at actuator parameter t
+(a number, or one per finger). t = 0 is the open preshape.)doc")
+      .def(
+          "link_poses",
+          [](const HandModel& h, const DArray& q, const py::object& hand_pose) {
+            return poses_array(h.link_poses(pose_or_identity(hand_pose, "hand_pose"), joints_arg(h, q)));
+          },
+          py::arg("q"), py::arg("hand_pose") = py::none(),
+          "(L, 4, 4) poses of every link for joint vector q, in the frame of hand_pose (4x4, default identity).")
+      .def(
+          "fingertips",
+          [](const HandModel& h, const DArray& q, const py::object& hand_pose) {
+            const Iso3 T = pose_or_identity(hand_pose, "hand_pose");
+            const Eigen::VectorXd v = joints_arg(h, q);
+            RowMatrixXd out(static_cast<Eigen::Index>(h.fingers().size()), 3);
+            for (int f = 0; f < static_cast<int>(h.fingers().size()); ++f) out.row(f) = h.fingertip(T, f, v).transpose();
+            return to_numpy(out);
+          },
+          py::arg("q"), py::arg("hand_pose") = py::none(), "(F, 3) fingertip positions (end of each last phalanx).")
+      .def(
+          "link_shapes", [](const HandModel& h) { return per_link(h, [](const Link& l) { return l.shapes; }); },
+          "Per link, its collision shapes (Shape) in the link frame.");
+}
+
 }  // namespace
 
 void bind_hand(py::module_& m) {
   bind_shape(m);
-  py::class_<HandModel>(m, "Hand", R"doc(A multi-fingered hand described by a JSON file.
+  py::class_<HandModel> hand(m, "Hand", R"doc(A multi-fingered hand described by a JSON file.
 
 Frames: the hand frame has its origin at the centre of the palm face and +z along the
 approach direction. Joint vector q (radians): [spread, finger 0 phalanx 0, finger 0
 phalanx 1, ..., finger 1 phalanx 0, ...]; phalanx angles are relative to the previous
 phalanx. Each finger closes by one actuator parameter t: phalanx j follows
-offset_j + ratio_j * t, clamped to its limits (the coupling), with breakaway.)doc")
-      .def_static(
+offset_j + ratio_j * t, clamped to its limits (the coupling), with breakaway.)doc");
+  hand.def_static(
           "from_file", [](const std::string& path) { return HandModel::from_file(path); },
           py::arg("path"), "Loads a hand file; ValueError naming the problem if it is missing or invalid.")
       .def_static(
@@ -121,39 +158,6 @@ offset_j + ratio_j * t, clamped to its limits (the coupling), with breakaway.)do
             return out;
           },
           "Per finger, the link indices of its phalanges (base to tip).")
-      .def_property_readonly("spread_default", &HandModel::spread_default, "Default spread (rad).")
-      .def(
-          "coupled_joints",
-          [](const HandModel& h, double spread, const py::object& t) {
-            h.check_spread(spread);
-            if (py::isinstance<py::float_>(t) || py::isinstance<py::int_>(t))
-              return Eigen::VectorXd(h.coupled_joints(spread, finite(t.cast<double>(), "t")));
-            const Eigen::VectorXd tv = vector(t.cast<DArray>(), "t", static_cast<py::ssize_t>(h.fingers().size()));
-            return Eigen::VectorXd(h.coupled_joints(spread, tv));
-          },
-          py::arg("spread"), py::arg("t") = 0.0,
-          R"doc(Joint vector at the given spread with every finger at actuator parameter t
-(a number, or one per finger). t = 0 is the open preshape.)doc")
-      .def(
-          "link_poses",
-          [](const HandModel& h, const DArray& q, const py::object& hand_pose) {
-            return poses_array(h.link_poses(pose_or_identity(hand_pose, "hand_pose"), joints_arg(h, q)));
-          },
-          py::arg("q"), py::arg("hand_pose") = py::none(),
-          "(L, 4, 4) poses of every link for joint vector q, in the frame of hand_pose (4x4, default identity).")
-      .def(
-          "fingertips",
-          [](const HandModel& h, const DArray& q, const py::object& hand_pose) {
-            const Iso3 T = pose_or_identity(hand_pose, "hand_pose");
-            const Eigen::VectorXd v = joints_arg(h, q);
-            RowMatrixXd out(static_cast<Eigen::Index>(h.fingers().size()), 3);
-            for (int f = 0; f < static_cast<int>(h.fingers().size()); ++f) out.row(f) = h.fingertip(T, f, v).transpose();
-            return to_numpy(out);
-          },
-          py::arg("q"), py::arg("hand_pose") = py::none(), "(F, 3) fingertip positions (end of each last phalanx).")
-      .def(
-          "link_shapes", [](const HandModel& h) { return per_link(h, [](const Link& l) { return l.shapes; }); },
-          "Per link, its collision shapes (Shape) in the link frame.")
       .def_property_readonly(
           "spread_limits", [](const HandModel& h) { return std::make_pair(h.spread_lower(), h.spread_upper()); },
           "(lower, upper) spread limits (rad).")
@@ -169,6 +173,7 @@ offset_j + ratio_j * t, clamped to its limits (the coupling), with breakaway.)do
         return "<Hand '" + h.name() + "': " + std::to_string(h.fingers().size()) + " fingers, " +
                std::to_string(h.num_joints()) + " joints>";
       });
+  def_kinematics(hand);
 }
 
 }  // namespace bayesgrasp::bind

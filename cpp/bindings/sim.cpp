@@ -133,7 +133,7 @@ py::tuple object_contacts(const Contacts& cs) {
   return py::make_tuple(to_numpy(P), to_numpy(N));
 }
 
-void bind_results(py::module_& m) {
+void bind_result(py::module_& m) {
   using R = GraspResult;
   py::class_<R>(m, "GraspResult", "One simulated grasp (read-only; array fields are views).")
       .def_property_readonly(
@@ -178,6 +178,9 @@ void bind_results(py::module_& m) {
                (r.collision_at_start ? ", collision at start>" : ">");
       });
 
+}
+
+void bind_batch(py::module_& m) {
   using B = GraspBatch;
   py::class_<B>(m, "GraspBatch", R"doc(N simulated grasps as arrays (row i = grasp i; read-only views).)doc")
       .def_readonly("num_grasps", &B::num_grasps, "num_grasps : int\n    N.")
@@ -241,13 +244,44 @@ void bind_results(py::module_& m) {
       .def("__len__", [](const B& b) { return b.num_grasps; });
 }
 
+/// The batch calls (GIL released; threads: 0 = all cores).
+void def_batches(py::class_<GraspSimulator>& sim) {
+  sim      .def(
+          "close_batch",
+          [](const GraspSimulator& s, const DArray& hand_poses, const py::object& spreads, int threads) {
+            const std::vector<Iso3> P = poses(hand_poses, "hand_poses");
+            std::vector<double> sp;
+            if (py::isinstance<py::float_>(spreads) || py::isinstance<py::int_>(spreads)) {
+              sp.push_back(spreads.cast<double>());
+            } else {
+              const Eigen::VectorXd v = vector(spreads.cast<DArray>(), "spreads");
+              sp.assign(v.data(), v.data() + v.size());
+            }
+            py::gil_scoped_release release;
+            return s.close_batch(P, sp, threads);
+          },
+          py::arg("hand_poses"), py::arg("spreads"), py::arg("threads") = 1,
+          R"doc(Auto-grasp of N hand poses (N, 4, 4), spreads a number or (N,), in `threads` C++
+threads (0 = all cores), without the GIL. A GraspBatch.)doc")
+      .def(
+          "top_grasp_batch",
+          [](const GraspSimulator& s, const DArray& xyyaw, double spread, double standoff, int threads) {
+            const Eigen::Matrix<double, Eigen::Dynamic, 3, Eigen::RowMajor> rows = matrix(xyyaw, "xyyaw", 3, true);
+            py::gil_scoped_release release;
+            return s.top_grasp_batch(rows, spread, standoff, threads);
+          },
+          py::arg("xyyaw"), py::arg("spread"), py::arg("standoff") = 0.0, py::arg("threads") = 1,
+          "Top grasps at the rows (x, y, yaw) of an (N, 3) array; a GraspBatch.");
+}
+
 }  // namespace
 
 void bind_sim(py::module_& m) {
   bind_contacts(m);
   bind_options(m);
-  bind_results(m);
-  py::class_<GraspSimulator>(m, "GraspSimulator", R"doc(Auto-grasp of a hand on a static triangle-mesh object.
+  bind_result(m);
+  bind_batch(m);
+  py::class_<GraspSimulator> sim(m, "GraspSimulator", R"doc(Auto-grasp of a hand on a static triangle-mesh object.
 
 The object mesh is in the world frame (z up); an infinite table at z = 0 is optional. Fingers
 close from the open preshape by conservative advancement with FCL distance queries; each
@@ -258,8 +292,8 @@ Args:
     hand: a bayesgrasp._core.hand.Hand.
     vertices: (N, 3) float object vertices (m, world frame).
     faces: (M, 3) int triangles, counter-clockwise seen from outside.
-    options: SimOptions (ValueError naming an option out of range).)doc")
-      .def(py::init([](const HandModel& hand, const DArray& vertices, const IArray& faces, const SimOptions& options) {
+    options: SimOptions (ValueError naming an option out of range).)doc");
+  sim.def(py::init([](const HandModel& hand, const DArray& vertices, const IArray& faces, const SimOptions& options) {
              return GraspSimulator(hand, bind::mesh(vertices, faces, "object"), options);
            }),
            py::arg("hand"), py::arg("vertices"), py::arg("faces"), py::arg("options") = SimOptions())
@@ -292,38 +326,13 @@ the contact tolerance of the object or the table, rises by `standoff` (m, >= 0, 
 first touching link stays in contact; and by the table clearance) and closes. Its hand_pose is
 where the hand stopped.)doc")
       .def(
-          "close_batch",
-          [](const GraspSimulator& s, const DArray& hand_poses, const py::object& spreads, int threads) {
-            const std::vector<Iso3> P = poses(hand_poses, "hand_poses");
-            std::vector<double> sp;
-            if (py::isinstance<py::float_>(spreads) || py::isinstance<py::int_>(spreads)) {
-              sp.push_back(spreads.cast<double>());
-            } else {
-              const Eigen::VectorXd v = vector(spreads.cast<DArray>(), "spreads");
-              sp.assign(v.data(), v.data() + v.size());
-            }
-            py::gil_scoped_release release;
-            return s.close_batch(P, sp, threads);
-          },
-          py::arg("hand_poses"), py::arg("spreads"), py::arg("threads") = 1,
-          R"doc(Auto-grasp of N hand poses (N, 4, 4), spreads a number or (N,), in `threads` C++
-threads (0 = all cores), without the GIL. A GraspBatch.)doc")
-      .def(
-          "top_grasp_batch",
-          [](const GraspSimulator& s, const DArray& xyyaw, double spread, double standoff, int threads) {
-            const Eigen::Matrix<double, Eigen::Dynamic, 3, Eigen::RowMajor> rows = matrix(xyyaw, "xyyaw", 3, true);
-            py::gil_scoped_release release;
-            return s.top_grasp_batch(rows, spread, standoff, threads);
-          },
-          py::arg("xyyaw"), py::arg("spread"), py::arg("standoff") = 0.0, py::arg("threads") = 1,
-          "Top grasps at the rows (x, y, yaw) of an (N, 3) array; a GraspBatch.")
-      .def(
           "link_object_distance",
           [](const GraspSimulator& s, const DArray& hand_pose, const DArray& q, int link) {
             return s.link_object_distance(pose(hand_pose, "hand_pose"), vector(q, "q"), link);
           },
           py::arg("hand_pose"), py::arg("q"), py::arg("link"),
           "Exact distance (m) from one link to the object (not the table); <= 0 when penetrating.");
+  def_batches(sim);
 }
 
 }  // namespace bayesgrasp::bind

@@ -75,6 +75,22 @@ std::vector<Shape> shapes(const json& j, const std::string& where) {
   return out;
 }
 
+/// One phalanx of a finger from its JSON object (`where` names it in errors).
+Phalanx parse_phalanx(const json& j, size_t p, const std::string& where) {
+  Phalanx phalanx;
+  phalanx.name = j.contains("name") ? j.at("name").get<std::string>() : "phalanx" + std::to_string(p);
+  phalanx.length = number(j, "length", where);
+  if (!(phalanx.length > 0)) fail(where, "length must be positive");
+  phalanx.lower = number(j, "lower_deg", where) * kDeg;
+  phalanx.upper = number(j, "upper_deg", where) * kDeg;
+  if (phalanx.lower > phalanx.upper) fail(where, "lower_deg > upper_deg");
+  phalanx.offset = number_or(j, "offset_deg", j.contains("lower_deg") ? number(j, "lower_deg", where) : 0.0, where) * kDeg;
+  phalanx.ratio = number_or(j, "ratio", 1.0, where);
+  if (phalanx.ratio < 0) fail(where, "ratio must be >= 0");
+  phalanx.shapes = shapes(j, where);
+  return phalanx;
+}
+
 Eigen::Matrix3d link_rotation(const Vec3& d, double theta) {
   const Vec3 z = Vec3::UnitZ();
   const Vec3 a = d.cross(z);
@@ -147,18 +163,7 @@ HandModel HandModel::from_json(const std::string& json_text) {
     if (!ph.is_array() || ph.empty()) fail(w, "'phalanges' must be a non-empty list");
     finger.first_joint = joint;
     for (size_t p = 0; p < ph.size(); ++p) {
-      const std::string wp = w + ".phalanges[" + std::to_string(p) + "]";
-      Phalanx phalanx;
-      phalanx.name = ph[p].contains("name") ? ph[p].at("name").get<std::string>() : "phalanx" + std::to_string(p);
-      phalanx.length = number(ph[p], "length", wp);
-      if (!(phalanx.length > 0)) fail(wp, "length must be positive");
-      phalanx.lower = number(ph[p], "lower_deg", wp) * kDeg;
-      phalanx.upper = number(ph[p], "upper_deg", wp) * kDeg;
-      if (phalanx.lower > phalanx.upper) fail(wp, "lower_deg > upper_deg");
-      phalanx.offset = number_or(ph[p], "offset_deg", ph[p].contains("lower_deg") ? number(ph[p], "lower_deg", wp) : 0.0, wp) * kDeg;
-      phalanx.ratio = number_or(ph[p], "ratio", 1.0, wp);
-      if (phalanx.ratio < 0) fail(wp, "ratio must be >= 0");
-      phalanx.shapes = shapes(ph[p], wp);
+      Phalanx phalanx = parse_phalanx(ph[p], p, w + ".phalanges[" + std::to_string(p) + "]");
       Link link;
       link.name = finger.name + "/" + phalanx.name;
       link.finger = static_cast<int>(f);
