@@ -1,4 +1,4 @@
-"""Auto-grasp + epsilon throughput on the built-in mug, one core (issue 2 section 10).
+"""Auto-grasp + epsilon throughput on the built-in mug, one core.
 
 Times, on the same 256 seeded random top grasps around the mug (relative x, y in +-3 cm, yaw in
 [0, pi), spread 0): the simulator alone (top_grasp_batch, 1 thread) and the simulator followed by

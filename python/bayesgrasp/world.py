@@ -88,8 +88,8 @@ class World:
     """One object of a scene, a hand and everything needed to try grasps on it.
 
     Args:
-        scene: the table-top scene; ``object_index`` selects the object to grasp (all objects
-            other than that one are ignored by the simulator for now).
+        scene: the table-top scene; ``object_index`` selects the object to grasp (the
+            simulator sees only that object; the others are not obstacles).
         hand: a :class:`Hand`, a built-in hand name or a hand file path.
         mu: friction coefficient for the quality metric and the lift test.
         spread: default finger spread (rad); None = the hand's default.

@@ -159,8 +159,8 @@ def test_decomposition_cache(tmp_path):
 def test_decomposed_mug_gives_the_tetrahedra_verdicts_when_the_hand_reaches_into_it():
     # Two top grasps of the bench grid (bench/bench_physics_concave.py) over the mug's opening,
     # where a finger starts inside the mug's hull (Auto needs a concave shape): 1.1 cm from
-    # the body's axis away from the handle, yaw 90 deg - both shapes lift it (displacements
-    # 13.4 and 13.6 mm); 2.6 cm from it, y -1.3 cm, yaw 45 deg - both drop it.
+    # the body's axis away from the handle, yaw 90 deg - both shapes lift it; 2.6 cm from it,
+    # y -1.3 cm, yaw 45 deg - both drop it.
     from bayesgrasp.world import World
     w = World.single("mug")
     lo, hi = w.object.vertices.min(0), w.object.vertices.max(0)
@@ -217,7 +217,7 @@ def test_box_as_its_own_single_piece_is_lifted_like_its_hull():
 def test_side_contacts_hold_a_cylinder_with_friction_in_both_tangent_directions():
     # A centred 60-degree top grasp of the cylinder (epsilon 0.96, mu 2): its fingertip contacts
     # press on the side wall and must hold the weight by friction along the vertical tangent.
-    # With friction along one tangent per contact (Bullet's default) it slid out (5.6 cm).
+    # (With friction along one tangent per contact, Bullet's default, it slides out.)
     from bayesgrasp.world import World
     w = World.single("cylinder", spread=np.radians(60), mu=2.0)
     g = w.grasp(0.0, 0.0, 3 * np.pi / 4)
