@@ -38,6 +38,15 @@ namespace {
 
 const std::string kSrc = BAYESGRASP_SOURCE_DIR;
 
+TriMesh to_mesh(const std::vector<Vec3>& V, const std::vector<Eigen::Vector3i>& F) {
+  TriMesh m;
+  m.V.resize(static_cast<int>(V.size()), 3);
+  for (size_t i = 0; i < V.size(); ++i) m.V.row(static_cast<int>(i)) = V[i].transpose();
+  m.F.resize(static_cast<int>(F.size()), 3);
+  for (size_t i = 0; i < F.size(); ++i) m.F.row(static_cast<int>(i)) = F[i].transpose();
+  return m;
+}
+
 /// Closed mug-like mesh: cylinder body r = 4 cm, h = 9.5 cm (64 sides, 8 rings) and a
 /// torus-segment handle (major radius 3 cm, tube 6 mm) whose capped ends sit inside the body.
 TriMesh generated_mug() {
@@ -94,12 +103,7 @@ TriMesh generated_mug() {
       else F.emplace_back(ci, base + i, base + (i + 1) % around);
     }
   }
-  TriMesh m;
-  m.V.resize(static_cast<int>(V.size()), 3);
-  for (size_t i = 0; i < V.size(); ++i) m.V.row(static_cast<int>(i)) = V[i].transpose();
-  m.F.resize(static_cast<int>(F.size()), 3);
-  for (size_t i = 0; i < F.size(); ++i) m.F.row(static_cast<int>(i)) = F[i].transpose();
-  return m;
+  return to_mesh(V, F);
 }
 
 TriMesh read_obj(const std::string& path) {
@@ -122,12 +126,7 @@ TriMesh read_obj(const std::string& path) {
       for (size_t k = 1; k + 1 < idx.size(); ++k) F.emplace_back(idx[0], idx[k], idx[k + 1]);
     }
   }
-  TriMesh m;
-  m.V.resize(static_cast<int>(V.size()), 3);
-  for (size_t i = 0; i < V.size(); ++i) m.V.row(static_cast<int>(i)) = V[i].transpose();
-  m.F.resize(static_cast<int>(F.size()), 3);
-  for (size_t i = 0; i < F.size(); ++i) m.F.row(static_cast<int>(i)) = F[i].transpose();
-  return m;
+  return to_mesh(V, F);
 }
 
 void write_obj(const TriMesh& m, const std::string& path) {

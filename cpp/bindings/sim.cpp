@@ -34,6 +34,10 @@ py::array flags_view(const uint8_t* data, std::vector<py::ssize_t> shape, std::v
   return readonly_view(py::dtype::of<bool>(), shape, strides, data, owner);
 }
 
+py::array flags_view(const std::vector<uint8_t>& flags, py::handle owner) {
+  return flags_view(flags.data(), {static_cast<py::ssize_t>(flags.size())}, {1}, owner);
+}
+
 template <class M>
 py::array flag_matrix_view(const M& m, py::handle owner) {
   return flags_view(m.data(), {m.rows(), m.cols()}, {m.cols(), 1}, owner);
@@ -147,18 +151,10 @@ void bind_result(py::module_& m) {
           "contacts", [](const py::object& self) { return contacts_of(self, self.cast<const R&>().contacts); },
           "contacts : Contacts\n    At most one object and one table contact per link.")
       .def_property_readonly(
-          "link_contact",
-          [](const py::object& self) {
-            const R& r = self.cast<const R&>();
-            return flags_view(r.link_contact.data(), {static_cast<py::ssize_t>(r.link_contact.size())}, {1}, self);
-          },
+          "link_contact", [](const py::object& self) { return flags_view(self.cast<const R&>().link_contact, self); },
           "link_contact : numpy.ndarray (L,) bool\n    Per link: it touches the object.")
       .def_property_readonly(
-          "table_contact",
-          [](const py::object& self) {
-            const R& r = self.cast<const R&>();
-            return flags_view(r.table_contact.data(), {static_cast<py::ssize_t>(r.table_contact.size())}, {1}, self);
-          },
+          "table_contact", [](const py::object& self) { return flags_view(self.cast<const R&>().table_contact, self); },
           "table_contact : numpy.ndarray (L,) bool\n    Per link: it touches the table.")
       .def_readonly("collision_at_start", &R::collision_at_start,
                     "collision_at_start : bool\n    The open hand penetrated the object or the table (the fingers "
@@ -220,11 +216,7 @@ void bind_batch(py::module_& m) {
           "table_contact : numpy.ndarray (N, L) bool\n    Per grasp and link: it touches the table.")
       .def_property_readonly(
           "collision_at_start",
-          [](const py::object& self) {
-            const B& b = self.cast<const B&>();
-            return flags_view(b.collision_at_start.data(), {static_cast<py::ssize_t>(b.collision_at_start.size())}, {1},
-                              self);
-          },
+          [](const py::object& self) { return flags_view(self.cast<const B&>().collision_at_start, self); },
           "collision_at_start : numpy.ndarray (N,) bool\n    The open hand penetrated the object or the table.")
       .def_property_readonly(
           "hand_pose",
