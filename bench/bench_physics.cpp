@@ -25,10 +25,6 @@ using namespace bayesgrasp::fixtures;
 
 namespace {
 
-
-
-
-
 // Closes every finger in turn (from `start`, default open) until it touches the object.
 template <class Dist>
 Eigen::VectorXd touch(const HandModel& hand, const Iso3& T, Dist dist, Eigen::VectorXd start = {}) {
@@ -57,23 +53,18 @@ const Vec3 kLo(-0.04, -0.025, 0.0), kHi(0.04, 0.025, 0.12);
 
 double box_dist(const Vec3& p) { return (p - p.cwiseMax(kLo).cwiseMin(kHi)).norm(); }
 
-void BM_LiftBoxHeld(benchmark::State& state) {
+// The box with the palm 1 cm above it; `held`: the fingertips touch it, else the hand is open.
+void box_bench(benchmark::State& state, bool held) {
   const HandModel hand = barrett();
   const Iso3 pose = HandModel::top_grasp_pose(0, 0, 0, 0.13);
   LiftOptions o;
   o.density = 400.0;
   const LiftTester tester(hand, box_mesh(kLo, kHi), o);
-  run_bench(state, tester, pose, touch(hand, pose, box_dist));
+  run_bench(state, tester, pose, held ? touch(hand, pose, box_dist) : hand.coupled_joints(0.0, 0.0));
 }
 
-void BM_LiftBoxOpen(benchmark::State& state) {
-  const HandModel hand = barrett();
-  const Iso3 pose = HandModel::top_grasp_pose(0, 0, 0, 0.13);
-  LiftOptions o;
-  o.density = 400.0;
-  const LiftTester tester(hand, box_mesh(kLo, kHi), o);
-  run_bench(state, tester, pose, hand.coupled_joints(0.0, 0.0));
-}
+void BM_LiftBoxHeld(benchmark::State& state) { box_bench(state, true); }
+void BM_LiftBoxOpen(benchmark::State& state) { box_bench(state, false); }
 
 void cup_bench(benchmark::State& state, LiftOptions::Shape shape) {
   const HandModel hand = barrett();

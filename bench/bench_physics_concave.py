@@ -39,10 +39,10 @@ def main():
         t0 = time.process_time()
         dec = w.lift_tester()  # auto, with the CoACD pieces (decomposed or read from the cache)
         t_prep = time.process_time() - t0
-        ok = ~np.asarray(b["collision_at_start"], bool)
-        poses, joints = b["hand_pose"][ok], b["joint_angles"][ok]
+        ok = ~np.asarray(b.collision_at_start, bool)
+        poses, joints = b.hand_pose[ok], b.joint_angles[ok]
         r_all = dec.run_batch(poses, joints, threads=1)
-        inside = np.array([s == "decomposition" for s in r_all["shape"]])
+        inside = np.array([s == "decomposition" for s in r_all.shape])
         idx = np.flatnonzero(inside)[: a.max_grasps]
         P, J = poses[idx], joints[idx]
         t0 = time.process_time()
@@ -56,12 +56,12 @@ def main():
         hull = physics.LiftTester(w.hand.path, w.vertices, w.faces, shape="hull", mu=w.mu, density=obj.density)
         rh = hull.run_batch(P, J, threads=1)
         n = len(idx)
-        agree = int(np.sum(rd["lifted"] == rt["lifted"]))
+        agree = int(np.sum(rd.lifted == rt.lifted))
         row = dict(object=name, triangles=int(len(w.faces)), pieces=dec.num_pieces, grasps_grid=int(len(g)),
                    grasps_inside_hull=int(inside.sum()), tested=n, agree=agree,
-                   lifted_decomposition=int(rd["lifted"].sum()), lifted_tetrahedra=int(rt["lifted"].sum()),
-                   agree_hull=int(np.sum(rh["lifted"] == rt["lifted"])),
-                   median_abs_displacement_diff_m=float(np.median(np.abs(rd["displacement"] - rt["displacement"]))),
+                   lifted_decomposition=int(rd.lifted.sum()), lifted_tetrahedra=int(rt.lifted.sum()),
+                   agree_hull=int(np.sum(rh.lifted == rt.lifted)),
+                   median_abs_displacement_diff_m=float(np.median(np.abs(rd.displacement - rt.displacement))),
                    tests_per_s_decomposition=n / t_dec, tests_per_s_tetrahedra=n / t_tet,
                    decomposition_prep_s=t_prep)
         rows.append(row)

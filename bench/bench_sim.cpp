@@ -10,7 +10,7 @@
 // machine does not distort them; the thread benchmark uses wall-clock time.
 // Variants compare FCL representations: OBBRSS vs RSS bounding volumes for the object,
 // capsule axes as sliver triangles vs capsule/box primitives (vs tessellated capsule meshes:
-// variant 6, not run by default, about 7 grasps/s), exact queries vs an error allowance, and
+// variant 6, not run by default: far slower, see BENCHMARKS.md), exact queries vs an error allowance, and
 // without the box / 26-DOP lower-bound culling.
 //
 // Extra flags (before Google Benchmark's own):
@@ -37,6 +37,15 @@ using namespace bayesgrasp;
 namespace {
 
 const std::string kSrc = BAYESGRASP_SOURCE_DIR;
+
+TriMesh to_mesh(const std::vector<Vec3>& V, const std::vector<Eigen::Vector3i>& F) {
+  TriMesh m;
+  m.V.resize(static_cast<int>(V.size()), 3);
+  for (size_t i = 0; i < V.size(); ++i) m.V.row(static_cast<int>(i)) = V[i].transpose();
+  m.F.resize(static_cast<int>(F.size()), 3);
+  for (size_t i = 0; i < F.size(); ++i) m.F.row(static_cast<int>(i)) = F[i].transpose();
+  return m;
+}
 
 /// Closed mug-like mesh: cylinder body r = 4 cm, h = 9.5 cm (64 sides, 8 rings) and a
 /// torus-segment handle (major radius 3 cm, tube 6 mm) whose capped ends sit inside the body.
@@ -94,12 +103,7 @@ TriMesh generated_mug() {
       else F.emplace_back(ci, base + i, base + (i + 1) % around);
     }
   }
-  TriMesh m;
-  m.V.resize(static_cast<int>(V.size()), 3);
-  for (size_t i = 0; i < V.size(); ++i) m.V.row(static_cast<int>(i)) = V[i].transpose();
-  m.F.resize(static_cast<int>(F.size()), 3);
-  for (size_t i = 0; i < F.size(); ++i) m.F.row(static_cast<int>(i)) = F[i].transpose();
-  return m;
+  return to_mesh(V, F);
 }
 
 TriMesh read_obj(const std::string& path) {
@@ -122,12 +126,7 @@ TriMesh read_obj(const std::string& path) {
       for (size_t k = 1; k + 1 < idx.size(); ++k) F.emplace_back(idx[0], idx[k], idx[k + 1]);
     }
   }
-  TriMesh m;
-  m.V.resize(static_cast<int>(V.size()), 3);
-  for (size_t i = 0; i < V.size(); ++i) m.V.row(static_cast<int>(i)) = V[i].transpose();
-  m.F.resize(static_cast<int>(F.size()), 3);
-  for (size_t i = 0; i < F.size(); ++i) m.F.row(static_cast<int>(i)) = F[i].transpose();
-  return m;
+  return to_mesh(V, F);
 }
 
 void write_obj(const TriMesh& m, const std::string& path) {
@@ -193,15 +192,14 @@ const char* variant_name(int v) {
   return names[v];
 }
 
-void BM_TopGrasp(benchmark::State& state) {
-  Setup& s = setup();
-  const int v = static_cast<int>(state.range(0));
-  const GraspSimulator sim(s.hand, s.mug, variant(v));
-  state.SetLabel(variant_name(v));
+// Runs grasp(i) for every grasp of the set per iteration; counts grasps/s (CPU time), FCL
+// queries and advancement steps per grasp.
+template <class Grasp>
+void run_grasps(benchmark::State& state, Grasp grasp) {
   int64_t n = 0, queries = 0, iterations = 0;
   for (auto _ : state) {
     for (int i = 0; i < g_grasps; ++i) {
-      const GraspResult r = sim.top_grasp(s.xyyaw(i, 0), s.xyyaw(i, 1), s.xyyaw(i, 2), s.spreads[i]);
+      const GraspResult r = grasp(i);
       queries += r.distance_queries;
       iterations += r.iterations;
       benchmark::DoNotOptimize(r.joints.data());
@@ -213,43 +211,27 @@ void BM_TopGrasp(benchmark::State& state) {
   state.counters["queries_per_grasp"] = static_cast<double>(queries) / n;
   state.counters["steps_per_grasp"] = static_cast<double>(iterations) / n;
 }
+
+void BM_TopGrasp(benchmark::State& state) {
+  Setup& s = setup();
+  const int v = static_cast<int>(state.range(0));
+  const GraspSimulator sim(s.hand, s.mug, variant(v));
+  state.SetLabel(variant_name(v));
+  run_grasps(state, [&](int i) { return sim.top_grasp(s.xyyaw(i, 0), s.xyyaw(i, 1), s.xyyaw(i, 2), s.spreads[i]); });
+}
 BENCHMARK(BM_TopGrasp)->DenseRange(0, 5)->Unit(benchmark::kMillisecond);
 
 void BM_Close(benchmark::State& state) {
   Setup& s = setup();
   const GraspSimulator sim(s.hand, s.mug);
-  int64_t n = 0, queries = 0, iterations = 0;
-  for (auto _ : state) {
-    for (int i = 0; i < g_grasps; ++i) {
-      const GraspResult r = sim.close(s.poses[i], s.spreads[i]);
-      queries += r.distance_queries;
-      iterations += r.iterations;
-      benchmark::DoNotOptimize(r.joints.data());
-    }
-    n += g_grasps;
-  }
-  state.counters["grasps_per_s"] = benchmark::Counter(static_cast<double>(n), benchmark::Counter::kIsRate);
-  state.counters["queries_per_grasp"] = static_cast<double>(queries) / n;
-  state.counters["steps_per_grasp"] = static_cast<double>(iterations) / n;
+  run_grasps(state, [&](int i) { return sim.close(s.poses[i], s.spreads[i]); });
 }
 BENCHMARK(BM_Close)->Unit(benchmark::kMillisecond);
 
 void BM_CloseFixedStep(benchmark::State& state) {
   Setup& s = setup();
   const GraspSimulator sim(s.hand, s.mug);
-  int64_t n = 0, queries = 0, iterations = 0;
-  for (auto _ : state) {
-    for (int i = 0; i < g_grasps; ++i) {
-      const GraspResult r = sim.close_fixed_step(s.poses[i], s.spreads[i], 0.01);
-      queries += r.distance_queries;
-      iterations += r.iterations;
-      benchmark::DoNotOptimize(r.joints.data());
-    }
-    n += g_grasps;
-  }
-  state.counters["grasps_per_s"] = benchmark::Counter(static_cast<double>(n), benchmark::Counter::kIsRate);
-  state.counters["queries_per_grasp"] = static_cast<double>(queries) / n;
-  state.counters["steps_per_grasp"] = static_cast<double>(iterations) / n;
+  run_grasps(state, [&](int i) { return sim.close_fixed_step(s.poses[i], s.spreads[i], 0.01); });
 }
 BENCHMARK(BM_CloseFixedStep)->Unit(benchmark::kMillisecond);
 

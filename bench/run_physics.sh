@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Lift-test benchmark (issue 2, sections 6 and 10): lift tests per second on one core
+# Lift-test benchmark: lift tests per second on one core
 # (bench_physics: a held box, an open hand, a held concave cup and a pot pinched through its
 # opening with the hull, tetrahedra and convex-decomposition shapes), then the built-in mugs
 # and pitcher through Python: decomposition (CoACD pieces) vs tetrahedra verdicts and speed on

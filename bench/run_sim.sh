@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Contact-simulation benchmarks (issue 2 section 10): auto-grasp on a ~2k-triangle mug, one core.
+# Contact-simulation benchmarks: auto-grasp on a ~2k-triangle mug, one core.
 #   1. bench_sim (C++, Google Benchmark): our conservative-advancement auto-grasp (top grasps and
 #      closing alone, FCL representation variants), the GraspIt!-style fixed 0.01-rad stepping on
 #      the same FCL backend and grasps, and the 2-thread batch. It also exports the mug and the

@@ -1,4 +1,4 @@
-"""Auto-grasp + epsilon throughput on the built-in mug, one core (issue 2 section 10).
+"""Auto-grasp + epsilon throughput on the built-in mug, one core.
 
 Times, on the same 256 seeded random top grasps around the mug (relative x, y in +-3 cm, yaw in
 [0, pi), spread 0): the simulator alone (top_grasp_batch, 1 thread) and the simulator followed by
@@ -33,11 +33,11 @@ def main(out_dir="bench/results"):
     t_sim = median_time(lambda: world.sim.top_grasp_batch(xy, spread=0.0, threads=1))
     t_all = median_time(lambda: world.grasp_batch(grasps, spread=0.0, threads=1))
     b = world.grasp_batch(grasps, spread=0.0, threads=1)
-    counts = np.bincount(b["contacts"]["grasp"][~b["contacts"]["on_table"]], minlength=n)
+    counts = np.bincount(b.contacts.grasp[~b.contacts.on_table], minlength=n)
     res = {"triangles": int(len(world.faces)), "grasps": n,
            "sim_grasps_per_s": n / t_sim, "sim_plus_epsilon_grasps_per_s": n / t_all,
            "median_object_contacts": float(np.median(counts)),
-           "force_closure_fraction": float(np.mean(b["epsilon"] > 0))}
+           "force_closure_fraction": float(np.mean(b.epsilon > 0))}
     Path(out_dir).mkdir(parents=True, exist_ok=True)
     Path(out_dir, "world_grasp_quality.json").write_text(json.dumps(res, indent=1))
     print(f"mug ({res['triangles']} triangles), {n} top grasps, one thread:")

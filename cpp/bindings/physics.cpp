@@ -46,23 +46,12 @@ LiftOptions::Shape shape_from(const std::string& s) {
   throw py::value_error("shape: expected 'auto', 'hull', 'tetrahedra' or 'decomposition', got '" + s + "'");
 }
 
-py::dict result_dict(const LiftResult& r) {
-  py::dict d;
-  d["lifted"] = r.lifted;
-  d["displacement"] = r.displacement;
-  d["rotation"] = r.rotation;
-  d["squeeze_displacement"] = r.squeeze_displacement;
-  d["height_gain"] = r.height_gain;
-  d["finite"] = r.finite;
-  d["steps"] = r.steps;
-  d["tetrahedra"] = r.tetrahedra;
-  d["shape"] = shape_name(r.shape);
-  return d;
-}
+/// The results of run_batch, in input order.
+struct LiftBatch {
+  std::vector<LiftResult> results;
+};
 
-// std::invalid_argument from the core already becomes ValueError (pybind11's default
-// translation); its messages name the argument.
-// convex_pieces: None or a sequence of (K, 3) float arrays (K >= 4, finite).
+// convex_pieces: None or a sequence of (K, 3) float arrays (the core checks K >= 4 and the volume).
 std::vector<Eigen::MatrixX3d> pieces_arg(const py::object& pieces) {
   std::vector<Eigen::MatrixX3d> out;
   if (pieces.is_none()) return out;
@@ -77,11 +66,111 @@ std::vector<Eigen::MatrixX3d> pieces_arg(const py::object& pieces) {
     } catch (const py::cast_error&) {
       throw py::value_error(name + ": expected a (K, 3) float array");
     }
-    const RowMatrixXd m = matrix(a, name.c_str(), 3);
-    if (m.rows() < 4) throw py::value_error(name + ": needs at least 4 points, got " + std::to_string(m.rows()));
-    out.emplace_back(m);
+    out.emplace_back(matrix(a, name.c_str(), 3, true));
   }
   return out;
+}
+
+void bind_options(py::module_& m) {
+  py::class_<LiftOptions>(m, "LiftOptions", R"doc(Options of the lift test (SI units). See ``lift_test``.)doc")
+      .def(py::init<>())
+      .def_readwrite("mu", &LiftOptions::mu, "mu : float\n    Friction coefficient hand-object (>= 0).")
+      .def_readwrite("table_mu", &LiftOptions::table_mu, "table_mu : float\n    Friction coefficient object-table (>= 0).")
+      .def_readwrite("density", &LiftOptions::density, "density : float\n    Object density, kg/m^3 (mass from the mesh).")
+      .def_readwrite("time_step", &LiftOptions::time_step, "time_step : float\n    Fixed time step, s (default 1/480).")
+      .def_readwrite("solver_iterations", &LiftOptions::solver_iterations,
+                     "solver_iterations : int\n    Bullet's constraint solver iterations per step (>= 1).")
+      .def_readwrite("squeeze_time", &LiftOptions::squeeze_time,
+                     "squeeze_time : float\n    s, the palm still while the fingers tighten.")
+      .def_readwrite("lift_height", &LiftOptions::lift_height, "lift_height : float\n    m the palm rises.")
+      .def_readwrite("lift_time", &LiftOptions::lift_time, "lift_time : float\n    s the rise takes.")
+      .def_readwrite("shake_amplitude", &LiftOptions::shake_amplitude, "shake_amplitude : float\n    m, per axis.")
+      .def_readwrite("shake_frequency", &LiftOptions::shake_frequency, "shake_frequency : float\n    Hz.")
+      .def_readwrite("shake_time", &LiftOptions::shake_time, "shake_time : float\n    s of shaking.")
+      .def_readwrite("hold_time", &LiftOptions::hold_time, "hold_time : float\n    s held still at the end.")
+      .def_readwrite("finger_torque", &LiftOptions::finger_torque,
+                     "finger_torque : float\n    N m, torque limit of each phalanx joint motor.")
+      .def_readwrite("closing_speed", &LiftOptions::closing_speed,
+                     "closing_speed : float\n    rad/s, target velocity of the joint motors (closing).")
+      .def_readwrite("squeeze_travel", &LiftOptions::squeeze_travel,
+                     "squeeze_travel : float\n    rad a joint may close beyond its given angle.")
+      .def_readwrite("link_mass", &LiftOptions::link_mass, "link_mass : float\n    kg per phalanx.")
+      .def_readwrite("success_distance", &LiftOptions::success_distance,
+                     "success_distance : float\n    m; lifted = the object moved less than this relative to the palm.")
+      .def_readwrite("table", &LiftOptions::table, "table : bool\n    A table plane at z = 0.")
+      .def_property(
+          "shape", [](const LiftOptions& o) { return shape_name(o.shape); },
+          [](LiftOptions& o, const std::string& s) { o.shape = shape_from(s); },
+          "shape : str\n    Object collision shape: 'auto', 'hull', 'tetrahedra' or 'decomposition' (needs "
+          "convex pieces).")
+      .def_readwrite("tet_depth", &LiftOptions::tet_depth, "tet_depth : float\n    m, depth of the tetrahedra skin.")
+      .def_readwrite("margin", &LiftOptions::margin, "margin : float\n    m, collision margin of every shape.")
+      .def_readwrite("skip_separated_pairs", &LiftOptions::skip_separated_pairs,
+                     "skip_separated_pairs : bool\n    Skip Bullet's narrowphase for shape pairs proven apart "
+                     "(same results, faster).");
+}
+
+void bind_results(py::module_& m) {
+  using R = LiftResult;
+  py::class_<R>(m, "LiftResult", "The outcome of one lift test.")
+      .def_readonly("lifted", &R::lifted,
+                    "lifted : bool\n    The object moved less than success_distance relative to the palm and the "
+                    "simulation stayed finite.")
+      .def_readonly("displacement", &R::displacement,
+                    "displacement : float\n    m, the object's centre of mass relative to the palm, end vs after "
+                    "the squeeze.")
+      .def_readonly("rotation", &R::rotation,
+                    "rotation : float\n    rad, the object's rotation relative to the palm, end vs after the squeeze.")
+      .def_readonly("squeeze_displacement", &R::squeeze_displacement,
+                    "squeeze_displacement : float\n    m the squeeze itself moved the object (palm frame).")
+      .def_readonly("height_gain", &R::height_gain,
+                    "height_gain : float\n    m, world z of the object's centre of mass, end minus start.")
+      .def_readonly("finite", &R::finite, "finite : bool\n    False if the simulation blew up.")
+      .def_readonly("tetrahedra", &R::tetrahedra, "tetrahedra : bool\n    The object used the tetrahedra shape.")
+      .def_property_readonly(
+          "shape", [](const R& r) { return shape_name(r.shape); },
+          "shape : str\n    The shape used: 'hull', 'tetrahedra' or 'decomposition'.")
+      .def_readonly("steps", &R::steps, "steps : int\n    Time steps simulated (fewer when the object was lost early).")
+      .def_readonly("skipped_queries", &R::skipped_queries,
+                    "skipped_queries : int\n    Narrowphase queries skipped (skip_separated_pairs).")
+      .def("__repr__", [](const R& r) {
+        return std::string("<LiftResult: ") + (r.lifted ? "lifted" : "dropped") + ", displacement " +
+               std::to_string(r.displacement) + " m>";
+      });
+
+  using B = LiftBatch;
+  auto view = [](auto member) {
+    return [member](const py::object& self) {
+      const B& b = self.cast<const B&>();
+      return field_view(b.results.data(), b.results.size(), member, self);
+    };
+  };
+  py::class_<B>(m, "LiftBatch", "N lift tests: each LiftResult field as an (N,) array (read-only views).")
+      .def_property_readonly("lifted", view(&R::lifted), "lifted : numpy.ndarray (N,) bool")
+      .def_property_readonly("displacement", view(&R::displacement), "displacement : numpy.ndarray (N,) float\n    m.")
+      .def_property_readonly("rotation", view(&R::rotation), "rotation : numpy.ndarray (N,) float\n    rad.")
+      .def_property_readonly("squeeze_displacement", view(&R::squeeze_displacement),
+                             "squeeze_displacement : numpy.ndarray (N,) float\n    m.")
+      .def_property_readonly("height_gain", view(&R::height_gain), "height_gain : numpy.ndarray (N,) float\n    m.")
+      .def_property_readonly("finite", view(&R::finite), "finite : numpy.ndarray (N,) bool")
+      .def_property_readonly("tetrahedra", view(&R::tetrahedra), "tetrahedra : numpy.ndarray (N,) bool")
+      .def_property_readonly("steps", view(&R::steps), "steps : numpy.ndarray (N,) int32")
+      .def_property_readonly("skipped_queries", view(&R::skipped_queries), "skipped_queries : numpy.ndarray (N,) int64")
+      .def_property_readonly(
+          "shape",
+          [](const B& b) {
+            py::list out;
+            for (const R& r : b.results) out.append(shape_name(r.shape));
+            return out;
+          },
+          "shape : list of str\n    The shape each test used.")
+      .def("__len__", [](const B& b) { return b.results.size(); })
+      .def("__getitem__", [](const B& b, py::ssize_t i) {
+        const auto n = static_cast<py::ssize_t>(b.results.size());
+        if (i < 0) i += n;
+        if (i < 0 || i >= n) throw py::index_error("lift batch index out of range");
+        return b.results[static_cast<size_t>(i)];
+      });
 }
 
 std::unique_ptr<LiftTester> make_tester(const py::handle& hand, const DArray& vertices, const IArray& faces,
@@ -96,35 +185,8 @@ std::unique_ptr<LiftTester> make_tester(const py::handle& hand, const DArray& ve
 }  // namespace
 
 void bind_physics(py::module_& m) {
-  py::class_<LiftOptions>(m, "LiftOptions", R"doc(Options of the lift test (SI units). See ``lift_test``.)doc")
-      .def(py::init<>())
-      .def_readwrite("mu", &LiftOptions::mu, "friction coefficient hand-object")
-      .def_readwrite("table_mu", &LiftOptions::table_mu, "friction coefficient object-table")
-      .def_readwrite("density", &LiftOptions::density, "object density, kg/m^3 (mass from the mesh)")
-      .def_readwrite("time_step", &LiftOptions::time_step, "fixed time step, s (default 1/480)")
-      .def_readwrite("solver_iterations", &LiftOptions::solver_iterations)
-      .def_readwrite("squeeze_time", &LiftOptions::squeeze_time, "s, palm still while the fingers tighten")
-      .def_readwrite("lift_height", &LiftOptions::lift_height, "m the palm rises (default 0.1)")
-      .def_readwrite("lift_time", &LiftOptions::lift_time, "s")
-      .def_readwrite("shake_amplitude", &LiftOptions::shake_amplitude, "m")
-      .def_readwrite("shake_frequency", &LiftOptions::shake_frequency, "Hz")
-      .def_readwrite("shake_time", &LiftOptions::shake_time, "s")
-      .def_readwrite("hold_time", &LiftOptions::hold_time, "s")
-      .def_readwrite("finger_torque", &LiftOptions::finger_torque, "N m, joint motor limit")
-      .def_readwrite("closing_speed", &LiftOptions::closing_speed, "rad/s, joint motor target")
-      .def_readwrite("squeeze_travel", &LiftOptions::squeeze_travel, "rad a joint may close beyond its angle")
-      .def_readwrite("link_mass", &LiftOptions::link_mass, "kg per phalanx")
-      .def_readwrite("success_distance", &LiftOptions::success_distance, "m (default 0.02)")
-      .def_readwrite("table", &LiftOptions::table, "table plane at z = 0 present")
-      .def_property(
-          "shape", [](const LiftOptions& o) { return shape_name(o.shape); },
-          [](LiftOptions& o, const std::string& s) { o.shape = shape_from(s); },
-          "object collision shape: 'auto', 'hull', 'tetrahedra' or 'decomposition' (needs convex pieces)")
-      .def_readwrite("tet_depth", &LiftOptions::tet_depth, "m, depth of the tetrahedra skin")
-      .def_readwrite("margin", &LiftOptions::margin, "m, collision margin")
-      .def_readwrite("skip_separated_pairs", &LiftOptions::skip_separated_pairs,
-                     "skip Bullet's narrowphase for shape pairs proven apart (same results, faster)");
-
+  bind_options(m);
+  bind_results(m);
   py::class_<LiftTester>(m, "LiftTester", R"doc(Lift tests of one object with one hand (see ``lift_test``).
 
 Args:
@@ -155,67 +217,23 @@ Args:
           [](const LiftTester& t, const DArray& hand_pose, const DArray& joints) {
             const Iso3 T = pose(hand_pose, "hand_pose");
             const Eigen::VectorXd q = vector(joints, "joints");
-            LiftResult r;
-            {
-              py::gil_scoped_release release;
-              r = t.run(T, q);
-            }
-            return result_dict(r);
+            py::gil_scoped_release release;
+            return t.run(T, q);
           },
           py::arg("hand_pose"), py::arg("joints"),
           R"doc(One lift test. hand_pose: (4, 4) world pose of the hand; joints: (J,) closed joint
-angles (HandModel layout). Returns a dict: lifted, displacement (m), rotation (rad),
-squeeze_displacement (m), height_gain (m), finite, steps, tetrahedra (the object used the
-tetrahedra shape), shape (the shape used: 'hull', 'tetrahedra' or 'decomposition').)doc")
+angles (HandModel layout). A LiftResult.)doc")
       .def(
           "run_batch",
           [](const LiftTester& t, const DArray& hand_poses, const DArray& joints, int threads) {
-            if (hand_poses.ndim() != 3 || hand_poses.shape(1) != 4 || hand_poses.shape(2) != 4)
-              throw py::value_error("hand_poses: expected shape (N, 4, 4), got " + shape_str(hand_poses));
+            const std::vector<Iso3> P = poses(hand_poses, "hand_poses");
             const RowMatrixXd J = matrix(joints, "joints", -1, true);
-            const py::ssize_t n = hand_poses.shape(0);
-            if (J.rows() != n)
-              throw py::value_error("joints: expected " + std::to_string(n) + " rows (one per pose), got " +
-                                    std::to_string(J.rows()));
-            std::vector<Iso3> poses;
-            poses.reserve(static_cast<size_t>(n));
-            for (py::ssize_t i = 0; i < n; ++i) {
-              Eigen::Map<const Eigen::Matrix<double, 4, 4, Eigen::RowMajor>> M(hand_poses.data() + 16 * i);
-              try {
-                poses.push_back(pose_from_matrix(M));
-              } catch (const std::invalid_argument& e) {
-                throw py::value_error("hand_poses[" + std::to_string(i) + "]: " + e.what());
-              }
-            }
-            std::vector<LiftResult> rs;
-            {
-              py::gil_scoped_release release;
-              rs = t.run_batch(poses, J, threads);
-            }
-            py::array_t<bool> lifted(n);
-            py::array_t<double> disp(n), rot(n), gain(n);
-            for (py::ssize_t i = 0; i < n; ++i) {
-              const LiftResult& r = rs[static_cast<size_t>(i)];
-              lifted.mutable_data()[i] = r.lifted;
-              disp.mutable_data()[i] = r.displacement;
-              rot.mutable_data()[i] = r.rotation;
-              gain.mutable_data()[i] = r.height_gain;
-            }
-            py::list shapes;
-            for (const LiftResult& r : rs) shapes.append(shape_name(r.shape));
-            py::dict d;
-            d["shape"] = shapes;
-            d["lifted"] = lifted;
-            d["displacement"] = disp;
-            d["rotation"] = rot;
-            d["height_gain"] = gain;
-            return d;
+            py::gil_scoped_release release;
+            return LiftBatch{t.run_batch(P, J, threads)};
           },
           py::arg("hand_poses"), py::arg("joints"), py::arg("threads") = 1,
-          R"doc(N lift tests in ``threads`` threads (<= 0: all cores), each with its own Bullet
-world; GIL released. hand_poses: (N, 4, 4); joints: (N, J). Returns a dict of (N,) arrays:
-lifted, displacement, rotation, height_gain - equal to ``run`` one by one - and shape (list
-of the shapes used).)doc");
+          R"doc(N lift tests in ``threads`` threads (0 = all cores), each with its own Bullet world;
+GIL released. hand_poses: (N, 4, 4); joints: (N, J). A LiftBatch, equal to ``run`` one by one.)doc");
 }
 
 }  // namespace bayesgrasp::bind

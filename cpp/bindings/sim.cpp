@@ -1,6 +1,10 @@
 // Bindings for cpp/bayesgrasp/sim: the grasp simulator (auto-grasp with breakaway, top grasps,
-// batches with the GIL released). Results are dicts of numpy arrays.
+// batches with the GIL released). Options and results are bound classes; the results' array
+// fields are read-only numpy views of the C++ results (no copies). Arguments are validated by
+// the core (std::invalid_argument becomes ValueError).
 #include <pybind11/stl.h>
+
+#include <type_traits>
 
 #include "bayesgrasp/sim/grasp_simulator.hpp"
 #include "validate.hpp"
@@ -9,270 +13,318 @@ namespace bayesgrasp::bind {
 
 namespace {
 
-py::array_t<double> matrix4(const Iso3& T) {
-  py::array_t<double> out({4, 4});
-  auto o = out.mutable_unchecked<2>();
-  for (int r = 0; r < 4; ++r)
-    for (int c = 0; c < 4; ++c) o(r, c) = T.matrix()(r, c);
-  return out;
+/// A run of contacts inside a bound result (`owner` keeps the memory alive).
+struct ContactArrays {
+  py::object owner;
+  const Contact* first = nullptr;
+  size_t count = 0;
+};
+
+/// A batch's contacts with the grasp each belongs to.
+struct BatchContactArrays : ContactArrays {
+  const std::vector<int64_t>* offsets = nullptr;
+};
+
+constexpr py::ssize_t kDouble = sizeof(double), kInt = sizeof(int);
+
+ContactArrays contacts_of(const py::object& owner, const Contacts& cs) { return {owner, cs.data(), cs.size()}; }
+
+py::array flags_view(const uint8_t* data, std::vector<py::ssize_t> shape, std::vector<py::ssize_t> strides,
+                     py::handle owner) {
+  return readonly_view(py::dtype::of<bool>(), shape, strides, data, owner);
 }
 
-py::dict contacts_dict(const Contacts& cs, const std::vector<int64_t>* offsets) {
-  const py::ssize_t K = static_cast<py::ssize_t>(cs.size());
-  py::array_t<double> point({K, py::ssize_t{3}}), normal({K, py::ssize_t{3}});
-  py::array_t<int> link(K);
-  py::array_t<double> pen(K);
-  py::array_t<bool> table(K);
-  auto p = point.mutable_unchecked<2>();
-  auto n = normal.mutable_unchecked<2>();
-  auto l = link.mutable_unchecked<1>();
-  auto d = pen.mutable_unchecked<1>();
-  auto t = table.mutable_unchecked<1>();
-  for (py::ssize_t k = 0; k < K; ++k) {
-    const Contact& c = cs[k];
-    for (int i = 0; i < 3; ++i) p(k, i) = c.point[i], n(k, i) = c.normal[i];
-    l(k) = c.link;
-    d(k) = c.penetration;
-    t(k) = c.on_table;
-  }
-  py::dict out;
-  out["point"] = point;
-  out["normal"] = normal;
-  out["link"] = link;
-  out["penetration"] = pen;
-  out["on_table"] = table;
-  if (offsets) {
-    py::array_t<int64_t> grasp(K);
-    auto g = grasp.mutable_unchecked<1>();
-    for (size_t i = 0; i + 1 < offsets->size(); ++i)
-      for (int64_t k = (*offsets)[i]; k < (*offsets)[i + 1]; ++k) g(k) = static_cast<int64_t>(i);
-    out["grasp"] = grasp;
-    out["offsets"] = py::array_t<int64_t>(static_cast<py::ssize_t>(offsets->size()), offsets->data());
-  }
-  return out;
+py::array flags_view(const std::vector<uint8_t>& flags, py::handle owner) {
+  return flags_view(flags.data(), {static_cast<py::ssize_t>(flags.size())}, {1}, owner);
 }
 
-template <class V>
-py::array_t<bool> bools(const V& v) {
-  py::array_t<bool> out(static_cast<py::ssize_t>(v.size()));
-  auto o = out.mutable_unchecked<1>();
-  for (size_t i = 0; i < v.size(); ++i) o(static_cast<py::ssize_t>(i)) = v[i] != 0;
-  return out;
+template <class M>
+py::array flag_matrix_view(const M& m, py::handle owner) {
+  return flags_view(m.data(), {m.rows(), m.cols()}, {m.cols(), 1}, owner);
 }
 
-py::dict result_dict(const GraspResult& r) {
-  py::dict d;
-  d["joint_angles"] = Eigen::VectorXd(r.joints);
-  d["contacts"] = contacts_dict(r.contacts, nullptr);
-  d["link_contact"] = bools(r.link_contact);
-  d["table_contact"] = bools(r.table_contact);
-  d["collision_at_start"] = r.collision_at_start;
-  d["hand_pose"] = matrix4(r.hand_pose);
-  d["distance_queries"] = r.distance_queries;
-  return d;
+void bind_contacts(py::module_& m) {
+  // a property returning the view of one Contact member
+  const auto column = [](auto member) {
+    return [member](const ContactArrays& c) {
+      if constexpr (std::is_same_v<decltype(c.first->*member), const Vec3&>)
+        return vec3_field_view(c.first, c.count, member, c.owner);
+      else
+        return field_view(c.first, c.count, member, c.owner);
+    };
+  };
+  py::class_<ContactArrays>(m, "Contacts", R"doc(Contacts of a simulated grasp, as arrays (K rows).
+
+Normals are the object's outward surface normals (+z for the table): what bayesgrasp.quality
+consumes. Read-only views of the result they belong to.)doc")
+      .def_property_readonly("point", column(&Contact::point),
+                             "point : numpy.ndarray (K, 3) float\n    Contact point on the object's (or the table's) "
+                             "surface, world frame (m).")
+      .def_property_readonly("normal", column(&Contact::normal),
+                             "normal : numpy.ndarray (K, 3) float\n    Outward unit normal of the object (+z for the "
+                             "table), world frame.")
+      .def_property_readonly("link", column(&Contact::link),
+                             "link : numpy.ndarray (K,) int32\n    Index of the hand link in contact (0 = palm).")
+      .def_property_readonly("penetration", column(&Contact::penetration),
+                             "penetration : numpy.ndarray (K,) float\n    Depth of overlap (m, >= 0; 0 when touching "
+                             "within the tolerance).")
+      .def_property_readonly("on_table", column(&Contact::on_table),
+                             "on_table : numpy.ndarray (K,) bool\n    The contact is with the table, not the object.")
+      .def("__len__", [](const ContactArrays& c) { return c.count; });
+
+  py::class_<BatchContactArrays, ContactArrays>(m, "BatchContacts", R"doc(The contacts of a batch of grasps,
+concatenated: grasp i's contacts are rows offsets[i]:offsets[i+1].)doc")
+      .def_property_readonly(
+          "grasp",
+          [](const BatchContactArrays& c) {
+            py::array_t<int64_t> g(static_cast<py::ssize_t>(c.count));
+            auto o = g.mutable_unchecked<1>();
+            for (size_t i = 0; i + 1 < c.offsets->size(); ++i)
+              for (int64_t k = (*c.offsets)[i]; k < (*c.offsets)[i + 1]; ++k) o(k) = static_cast<int64_t>(i);
+            return g;
+          },
+          "grasp : numpy.ndarray (K,) int64\n    Index of the grasp each contact belongs to (a new array).")
+      .def_property_readonly(
+          "offsets",
+          [](const BatchContactArrays& c) {
+            return readonly_view(py::dtype::of<int64_t>(), {static_cast<py::ssize_t>(c.offsets->size())},
+                                 {static_cast<py::ssize_t>(sizeof(int64_t))}, c.offsets->data(), c.owner);
+          },
+          "offsets : numpy.ndarray (N + 1,) int64\n    Grasp i's contacts are rows offsets[i]:offsets[i+1].");
 }
 
-py::array_t<bool> bool_matrix(const Eigen::Matrix<uint8_t, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>& m) {
-  py::array_t<bool> out({static_cast<py::ssize_t>(m.rows()), static_cast<py::ssize_t>(m.cols())});
-  auto o = out.mutable_unchecked<2>();
-  for (Eigen::Index i = 0; i < m.rows(); ++i)
-    for (Eigen::Index j = 0; j < m.cols(); ++j) o(i, j) = m(i, j) != 0;
-  return out;
+void bind_options(py::module_& m) {
+  py::class_<SimOptions> o(m, "SimOptions", R"doc(Options of the grasp simulator (SI units).
+
+The defaults are what every caller uses; the others exist for tests and benchmarks.)doc");
+  py::enum_<SimOptions::Bv>(o, "BoundingVolume", "FCL bounding volume of the object's BVH.")
+      .value("OBBRSS", SimOptions::Bv::OBBRSS)
+      .value("RSS", SimOptions::Bv::RSS);
+  py::enum_<SimOptions::LinkGeometry>(o, "LinkGeometry", "Link geometry of the FCL distance queries.")
+      .value("Segments", SimOptions::LinkGeometry::Segments)
+      .value("Primitives", SimOptions::LinkGeometry::Primitives)
+      .value("Meshes", SimOptions::LinkGeometry::Meshes);
+  o.def(py::init<>())
+      .def_readwrite("table", &SimOptions::table, "table : bool\n    An infinite table plane at z = 0.")
+      .def_readwrite("contact_tolerance", &SimOptions::contact_tolerance,
+                     "contact_tolerance : float\n    A link touches when closer than this (m, > 0).")
+      .def_readwrite("rel_err", &SimOptions::rel_err,
+                     "rel_err : float\n    Error allowance of the advancing distance queries, relative to the "
+                     "link's lower bound on its distance (in [0, 1); 0 = exact).")
+      .def_readwrite("box_skip", &SimOptions::box_skip,
+                     "box_skip : float\n    Links whose lower bound on the object distance exceeds this use the "
+                     "bound instead of an FCL query (m, > contact_tolerance).")
+      .def_readwrite("bv", &SimOptions::bv, "bv : SimOptions.BoundingVolume\n    The object's bounding volumes.")
+      .def_readwrite("links", &SimOptions::links,
+                     "links : SimOptions.LinkGeometry\n    Segments (capsule axes as sliver triangles, boxes as "
+                     "meshes), Primitives (FCL capsules and boxes) or Meshes (tessellated capsules).")
+      .def_readwrite("max_iterations", &SimOptions::max_iterations,
+                     "max_iterations : int\n    Advancement steps per finger and per approach (a safety net, >= 1).")
+      .def_readwrite("table_clearance", &SimOptions::table_clearance,
+                     "table_clearance : float\n    Top grasps with a table keep the fingers' closing sweep at least "
+                     "this far above it (m); negative: stop at the first contact.")
+      .def_readwrite("prune_queries", &SimOptions::prune_queries,
+                     "prune_queries : bool\n    Skip FCL queries whose answer cannot change the result (same "
+                     "grasps up to round-off).");
 }
 
-py::dict batch_dict(const GraspBatch& b) {
-  py::dict d;
-  d["joint_angles"] = to_numpy(b.joints);
-  d["contacts"] = contacts_dict(b.contacts, &b.offsets);
-  d["link_contact"] = bool_matrix(b.link_contact);
-  d["table_contact"] = bool_matrix(b.table_contact);
-  d["collision_at_start"] = bools(b.collision_at_start);
-  py::array_t<double> poses({static_cast<py::ssize_t>(b.num_grasps), py::ssize_t{4}, py::ssize_t{4}});
-  auto o = poses.mutable_unchecked<3>();
-  for (int i = 0; i < b.num_grasps; ++i)
-    for (int r = 0; r < 4; ++r)
-      for (int c = 0; c < 4; ++c) o(i, r, c) = b.hand_poses[i].matrix()(r, c);
-  d["hand_pose"] = poses;
-  d["distance_queries"] = py::array_t<int>(static_cast<py::ssize_t>(b.distance_queries.size()), b.distance_queries.data());
-  return d;
+py::tuple object_contacts(const Contacts& cs) {
+  std::vector<Vec3> p, n;
+  for (const Contact& c : cs)
+    if (!c.on_table) p.push_back(c.point), n.push_back(c.normal);
+  RowMatrixXd P(p.size(), 3), N(n.size(), 3);
+  for (size_t k = 0; k < p.size(); ++k) P.row(k) = p[k].transpose(), N.row(k) = n[k].transpose();
+  return py::make_tuple(to_numpy(P), to_numpy(N));
 }
 
-double spread_arg(const GraspSimulator& s, double spread) {
-  finite(spread, "spread");
-  const HandModel& h = s.hand();
-  if (spread < h.spread_lower() - 1e-12 || spread > h.spread_upper() + 1e-12)
-    throw py::value_error("spread: must lie in [" + std::to_string(h.spread_lower()) + ", " +
-                          std::to_string(h.spread_upper()) + "] rad, got " + std::to_string(spread));
-  return spread;
+void bind_result(py::module_& m) {
+  using R = GraspResult;
+  py::class_<R>(m, "GraspResult", "One simulated grasp (read-only; array fields are views).")
+      .def_property_readonly(
+          "joint_angles",
+          [](const py::object& self) {
+            const R& r = self.cast<const R&>();
+            return readonly_view(py::dtype::of<double>(), {r.joints.size()}, {kDouble}, r.joints.data(), self);
+          },
+          "joint_angles : numpy.ndarray (J,) float\n    Closed joint angles (rad), hand layout.")
+      .def_property_readonly(
+          "contacts", [](const py::object& self) { return contacts_of(self, self.cast<const R&>().contacts); },
+          "contacts : Contacts\n    At most one object and one table contact per link.")
+      .def_property_readonly(
+          "link_contact", [](const py::object& self) { return flags_view(self.cast<const R&>().link_contact, self); },
+          "link_contact : numpy.ndarray (L,) bool\n    Per link: it touches the object.")
+      .def_property_readonly(
+          "table_contact", [](const py::object& self) { return flags_view(self.cast<const R&>().table_contact, self); },
+          "table_contact : numpy.ndarray (L,) bool\n    Per link: it touches the table.")
+      .def_readonly("collision_at_start", &R::collision_at_start,
+                    "collision_at_start : bool\n    The open hand penetrated the object or the table (the fingers "
+                    "then stay open and there are no contacts).")
+      .def_property_readonly(
+          "hand_pose", [](const py::object& self) { return pose_view(self.cast<const R&>().hand_pose, self); },
+          "hand_pose : numpy.ndarray (4, 4) float\n    World pose of the hand (where a top grasp stopped).")
+      .def_readonly("distance_queries", &R::distance_queries, "distance_queries : int\n    FCL distance calls spent.")
+      .def_readonly("iterations", &R::iterations, "iterations : int\n    Advancement steps (fingers and approach).")
+      .def_property_readonly(
+          "num_contacts", [](const R& r) { return r.contacts.size(); }, "num_contacts : int\n    Number of contacts.")
+      .def(
+          "object_contacts", [](const R& r) { return object_contacts(r.contacts); },
+          "(points, normals): (K, 3) arrays of the contacts with the object (not the table), for quality metrics.")
+      .def("__repr__", [](const R& r) {
+        return "<GraspResult: " + std::to_string(r.contacts.size()) + " contacts" +
+               (r.collision_at_start ? ", collision at start>" : ">");
+      });
+
 }
 
-double standoff_arg(double standoff) {
-  if (!std::isfinite(standoff) || standoff < 0)
-    throw py::value_error("standoff: must be >= 0 and finite, got " + std::to_string(standoff));
-  return standoff;
+void bind_batch(py::module_& m) {
+  using B = GraspBatch;
+  py::class_<B>(m, "GraspBatch", R"doc(N simulated grasps as arrays (row i = grasp i; read-only views).)doc")
+      .def_readonly("num_grasps", &B::num_grasps, "num_grasps : int\n    N.")
+      .def_property_readonly(
+          "joint_angles",
+          [](const py::object& self) {
+            const B& b = self.cast<const B&>();
+            return readonly_view(py::dtype::of<double>(), {b.joints.rows(), b.joints.cols()},
+                                 {kDouble * b.joints.cols(), kDouble},
+                                 b.joints.data(), self);
+          },
+          "joint_angles : numpy.ndarray (N, J) float\n    Closed joint angles (rad), hand layout.")
+      .def_property_readonly(
+          "contacts",
+          [](const py::object& self) {
+            const B& b = self.cast<const B&>();
+            BatchContactArrays c;
+            static_cast<ContactArrays&>(c) = contacts_of(self, b.contacts);
+            c.offsets = &b.offsets;
+            return c;
+          },
+          "contacts : BatchContacts\n    All contacts, concatenated; see BatchContacts.offsets.")
+      .def(
+          "grasp_contacts",
+          [](const py::object& self, int i) {
+            const B& b = self.cast<const B&>();
+            if (i < 0 || i >= b.num_grasps)
+              throw py::index_error("i: must lie in [0, " + std::to_string(b.num_grasps) + ")");
+            return ContactArrays{self, b.contacts.data() + b.offsets[i], static_cast<size_t>(b.offsets[i + 1] - b.offsets[i])};
+          },
+          py::arg("i"), "The contacts of grasp i (views).")
+      .def_property_readonly(
+          "link_contact", [](const py::object& self) { return flag_matrix_view(self.cast<const B&>().link_contact, self); },
+          "link_contact : numpy.ndarray (N, L) bool\n    Per grasp and link: it touches the object.")
+      .def_property_readonly(
+          "table_contact", [](const py::object& self) { return flag_matrix_view(self.cast<const B&>().table_contact, self); },
+          "table_contact : numpy.ndarray (N, L) bool\n    Per grasp and link: it touches the table.")
+      .def_property_readonly(
+          "collision_at_start",
+          [](const py::object& self) { return flags_view(self.cast<const B&>().collision_at_start, self); },
+          "collision_at_start : numpy.ndarray (N,) bool\n    The open hand penetrated the object or the table.")
+      .def_property_readonly(
+          "hand_pose",
+          [](const py::object& self) {
+            const B& b = self.cast<const B&>();
+            return poses_view(b.hand_poses.data(), b.hand_poses.size(), self);
+          },
+          "hand_pose : numpy.ndarray (N, 4, 4) float\n    World poses of the hand (where the top grasps stopped).")
+      .def_property_readonly(
+          "distance_queries",
+          [](const py::object& self) {
+            const B& b = self.cast<const B&>();
+            return readonly_view(py::dtype::of<int>(), {static_cast<py::ssize_t>(b.distance_queries.size())},
+                                 {kInt}, b.distance_queries.data(), self);
+          },
+          "distance_queries : numpy.ndarray (N,) int32\n    FCL distance calls per grasp.")
+      .def("__len__", [](const B& b) { return b.num_grasps; });
 }
 
-int threads_arg(int threads) {
-  if (threads < 0) throw py::value_error("threads: must be >= 0 (0 = all cores)");
-  return threads;
-}
-
-std::vector<Iso3> poses_arg(const DArray& a, const char* name) {
-  if (a.ndim() != 3 || a.shape(1) != 4 || a.shape(2) != 4)
-    throw py::value_error(std::string(name) + ": expected shape (N, 4, 4), got " + shape_str(a));
-  std::vector<Iso3> out(a.shape(0));
-  for (py::ssize_t i = 0; i < a.shape(0); ++i) {
-    Eigen::Map<const Eigen::Matrix<double, 4, 4, Eigen::RowMajor>> m(a.data() + 16 * i);
-    try {
-      out[i] = pose_from_matrix(m);
-    } catch (const std::invalid_argument& e) {
-      throw py::value_error(std::string(name) + "[" + std::to_string(i) + "]: " + e.what());
-    }
-  }
-  return out;
+/// The batch calls (GIL released; threads: 0 = all cores).
+void def_batches(py::class_<GraspSimulator>& sim) {
+  sim      .def(
+          "close_batch",
+          [](const GraspSimulator& s, const DArray& hand_poses, const py::object& spreads, int threads) {
+            const std::vector<Iso3> P = poses(hand_poses, "hand_poses");
+            std::vector<double> sp;
+            if (py::isinstance<py::float_>(spreads) || py::isinstance<py::int_>(spreads)) {
+              sp.push_back(spreads.cast<double>());
+            } else {
+              const Eigen::VectorXd v = vector(spreads.cast<DArray>(), "spreads");
+              sp.assign(v.data(), v.data() + v.size());
+            }
+            py::gil_scoped_release release;
+            return s.close_batch(P, sp, threads);
+          },
+          py::arg("hand_poses"), py::arg("spreads"), py::arg("threads") = 1,
+          R"doc(Auto-grasp of N hand poses (N, 4, 4), spreads a number or (N,), in `threads` C++
+threads (0 = all cores), without the GIL. A GraspBatch.)doc")
+      .def(
+          "top_grasp_batch",
+          [](const GraspSimulator& s, const DArray& xyyaw, double spread, double standoff, int threads) {
+            const Eigen::Matrix<double, Eigen::Dynamic, 3, Eigen::RowMajor> rows = matrix(xyyaw, "xyyaw", 3, true);
+            py::gil_scoped_release release;
+            return s.top_grasp_batch(rows, spread, standoff, threads);
+          },
+          py::arg("xyyaw"), py::arg("spread"), py::arg("standoff") = 0.0, py::arg("threads") = 1,
+          "Top grasps at the rows (x, y, yaw) of an (N, 3) array; a GraspBatch.");
 }
 
 }  // namespace
 
 void bind_sim(py::module_& m) {
-  py::class_<GraspSimulator>(m, "GraspSimulator", R"doc(Auto-grasp of a hand on a static triangle-mesh object.
+  bind_contacts(m);
+  bind_options(m);
+  bind_result(m);
+  bind_batch(m);
+  py::class_<GraspSimulator> sim(m, "GraspSimulator", R"doc(Auto-grasp of a hand on a static triangle-mesh object.
 
 The object mesh is in the world frame (z up); an infinite table at z = 0 is optional. Fingers
 close from the open preshape by conservative advancement with FCL distance queries; each
 phalanx stops within contact_tolerance of the object or the table, with breakaway (a stopped
-phalanx freezes itself and the earlier ones; the later ones keep closing). Thread-safe.)doc")
-      .def(py::init([](const HandModel& hand, const DArray& vertices, const IArray& faces, bool table,
-                       double contact_tolerance, double table_clearance) {
-             const TriMesh mesh = bind::mesh(vertices, faces, "object");
-             SimOptions o;
-             o.table = table;
-             o.table_clearance = finite(table_clearance, "table_clearance");
-             o.contact_tolerance = positive(contact_tolerance, "contact_tolerance");
-             o.box_skip = std::max(o.box_skip, 2.5 * o.contact_tolerance);
-             return GraspSimulator(hand, mesh, o);
-           }),
-           py::arg("hand"), py::arg("vertices"), py::arg("faces"), py::arg("table") = true,
-           py::arg("contact_tolerance") = 2e-4, py::arg("table_clearance") = SimOptions{}.table_clearance,
-           R"doc(Args:
+phalanx freezes itself and the earlier ones; the later ones keep closing). Thread-safe.
+
+Args:
     hand: a bayesgrasp._core.hand.Hand.
     vertices: (N, 3) float object vertices (m, world frame).
     faces: (M, 3) int triangles, counter-clockwise seen from outside.
-    table: add the table plane z = 0.
-    contact_tolerance: a link touches when closer than this (m, default 0.2 mm).
-    table_clearance: top grasps keep the fingers' closing sweep at least this far above the
-        table (m, default 5 mm); negative: stop at the first contact instead.)doc")
+    options: SimOptions (ValueError naming an option out of range).)doc");
+  sim.def(py::init([](const HandModel& hand, const DArray& vertices, const IArray& faces, const SimOptions& options) {
+             return GraspSimulator(hand, bind::mesh(vertices, faces, "object"), options);
+           }),
+           py::arg("hand"), py::arg("vertices"), py::arg("faces"), py::arg("options") = SimOptions())
+      .def_property_readonly("options", &GraspSimulator::options, "options : SimOptions\n    A copy of the options.")
       .def_property_readonly("num_links", [](const GraspSimulator& s) { return s.hand().num_links(); })
       .def_property_readonly("num_joints", [](const GraspSimulator& s) { return s.hand().num_joints(); })
       .def(
           "close",
           [](const GraspSimulator& s, const DArray& hand_pose, double spread) {
             const Iso3 T = pose(hand_pose, "hand_pose");
-            spread_arg(s, spread);
-            GraspResult r;
-            {
-              py::gil_scoped_release release;
-              r = s.close(T, spread);
-            }
-            return result_dict(r);
+            py::gil_scoped_release release;
+            return s.close(T, spread);
           },
           py::arg("hand_pose"), py::arg("spread"),
-          R"doc(Auto-grasp from a 4x4 world hand pose with the given spread (rad).
-
-Returns a dict: joint_angles (J,), contacts {point (K,3), normal (K,3) (the object's outward
-normal, +z for the table), link (K,), penetration (K,), on_table (K,)}, link_contact (L,)
-and table_contact (L,) booleans, collision_at_start (bool: the open hand penetrated the
-object or table; fingers then stay open and there are no contacts), hand_pose (4,4),
-distance_queries (int).)doc")
+          R"doc(Auto-grasp from a 4x4 world hand pose with the given spread (rad); a GraspResult.)doc")
       .def(
           "close_fixed_step",
           [](const GraspSimulator& s, const DArray& hand_pose, double spread, double step) {
             const Iso3 T = pose(hand_pose, "hand_pose");
-            spread_arg(s, spread);
-            positive(step, "step");
-            GraspResult r;
-            {
-              py::gil_scoped_release release;
-              r = s.close_fixed_step(T, spread, step);
-            }
-            return result_dict(r);
+            py::gil_scoped_release release;
+            return s.close_fixed_step(T, spread, step);
           },
           py::arg("hand_pose"), py::arg("spread"), py::arg("step") = 0.01,
-          "The same auto-grasp GraspIt!-style (fixed actuator steps + collision checks, bisection on a hit); for comparison.")
-      .def(
-          "top_grasp",
-          [](const GraspSimulator& s, double x, double y, double yaw, double spread, double standoff) {
-            finite(x, "x"), finite(y, "y"), finite(yaw, "yaw");
-            spread_arg(s, spread);
-            standoff_arg(standoff);
-            GraspResult r;
-            {
-              py::gil_scoped_release release;
-              r = s.top_grasp(x, y, yaw, spread, standoff);
-            }
-            return result_dict(r);
-          },
-          py::arg("x"), py::arg("y"), py::arg("yaw"), py::arg("spread"), py::arg("standoff") = 0.0,
-          R"doc(Top grasp: the hand, palm down at (x, y, yaw), descends along -z until any link is
-within the contact tolerance of the object or the table, rises by `standoff` (m, >= 0,
-default 0: the first touching link stays in contact) and closes. Same dict as close(); its
-hand_pose is where the hand stopped.)doc")
-      .def(
-          "close_batch",
-          [](const GraspSimulator& s, const DArray& hand_poses, const py::object& spreads, int threads) {
-            const std::vector<Iso3> poses = poses_arg(hand_poses, "hand_poses");
-            std::vector<double> sp;
-            if (py::isinstance<py::float_>(spreads) || py::isinstance<py::int_>(spreads)) {
-              sp.push_back(spread_arg(s, spreads.cast<double>()));
-            } else {
-              const Eigen::VectorXd v = vector(spreads.cast<DArray>(), "spreads", static_cast<py::ssize_t>(poses.size()));
-              for (Eigen::Index i = 0; i < v.size(); ++i) sp.push_back(spread_arg(s, v[i]));
-            }
-            threads_arg(threads);
-            GraspBatch b;
-            {
-              py::gil_scoped_release release;
-              b = s.close_batch(poses, sp, threads);
-            }
-            return batch_dict(b);
-          },
-          py::arg("hand_poses"), py::arg("spreads"), py::arg("threads") = 1,
-          R"doc(Auto-grasp of N hand poses (N, 4, 4), spreads a number or (N,), in `threads` C++
-threads (0 = all cores), without the GIL. Returns a dict of arrays: joint_angles (N, J),
-link_contact and table_contact (N, L), collision_at_start (N,), hand_pose (N, 4, 4),
-distance_queries (N,), contacts {point (K,3), normal (K,3), link, penetration, on_table,
-grasp (K,) (the grasp index of each contact), offsets (N+1,) (grasp i's contacts are rows
-offsets[i]:offsets[i+1])}.)doc")
-      .def(
-          "top_grasp_batch",
-          [](const GraspSimulator& s, const DArray& xyyaw, double spread, double standoff, int threads) {
-            const RowMatrixXd a = matrix(xyyaw, "xyyaw", 3, true);
-            spread_arg(s, spread);
-            standoff_arg(standoff);
-            threads_arg(threads);
-            const Eigen::Matrix<double, Eigen::Dynamic, 3, Eigen::RowMajor> rows = a;
-            GraspBatch b;
-            {
-              py::gil_scoped_release release;
-              b = s.top_grasp_batch(rows, spread, standoff, threads);
-            }
-            return batch_dict(b);
-          },
-          py::arg("xyyaw"), py::arg("spread"), py::arg("standoff") = 0.0, py::arg("threads") = 1,
-          "Top grasps at the rows (x, y, yaw) of an (N, 3) array; same dict as close_batch().")
+          "The same auto-grasp GraspIt!-style (fixed actuator steps of `step` rad with collision checks, "
+          "bisection on a hit); for comparison.")
+      .def("top_grasp", &GraspSimulator::top_grasp, py::arg("x"), py::arg("y"), py::arg("yaw"), py::arg("spread"),
+           py::arg("standoff") = 0.0, py::call_guard<py::gil_scoped_release>(),
+           R"doc(Top grasp: the hand, palm down at (x, y, yaw), moves along -z until any link is within
+the contact tolerance of the object or the table, rises by `standoff` (m, >= 0, default 0: the
+first touching link stays in contact; and by the table clearance) and closes. Its hand_pose is
+where the hand stopped.)doc")
       .def(
           "link_object_distance",
           [](const GraspSimulator& s, const DArray& hand_pose, const DArray& q, int link) {
-            const Iso3 T = pose(hand_pose, "hand_pose");
-            const Eigen::VectorXd v = vector(q, "q", s.hand().num_joints());
-            if (link < 0 || link >= s.hand().num_links()) throw py::value_error("link: out of range");
-            try {
-              return s.link_object_distance(T, v, link);
-            } catch (const std::invalid_argument& e) {
-              throw py::value_error(std::string("q: ") + e.what());
-            }
+            return s.link_object_distance(pose(hand_pose, "hand_pose"), vector(q, "q"), link);
           },
           py::arg("hand_pose"), py::arg("q"), py::arg("link"),
           "Exact distance (m) from one link to the object (not the table); <= 0 when penetrating.");
+  def_batches(sim);
 }
 
 }  // namespace bayesgrasp::bind

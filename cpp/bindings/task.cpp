@@ -9,35 +9,7 @@
 
 namespace bayesgrasp::bind {
 
-namespace {
-
 using namespace bayesgrasp::task;
-
-std::vector<Iso3> pose_stack(const DArray& a, const char* name) {
-  if (a.ndim() != 3 || a.shape(1) != 4 || a.shape(2) != 4)
-    throw py::value_error(std::string(name) + ": expected shape (N, 4, 4), got " + shape_str(a));
-  std::vector<Iso3> out(static_cast<size_t>(a.shape(0)));
-  for (py::ssize_t i = 0; i < a.shape(0); ++i) {
-    Eigen::Map<const Eigen::Matrix<double, 4, 4, Eigen::RowMajor>> m(a.data() + 16 * i);
-    try {
-      out[static_cast<size_t>(i)] = pose_from_matrix(m);
-    } catch (const std::invalid_argument& e) {
-      throw py::value_error(std::string(name) + "[" + std::to_string(i) + "]: " + e.what());
-    }
-  }
-  return out;
-}
-
-py::array_t<double> pose_stack_out(const std::vector<Iso3>& poses) {
-  py::array_t<double> out({static_cast<py::ssize_t>(poses.size()), py::ssize_t{4}, py::ssize_t{4}});
-  auto o = out.mutable_unchecked<3>();
-  for (size_t i = 0; i < poses.size(); ++i)
-    for (int r = 0; r < 4; ++r)
-      for (int c = 0; c < 4; ++c) o(static_cast<py::ssize_t>(i), r, c) = poses[i].matrix()(r, c);
-  return out;
-}
-
-}  // namespace
 
 void bind_task(py::module_& m) {
   py::enum_<DensityKind>(m, "DensityKind", "Form of the pose density around a task grasp (Eq. 4.1).")
@@ -72,7 +44,7 @@ lambda Gauss(kappa s); Laplace exp(-(d_t/s_t + d_R/s_R)). 1 at the grasp.)doc")
   py::class_<GraspMixture>(m, "GraspMixture", R"doc(Eq. 4.1's mixture: task grasps of the training
 models carried into the scene, each with weight psi(q_ik) phi(delta_i).)doc")
       .def(py::init([](const DArray& grasps, const DArray& weights, const std::vector<int>& models, int num_models) {
-             return GraspMixture(pose_stack(grasps, "grasps"), vector(weights, "weights"), models, num_models);
+             return GraspMixture(poses(grasps, "grasps"), vector(weights, "weights"), models, num_models);
            }),
            py::arg("grasps"), py::arg("weights"), py::arg("models"), py::arg("num_models"),
            "grasps (K, 4, 4) in the scene frame; weights (K,) >= 0; models (K,) model index of each.")
@@ -81,7 +53,7 @@ models carried into the scene, each with weight psi(q_ik) phi(delta_i).)doc")
       .def(
           "evaluate",
           [](const GraspMixture& g, const DArray& candidates, const PoseDensity& d, bool per_model, int threads) {
-            const std::vector<Iso3> c = pose_stack(candidates, "candidates");
+            const std::vector<Iso3> c = poses(candidates, "candidates");
             py::gil_scoped_release release;
             return g.evaluate(c, d, per_model, threads);
           },
@@ -102,7 +74,7 @@ models carried into the scene, each with weight psi(q_ik) phi(delta_i).)doc")
   m.def(
       "poses_from_local",
       [](const DArray& reference, const DArray& X) {
-        return pose_stack_out(poses_from_local(pose(reference, "reference"), matrix(X, "X", 6, true)));
+        return to_numpy(poses_from_local(pose(reference, "reference"), matrix(X, "X", 6, true)));
       },
       py::arg("reference"), py::arg("X"),
       "Poses (N, 4, 4) from rows (t, r) of X (N, 6): rotation exp([r]) R_ref, translation t_ref + t.");
@@ -118,10 +90,10 @@ models carried into the scene, each with weight psi(q_ik) phi(delta_i).)doc")
 
   m.def(
       "hand_clearance",
-      [](const HandModel& hand, const DArray& q, const DArray& poses, const DArray& cloud,
+      [](const HandModel& hand, const DArray& q, const DArray& hand_poses, const DArray& cloud,
          const ClearanceOptions& options, int threads) {
         const Eigen::VectorXd qv = vector(q, "q");
-        const std::vector<Iso3> P = pose_stack(poses, "poses");
+        const std::vector<Iso3> P = poses(hand_poses, "poses");
         const CloudPoints C = matrix(cloud, "cloud", 3, true);
         py::gil_scoped_release release;
         return hand_clearance(hand, qv, P, C, options, threads);

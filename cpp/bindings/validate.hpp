@@ -9,6 +9,7 @@
 
 #include <cmath>
 #include <string>
+#include <vector>
 
 #include "bayesgrasp/geometry/mesh.hpp"
 
@@ -71,6 +72,22 @@ inline Iso3 pose(const DArray& a, const char* name) {
   }
 }
 
+/// N 4x4 homogeneous poses from an (N, 4, 4) array; errors name the argument and the row.
+inline std::vector<Iso3> poses(const DArray& a, const char* name) {
+  if (a.ndim() != 3 || a.shape(1) != 4 || a.shape(2) != 4)
+    throw py::value_error(std::string(name) + ": expected shape (N, 4, 4), got " + shape_str(a));
+  std::vector<Iso3> out(static_cast<size_t>(a.shape(0)));
+  for (py::ssize_t i = 0; i < a.shape(0); ++i) {
+    Eigen::Map<const Eigen::Matrix<double, 4, 4, Eigen::RowMajor>> m(a.data() + 16 * i);
+    try {
+      out[static_cast<size_t>(i)] = pose_from_matrix(m);
+    } catch (const std::invalid_argument& e) {
+      throw py::value_error(std::string(name) + "[" + std::to_string(i) + "]: " + e.what());
+    }
+  }
+  return out;
+}
+
 /// A triangle mesh from (V: (N, 3) float, F: (M, 3) int).
 inline TriMesh mesh(const DArray& V, const IArray& F, const char* name = "mesh") {
   TriMesh m;
@@ -90,6 +107,65 @@ inline py::array_t<double> to_numpy(const RowMatrixXd& m) {
   py::array_t<double> out({m.rows(), m.cols()});
   std::copy(m.data(), m.data() + m.size(), out.mutable_data());
   return out;
+}
+
+/// A pose as a (4, 4) float array (copy).
+inline py::array_t<double> to_numpy(const Iso3& T) {
+  py::array_t<double> out({4, 4});
+  auto o = out.mutable_unchecked<2>();
+  for (int r = 0; r < 4; ++r)
+    for (int c = 0; c < 4; ++c) o(r, c) = T.matrix()(r, c);
+  return out;
+}
+
+/// Poses as an (N, 4, 4) float array (copy).
+inline py::array_t<double> to_numpy(const std::vector<Iso3>& poses) {
+  py::array_t<double> out({static_cast<py::ssize_t>(poses.size()), py::ssize_t{4}, py::ssize_t{4}});
+  auto o = out.mutable_unchecked<3>();
+  for (size_t i = 0; i < poses.size(); ++i)
+    for (int r = 0; r < 4; ++r)
+      for (int c = 0; c < 4; ++c) o(static_cast<py::ssize_t>(i), r, c) = poses[i].matrix()(r, c);
+  return out;
+}
+
+/// Read-only numpy view of memory owned by the Python object `owner` (which the array keeps
+/// alive): `shape` items of dtype `dt` at `data`, `strides` in bytes. Results bound as classes
+/// expose their C++ arrays this way, without copies. Flags of 0/1 bytes may be viewed as bool.
+inline py::array readonly_view(const py::dtype& dt, std::vector<py::ssize_t> shape, std::vector<py::ssize_t> strides,
+                               const void* data, py::handle owner) {
+  py::ssize_t n = 1;
+  for (py::ssize_t d : shape) n *= d;
+  py::array out = n == 0 ? py::array(dt, shape, strides) : py::array(dt, shape, strides, data, owner);
+  py::detail::array_proxy(out.ptr())->flags &= ~py::detail::npy_api::NPY_ARRAY_WRITEABLE_;
+  return out;
+}
+
+/// Read-only (n,) view of one scalar member of n consecutive structs (an empty array if n = 0).
+template <class T, class F>
+py::array field_view(const T* first, size_t n, F T::*member, py::handle owner) {
+  return readonly_view(py::dtype::of<F>(), {static_cast<py::ssize_t>(n)}, {static_cast<py::ssize_t>(sizeof(T))},
+                       n ? &(first->*member) : nullptr, owner);
+}
+
+/// Read-only (n, 3) view of one Vec3 member of n consecutive structs.
+template <class T>
+py::array vec3_field_view(const T* first, size_t n, Vec3 T::*member, py::handle owner) {
+  const auto d = static_cast<py::ssize_t>(sizeof(double));
+  return readonly_view(py::dtype::of<double>(), {static_cast<py::ssize_t>(n), 3}, {static_cast<py::ssize_t>(sizeof(T)), d},
+                       n ? (first->*member).data() : nullptr, owner);
+}
+
+/// Read-only (N, 4, 4) view of N poses (Iso3 stores its 4x4 matrix column-major).
+inline py::array poses_view(const Iso3* poses, size_t n, py::handle owner) {
+  const auto item = static_cast<py::ssize_t>(sizeof(Iso3)), d = static_cast<py::ssize_t>(sizeof(double));
+  return readonly_view(py::dtype::of<double>(), {static_cast<py::ssize_t>(n), 4, 4}, {item, d, 4 * d},
+                       n ? poses[0].matrix().data() : nullptr, owner);
+}
+
+/// Read-only (4, 4) view of one pose.
+inline py::array pose_view(const Iso3& pose, py::handle owner) {
+  const auto d = static_cast<py::ssize_t>(sizeof(double));
+  return readonly_view(py::dtype::of<double>(), {4, 4}, {d, 4 * d}, pose.matrix().data(), owner);
 }
 
 }  // namespace bayesgrasp::bind

@@ -7,7 +7,7 @@ files live in ``bayesgrasp/data/hands/``::
     hand = Hand.load("barrett_bh8")           # or Hand.load("path/to/my_hand.json")
     q = hand.open_joints(spread=np.pi / 2)     # open preshape
     poses = hand.link_poses(q, hand_pose)      # (L, 4, 4)
-    parts = hand.link_geometry(q, hand_pose)   # world-frame shapes, for plotting
+    parts = hand.link_geometry(q, hand_pose)   # world-frame shapes (ShapeGeometry), for plotting
 
 Joint vector q (radians): [spread, finger 0 phalanx 0, finger 0 phalanx 1, ..., finger 1
 phalanx 0, ...]; phalanx angles are relative to the previous phalanx. The hand frame has its
@@ -15,13 +15,15 @@ origin at the centre of the palm face and +z along the approach direction.
 """
 from __future__ import annotations
 
+from dataclasses import dataclass
 from pathlib import Path
+from typing import Optional
 
 import numpy as np
 
 from bayesgrasp import _core
 
-__all__ = ["Hand", "HANDS_DIR", "builtin_hands"]
+__all__ = ["Hand", "HANDS_DIR", "ShapeGeometry", "builtin_hands"]
 
 HANDS_DIR = Path(__file__).parent / "data" / "hands"
 
@@ -35,6 +37,25 @@ def _pose(hand_pose):
     if hand_pose is None:
         return None
     return np.asarray(hand_pose, dtype=float)
+
+
+@dataclass(frozen=True)
+class ShapeGeometry:
+    """One collision shape of a hand link in the world frame (see :meth:`Hand.link_geometry`).
+
+    A ``'capsule'`` has ``p0``, ``p1`` (3,) and ``radius``; a ``'box'`` has ``center`` (3,),
+    ``rotation`` (3, 3) (columns = box axes) and ``half_extents`` (3,); the other fields are None.
+    """
+
+    link: int                               # link index
+    name: str                               # link name
+    type: str                               # 'capsule' or 'box'
+    p0: Optional[np.ndarray] = None
+    p1: Optional[np.ndarray] = None
+    radius: Optional[float] = None
+    center: Optional[np.ndarray] = None
+    rotation: Optional[np.ndarray] = None
+    half_extents: Optional[np.ndarray] = None
 
 
 class Hand:
@@ -107,29 +128,24 @@ class Hand:
         """4x4 pose of a palm-down hand at (x, y, yaw), palm face at height z."""
         return _core.hand.Hand.top_grasp_pose(float(x), float(y), float(yaw), float(z))
 
-    def link_shapes(self) -> list[list[dict]]:
-        """Per link, its collision shapes in the link frame (dicts, see the hand file)."""
+    def link_shapes(self) -> list:
+        """Per link, its collision shapes (``_core.hand.Shape``: type, center, half_extents, p0,
+        p1, radius) in the link frame."""
         return self.core.link_shapes()
 
-    def link_geometry(self, q=None, hand_pose=None) -> list[dict]:
-        """World-frame geometry of every shape, for plotting.
-
-        Returns a list of dicts, one per shape, with ``link`` (index), ``name`` (link name) and
-        ``type``: a ``'capsule'`` has ``p0``, ``p1`` (3,) and ``radius``; a ``'box'`` has
-        ``center`` (3,), ``rotation`` (3, 3) (columns = box axes) and ``half_extents`` (3,).
-        q defaults to the open preshape at the default spread; hand_pose to identity.
-        """
+    def link_geometry(self, q=None, hand_pose=None) -> list[ShapeGeometry]:
+        """World-frame geometry of every shape, for plotting: one :class:`ShapeGeometry` per
+        shape. q defaults to the open preshape at the default spread; hand_pose to identity."""
         q = self.open_joints() if q is None else np.asarray(q, dtype=float)
         poses = self.link_poses(q, hand_pose)
         out = []
         for li, (shapes, T) in enumerate(zip(self.link_shapes(), poses)):
             R, t = T[:3, :3], T[:3, 3]
             for s in shapes:
-                d = {"link": li, "name": self.links[li], "type": s["type"]}
-                if s["type"] == "capsule":
-                    d.update(p0=R @ np.asarray(s["p0"]) + t, p1=R @ np.asarray(s["p1"]) + t, radius=float(s["radius"]))
+                if s.type == "capsule":
+                    out.append(ShapeGeometry(li, self.links[li], "capsule", p0=R @ s.p0 + t, p1=R @ s.p1 + t,
+                                             radius=float(s.radius)))
                 else:
-                    d.update(center=R @ np.asarray(s["center"]) + t, rotation=R.copy(),
-                             half_extents=np.asarray(s["half_extents"], dtype=float))
-                out.append(d)
+                    out.append(ShapeGeometry(li, self.links[li], "box", center=R @ s.center + t, rotation=R.copy(),
+                                             half_extents=np.asarray(s.half_extents, dtype=float)))
         return out

@@ -7,15 +7,16 @@ backdrivable). Script: squeeze 0.15 s, lift 10 cm in 0.4 s, gentle 3-axis shake 
 centre of mass moved less than 2 cm relative to the palm (after the squeeze)::
 
     r = lift_test("python/bayesgrasp/data/hands/barrett_bh8.json", hand_pose, joints, V, F)
-    r["lifted"], r["displacement"]
+    r.lifted, r.displacement                    # a LiftResult
 
-``LiftTester`` keeps the object's preprocessing for many tests (``run``, ``run_batch``).
+``LiftTester`` keeps the object's preprocessing for many tests (``run``, ``run_batch``: a
+``LiftBatch`` whose fields are (N,) arrays).
 
 Concave objects (a mug, a pitcher) need a concave collision shape when the hand reaches into
 a concavity (the opening, the handle's hole). ``shape="auto"`` (default) then uses an
 approximate convex decomposition of the mesh - a compound of a few dozen convex hulls,
 computed once per mesh by CoACD (:func:`convex_decomposition`, cached as ``.npz``) - instead
-of one tetrahedron per triangle (``shape="tetrahedra"``, ~40x slower; see BENCHMARKS.md).
+of one tetrahedron per triangle (``shape="tetrahedra"``, far slower; see BENCHMARKS.md).
 """
 from __future__ import annotations
 
@@ -28,24 +29,22 @@ import numpy as np
 
 from bayesgrasp import _core
 from bayesgrasp.cache import cache_root
+from bayesgrasp.sim import set_fields
 
-__all__ = ["BARRETT_HAND", "LiftOptions", "LiftTester", "convex_decomposition", "decomposition_cache_dir",
-           "is_concave", "lift_test", "lift_test_batch", "make_options"]
+__all__ = ["BARRETT_HAND", "LiftBatch", "LiftOptions", "LiftResult", "LiftTester", "convex_decomposition",
+           "decomposition_cache_dir", "is_concave", "lift_test", "lift_test_batch", "make_options"]
 
 #: Path of the built-in Barrett BH8 hand file.
 BARRETT_HAND = os.path.join(os.path.dirname(__file__), "data", "hands", "barrett_bh8.json")
 
 LiftOptions = _core.physics.LiftOptions
+LiftResult = _core.physics.LiftResult
+LiftBatch = _core.physics.LiftBatch
 
 
 def make_options(**kwargs) -> LiftOptions:
     """LiftOptions from keyword arguments (names as the LiftOptions attributes)."""
-    o = LiftOptions()
-    for k, v in kwargs.items():
-        if k.startswith("_") or not hasattr(o, k):
-            raise ValueError(f"{k}: not a lift-test option")
-        setattr(o, k, v)
-    return o
+    return set_fields(LiftOptions(), kwargs, "lift-test")
 
 
 def _hand(hand):
@@ -66,7 +65,8 @@ def convex_decomposition(vertices, faces, threshold: float = 0.05, seed: int = 0
     Args:
         vertices: (N, 3) float vertices (m). faces: (M, 3) int triangles.
         threshold: CoACD's concavity threshold (smaller: more, tighter pieces). 0.05 (CoACD's
-            default) cuts the built-in mug into ~25 pieces that keep its opening and handle.
+            default) cuts the built-in mug into a few dozen pieces that keep its opening and
+            handle.
         seed: CoACD's random seed (same mesh and seed give the same pieces).
         cache_dir: directory of the ``.npz`` cache (None: :func:`decomposition_cache_dir`;
             False: no cache). The key is a SHA-256 of the mesh's bytes and the parameters, so
@@ -113,9 +113,8 @@ def convex_decomposition(vertices, faces, threshold: float = 0.05, seed: int = 0
     return pieces
 
 
-#: CoACD's search, lighter than its defaults: on the built-in mug 3.7 s and 24 pieces of at most 48
-#: vertices instead of 21 s and 25 pieces (the lift test needs pieces near the hand's contacts, not
-#: the tightest decomposition).
+#: CoACD's search, lighter than its defaults (the lift test needs pieces near the hand's contacts,
+#: not the tightest decomposition; BENCHMARKS.md gives its time and pieces on the mug).
 _COACD_SEARCH = {"mcts_iterations": 50, "mcts_nodes": 10, "resolution": 1000, "max_ch_vertex": 48}
 
 
@@ -177,19 +176,19 @@ class LiftTester:
         still uses the hull for grasps that stay outside it; see the results' ``shape``)."""
         return self._t.shape
 
-    def run(self, hand_pose, joints) -> dict:
-        """One lift test; returns a dict (lifted, displacement, rotation, squeeze_displacement,
-        height_gain, finite, steps, tetrahedra, shape)."""
+    def run(self, hand_pose, joints) -> LiftResult:
+        """One lift test (lifted, displacement, rotation, squeeze_displacement, height_gain,
+        finite, steps, tetrahedra, shape)."""
         return self._t.run(np.asarray(hand_pose, dtype=float), np.asarray(joints, dtype=float))
 
-    def run_batch(self, hand_poses, joints, threads=1) -> dict:
-        """N lift tests ((N, 4, 4) poses, (N, J) joints) in C++ threads; dict of (N,) arrays
-        (and ``shape``, the list of shapes used)."""
+    def run_batch(self, hand_poses, joints, threads=1) -> LiftBatch:
+        """N lift tests ((N, 4, 4) poses, (N, J) joints) in C++ threads (0 = all cores): the
+        LiftResult fields as (N,) arrays, ``shape`` the list of shapes used."""
         return self._t.run_batch(np.asarray(hand_poses, dtype=float), np.asarray(joints, dtype=float),
                                  int(threads))
 
 
-def lift_test(hand, hand_pose, joints, vertices, faces, **options) -> dict:
+def lift_test(hand, hand_pose, joints, vertices, faces, **options) -> LiftResult:
     """One lift test of a closed grasp.
 
     Args:
@@ -200,12 +199,12 @@ def lift_test(hand, hand_pose, joints, vertices, faces, **options) -> dict:
         **options: LiftOptions fields, e.g. ``mu=0.5, density=1000.0, table=True``.
 
     Returns:
-        dict with ``lifted`` (bool), ``displacement`` (m), ``rotation`` (rad),
-        ``squeeze_displacement`` (m), ``height_gain`` (m), ``finite``, ``steps``.
+        a LiftResult: ``lifted`` (bool), ``displacement`` (m), ``rotation`` (rad),
+        ``squeeze_displacement`` (m), ``height_gain`` (m), ``finite``, ``steps``, ``shape``.
     """
     return LiftTester(hand, vertices, faces, **options).run(hand_pose, joints)
 
 
-def lift_test_batch(hand, hand_poses, joints, vertices, faces, threads=1, **options) -> dict:
-    """N lift tests of one object, in ``threads`` C++ threads; dict of (N,) arrays."""
+def lift_test_batch(hand, hand_poses, joints, vertices, faces, threads=1, **options) -> LiftBatch:
+    """N lift tests of one object, in ``threads`` C++ threads; a LiftBatch of (N,) arrays."""
     return LiftTester(hand, vertices, faces, **options).run_batch(hand_poses, joints, threads)

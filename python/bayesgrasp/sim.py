@@ -9,58 +9,46 @@ link, rise by ``standoff`` (default 0) and close::
     hand = Hand.load("barrett_bh8")
     sim = GraspSimulator(hand, vertices, faces)            # table at z = 0 by default
     g = sim.top_grasp(0.0, 0.0, 0.3, spread=np.pi / 2)      # -> GraspResult
-    b = sim.top_grasp_batch(xyyaw, spread=0.5, threads=0)  # -> dict of arrays (N rows)
+    b = sim.top_grasp_batch(xyyaw, spread=0.5, threads=0)  # -> GraspBatch (N rows)
 
-Batch dicts: ``joint_angles`` (N, J), ``link_contact`` / ``table_contact`` (N, L),
-``collision_at_start`` (N,), ``hand_pose`` (N, 4, 4), ``distance_queries`` (N,), and
-``contacts`` with ``point``/``normal`` (K, 3), ``link``, ``penetration``, ``on_table``,
-``grasp`` (K,) and ``offsets`` (N + 1,). Normals are the object's outward surface normals
-(+z for the table): what :mod:`bayesgrasp.quality` consumes.
+Results are the core's classes (:class:`GraspResult`, :class:`GraspBatch`); their array fields
+are read-only numpy views: ``joint_angles``, ``link_contact`` / ``table_contact``,
+``collision_at_start``, ``hand_pose``, ``distance_queries`` and ``contacts`` with
+``point``/``normal`` (K, 3), ``link``, ``penetration``, ``on_table`` (and, for batches, ``grasp``
+(K,) and ``offsets`` (N + 1,)). Normals are the object's outward surface normals (+z for the
+table): what :mod:`bayesgrasp.quality` consumes. Options are a :class:`SimOptions`.
 """
 from __future__ import annotations
-
-from dataclasses import dataclass, field
 
 import numpy as np
 
 from bayesgrasp import _core
 from bayesgrasp.hand import Hand
 
-__all__ = ["GraspSimulator", "GraspResult"]
+__all__ = ["GraspSimulator", "GraspResult", "GraspBatch", "SimOptions", "make_options", "set_fields"]
+
+GraspResult = _core.sim.GraspResult
+GraspBatch = _core.sim.GraspBatch
+SimOptions = _core.sim.SimOptions
 
 
-@dataclass
-class GraspResult:
-    """One simulated grasp."""
+def set_fields(options, fields: dict, what: str):
+    """Sets the attributes ``fields`` on an options object; ValueError for a name it does not have."""
+    for k, v in fields.items():
+        if k.startswith("_") or not hasattr(options, k):
+            raise ValueError(f"{k}: not a {what} option")
+        setattr(options, k, v)
+    return options
 
-    joint_angles: np.ndarray          # (J,) rad, hand layout
-    contact_points: np.ndarray        # (K, 3) on the object (or table) surface, world
-    contact_normals: np.ndarray       # (K, 3) outward object normal (+z for the table)
-    contact_links: np.ndarray         # (K,) link index (0 = palm)
-    contact_penetration: np.ndarray   # (K,) >= 0 (m)
-    contact_on_table: np.ndarray      # (K,) bool
-    link_contact: np.ndarray          # (L,) bool: the link touches the object
-    table_contact: np.ndarray         # (L,) bool: the link touches the table
-    collision_at_start: bool          # the open hand penetrated the object or the table
-    hand_pose: np.ndarray             # (4, 4) world pose of the hand (where a top grasp stopped)
-    distance_queries: int = 0         # FCL distance calls spent
-    extra: dict = field(default_factory=dict)
 
-    @classmethod
-    def from_dict(cls, d: dict) -> "GraspResult":
-        c = d["contacts"]
-        return cls(np.asarray(d["joint_angles"]), c["point"], c["normal"], c["link"], c["penetration"],
-                   c["on_table"], d["link_contact"], d["table_contact"], bool(d["collision_at_start"]),
-                   d["hand_pose"], int(d["distance_queries"]))
-
-    @property
-    def num_contacts(self) -> int:
-        return int(len(self.contact_links))
-
-    def object_contacts(self) -> tuple[np.ndarray, np.ndarray]:
-        """(points, normals) of the contacts with the object (not the table), for quality metrics."""
-        keep = ~np.asarray(self.contact_on_table, dtype=bool)
-        return self.contact_points[keep], self.contact_normals[keep]
+def make_options(**fields) -> SimOptions:
+    """SimOptions from keyword arguments (names as the SimOptions attributes). A larger
+    ``contact_tolerance`` raises ``box_skip`` (unless given) to 2.5 times it, as the bound must
+    exceed the tolerance."""
+    o = set_fields(SimOptions(), fields, "simulator")
+    if "contact_tolerance" in fields and "box_skip" not in fields:
+        o.box_skip = max(o.box_skip, 2.5 * o.contact_tolerance)
+    return o
 
 
 def _hand(hand) -> _core.hand.Hand:
@@ -74,10 +62,17 @@ def _hand(hand) -> _core.hand.Hand:
 
 
 class GraspSimulator:
-    """Auto-grasp of a hand on one static triangle-mesh object (world frame, z up)."""
+    """Auto-grasp of a hand on one static triangle-mesh object (world frame, z up).
 
-    def __init__(self, hand, vertices, faces, table: bool = True, contact_tolerance: float = 2e-4,
-                 table_clearance: float = 0.005):
+    Args:
+        hand: a :class:`Hand`, a built-in hand name or a hand file path.
+        vertices: (N, 3) float vertices (m). faces: (M, 3) int triangles.
+        options: a :class:`SimOptions` (None: defaults).
+        **fields: SimOptions fields set on top of ``options`` (e.g. ``table=False``,
+            ``contact_tolerance=5e-4``, ``table_clearance=-1.0``).
+    """
+
+    def __init__(self, hand, vertices, faces, options: SimOptions | None = None, **fields):
         self.hand = hand if isinstance(hand, Hand) else Hand(_hand(hand))
         try:
             V = np.asarray(vertices, dtype=float)
@@ -88,44 +83,43 @@ class GraspSimulator:
             if F.size and not np.all(np.equal(np.mod(F, 1), 0)):
                 raise ValueError("faces: must be integer vertex indices")
         self.vertices, self.faces = V, F.astype(np.int32)
-        self.core = _core.sim.GraspSimulator(self.hand.core, V, self.faces, bool(table), float(contact_tolerance),
-                                             float(table_clearance))
+        o = make_options(**fields) if options is None else set_fields(options, fields, "simulator")
+        self.core = _core.sim.GraspSimulator(self.hand.core, V, self.faces, o)
 
     @classmethod
     def from_mesh(cls, hand, mesh, **kwargs) -> "GraspSimulator":
         """From any object with ``vertices`` and ``faces`` (e.g. a trimesh.Trimesh)."""
         return cls(hand, mesh.vertices, mesh.faces, **kwargs)
 
+    @property
+    def options(self) -> SimOptions:
+        return self.core.options
+
     def _spread(self, spread):
         return float(self.hand.core.spread_default if spread is None else spread)
 
     def close(self, hand_pose, spread: float | None = None) -> GraspResult:
         """Auto-grasp from a 4x4 world hand pose at `spread` (rad; default: the hand's default)."""
-        return GraspResult.from_dict(self.core.close(np.asarray(hand_pose, dtype=float), self._spread(spread)))
+        return self.core.close(np.asarray(hand_pose, dtype=float), self._spread(spread))
 
     def close_fixed_step(self, hand_pose, spread: float | None = None, step: float = 0.01) -> GraspResult:
         """The same closing GraspIt!-style (fixed actuator steps + collision checks); for comparison."""
-        return GraspResult.from_dict(self.core.close_fixed_step(np.asarray(hand_pose, dtype=float),
-                                                                self._spread(spread), float(step)))
+        return self.core.close_fixed_step(np.asarray(hand_pose, dtype=float), self._spread(spread), float(step))
 
     def top_grasp(self, x: float, y: float, yaw: float, spread: float | None = None,
                   standoff: float = 0.0) -> GraspResult:
         """Palm-down approach at (x, y, yaw) to the first contact, rise by `standoff` (m), close."""
-        return GraspResult.from_dict(self.core.top_grasp(float(x), float(y), float(yaw), self._spread(spread),
-                                                         float(standoff)))
+        return self.core.top_grasp(float(x), float(y), float(yaw), self._spread(spread), float(standoff))
 
-    def close_batch(self, hand_poses, spreads=None, threads: int = 1) -> dict:
-        """N hand poses (N, 4, 4); spreads a number or (N,); threads 0 = all cores. Dict of arrays."""
+    def close_batch(self, hand_poses, spreads=None, threads: int = 1) -> GraspBatch:
+        """N hand poses (N, 4, 4); spreads a number or (N,); threads 0 = all cores."""
         spreads = self._spread(None) if spreads is None else spreads
-        if not np.isscalar(spreads):
-            spreads = np.asarray(spreads, dtype=float)
-        else:
-            spreads = float(spreads)
+        spreads = float(spreads) if np.isscalar(spreads) else np.asarray(spreads, dtype=float)
         return self.core.close_batch(np.asarray(hand_poses, dtype=float), spreads, int(threads))
 
     def top_grasp_batch(self, xyyaw, spread: float | None = None, standoff: float = 0.0,
-                        threads: int = 1) -> dict:
-        """Top grasps at the rows (x, y, yaw) of an (N, 3) array. Dict of arrays."""
+                        threads: int = 1) -> GraspBatch:
+        """Top grasps at the rows (x, y, yaw) of an (N, 3) array."""
         return self.core.top_grasp_batch(np.asarray(xyyaw, dtype=float), self._spread(spread), float(standoff),
                                          int(threads))
 
@@ -133,10 +127,3 @@ class GraspSimulator:
         """Exact distance from one link to the object (m), <= 0 when penetrating."""
         return self.core.link_object_distance(np.asarray(hand_pose, dtype=float), np.asarray(q, dtype=float),
                                               int(link))
-
-    @staticmethod
-    def split_contacts(batch: dict) -> list[dict]:
-        """The batch's contacts as one dict of arrays per grasp."""
-        c, off = batch["contacts"], batch["contacts"]["offsets"]
-        keys = ["point", "normal", "link", "penetration", "on_table"]
-        return [{k: c[k][off[i]:off[i + 1]] for k in keys} for i in range(len(off) - 1)]

@@ -8,7 +8,9 @@ boxes / capsules given 4x4 link poses:
   :func:`draw_capsule`, :func:`draw_segments`, :func:`draw_points`;
 * :func:`new_axes`, :func:`set_equal_aspect`, :func:`save_figure`;
 * :func:`plot_scene` draws a :class:`~bayesgrasp.objects.Scene` (table patch and objects) and
-  optional extra drawing via a callback.
+  optional extra drawing via a callback;
+* :func:`hand_meshes` (a hand's collision shapes as meshes) and :func:`plot_grasp` (a
+  :class:`~bayesgrasp.world.World` grasp: the scene, the closed hand, the object contacts).
 """
 from __future__ import annotations
 
@@ -295,3 +297,28 @@ def plot_registrations(cloud: np.ndarray, models: Sequence, results: Sequence, p
     fig.tight_layout()
     fig.savefig(path, dpi=110)
     plt.close(fig)
+
+
+def hand_meshes(hand, joint_angles, hand_pose, color="tab:gray", alpha: float = 1.0) -> list:
+    """A hand's collision shapes (a :class:`~bayesgrasp.hand.Hand` at joints and 4x4 pose) as
+    ``(V, F, color, alpha)`` meshes for :func:`draw_meshes` / :func:`plot_scene`."""
+    items = []
+    for s in hand.link_geometry(joint_angles, hand_pose):
+        if s.type == "capsule":
+            V, F = capsule_mesh(s.p0, s.p1, s.radius)
+        else:
+            T = np.eye(4)
+            T[:3, :3], T[:3, 3] = s.rotation, s.center
+            V, F = box_mesh(T, s.half_extents)
+        items.append((V, F, color, alpha))
+    return items
+
+
+def plot_grasp(world, grasp, path, title: Optional[str] = None):
+    """PNG of the world's scene with the hand closed as in ``grasp`` (a
+    :meth:`~bayesgrasp.world.World.grasp` result) and its object contacts marked."""
+    pts = np.array([c.point for c in grasp.contacts if not c.on_table]).reshape(-1, 3)
+    return plot_scene(
+        world.scene, path, title=title,
+        extra_meshes=hand_meshes(world.hand, grasp.joint_angles, grasp.hand_pose, alpha=0.9),
+        extra=(lambda ax: draw_points(ax, pts, color="red", size=25)) if len(pts) else None)

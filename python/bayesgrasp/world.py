@@ -3,15 +3,18 @@ lift test, in one object.
 
 A top grasp is given relative to the object frame (see :mod:`bayesgrasp.objects.scene`): the
 hand, palm down, at (x, y) in the object frame with yaw relative to the object's yaw, descends
-along -z to the first contact and closes. Results come back as numpy arrays::
+along -z to the first contact and closes::
 
     world = World.single("mug", pose=(0.1, 0.0, 0.3))
-    g = world.grasp(0.0, 0.0, 0.0)                # one grasp: dict with joints, contacts, epsilon, ...
-    b = world.grasp_batch(xyyaw, threads=0)       # N grasps: dict of arrays
+    g = world.grasp(0.0, 0.0, 0.0)                # one grasp: a WorldGrasp (joints, contacts, epsilon, ...)
+    b = world.grasp_batch(xyyaw, threads=0)       # N grasps: a WorldGraspBatch of arrays
+
+Pictures of a grasp are in :mod:`bayesgrasp.viz` (``viz.plot_grasp(world, g, path)``).
 """
 from __future__ import annotations
 
-from typing import Optional, Sequence, Union
+from dataclasses import dataclass
+from typing import List, Optional, Sequence, Union
 
 import numpy as np
 
@@ -20,17 +23,73 @@ from .hand import Hand
 from .objects import ObjectModel, Scene
 from .sim import GraspSimulator
 
-__all__ = ["World", "DEFAULT_FRICTION"]
+__all__ = ["World", "WorldGrasp", "WorldGraspBatch", "ContactRecord", "DEFAULT_FRICTION"]
 
 DEFAULT_FRICTION = quality.DEFAULT_FRICTION
+
+
+@dataclass(frozen=True)
+class ContactRecord:
+    """One contact of a :class:`WorldGrasp` (plain Python values, world frame)."""
+
+    point: List[float]     # on the object's (or the table's) surface (m)
+    normal: List[float]    # the object's outward unit normal (+z for the table)
+    link: int              # hand link index (0 = palm)
+    link_name: str
+    penetration: float     # >= 0 (m)
+    on_table: bool
+
+    def to_dict(self) -> dict:
+        return {"point": self.point, "normal": self.normal, "link": self.link, "link_name": self.link_name,
+                "penetration": self.penetration, "on_table": self.on_table}
+
+
+@dataclass(frozen=True)
+class WorldGrasp:
+    """One grasp tried in a :class:`World` (see :meth:`World.grasp`)."""
+
+    joint_angles: np.ndarray          # (J,) closed joint angles (rad)
+    contacts: List[ContactRecord]
+    epsilon: float                    # GWS epsilon on the object contacts (0 when collision_at_start)
+    volume: float                     # GWS volume
+    collision_at_start: bool          # the open hand started in collision (no grasp)
+    hand_pose: np.ndarray             # (4, 4) world pose where the hand stopped
+    lifted: Optional[bool] = None     # lift-test verdict (None unless lifted)
+    lift_displacement: Optional[float] = None  # m, the lift test's displacement
+
+    def to_dict(self) -> dict:
+        """The grasp as a dict of these fields (contacts as dicts)."""
+        return {"joint_angles": self.joint_angles, "contacts": [c.to_dict() for c in self.contacts],
+                "epsilon": self.epsilon, "volume": self.volume, "collision_at_start": self.collision_at_start,
+                "hand_pose": self.hand_pose, "lifted": self.lifted, "lift_displacement": self.lift_displacement}
+
+
+@dataclass(frozen=True)
+class WorldGraspBatch:
+    """N grasps tried in a :class:`World` (see :meth:`World.grasp_batch`); row i = grasp i."""
+
+    joint_angles: np.ndarray        # (N, J)
+    contacts: object                # sim BatchContacts: point, normal, link, penetration, on_table, grasp, offsets
+    epsilon: np.ndarray             # (N,) GWS epsilon (0 when collision_at_start)
+    volume: np.ndarray              # (N,) GWS volume
+    collision_at_start: np.ndarray  # (N,) bool
+    hand_pose: np.ndarray           # (N, 4, 4)
+    link_contact: np.ndarray        # (N, L) bool
+    table_contact: np.ndarray       # (N, L) bool
+    distance_queries: np.ndarray    # (N,) FCL distance calls
+    lifted: Optional[np.ndarray] = None             # (N,) bool when lift-tested, else None
+    lift_displacement: Optional[np.ndarray] = None  # (N,) m when lift-tested, else None
+
+    def __len__(self) -> int:
+        return len(self.epsilon)
 
 
 class World:
     """One object of a scene, a hand and everything needed to try grasps on it.
 
     Args:
-        scene: the table-top scene; ``object_index`` selects the object to grasp (all objects
-            other than that one are ignored by the simulator for now).
+        scene: the table-top scene; ``object_index`` selects the object to grasp (the
+            simulator sees only that object; the others are not obstacles).
         hand: a :class:`Hand`, a built-in hand name or a hand file path.
         mu: friction coefficient for the quality metric and the lift test.
         spread: default finger spread (rad); None = the hand's default.
@@ -94,56 +153,45 @@ class World:
 
     # ---- grasps -------------------------------------------------------------------------
     def grasp(self, x: float, y: float, yaw: float, spread: Optional[float] = None,
-              lift: bool = False) -> dict:
-        """One top grasp at (x, y, yaw) in the object frame: simulate, score, optionally lift.
-
-        Returns a dict with ``joint_angles`` (J,), ``contacts`` (list of dicts with point,
-        normal, link, link_name, penetration, on_table), ``epsilon``, ``volume``,
-        ``collision_at_start``, ``hand_pose`` (4, 4) and ``lifted`` (None unless ``lift``).
-        """
+              lift: bool = False) -> WorldGrasp:
+        """One top grasp at (x, y, yaw) in the object frame: simulate, score, optionally lift."""
         b = self.grasp_batch([[x, y, yaw]], spread=spread, lift=lift)
         names = self.hand.core.link_names
-        c = b["contacts"]
-        contacts = [{"point": c["point"][k].tolist(), "normal": c["normal"][k].tolist(),
-                     "link": int(c["link"][k]), "link_name": names[int(c["link"][k])],
-                     "penetration": float(c["penetration"][k]), "on_table": bool(c["on_table"][k])}
-                    for k in range(len(c["link"]))]
-        return {"joint_angles": b["joint_angles"][0], "contacts": contacts,
-                "epsilon": float(b["epsilon"][0]), "volume": float(b["volume"][0]),
-                "collision_at_start": bool(b["collision_at_start"][0]), "hand_pose": b["hand_pose"][0],
-                "lifted": None if b["lifted"] is None else bool(b["lifted"][0]),
-                "lift_displacement": None if b["lifted"] is None else float(b["lift_displacement"][0])}
+        c = b.contacts
+        contacts = [ContactRecord(c.point[k].tolist(), c.normal[k].tolist(), int(c.link[k]), names[int(c.link[k])],
+                                  float(c.penetration[k]), bool(c.on_table[k]))
+                    for k in range(len(c.link))]
+        return WorldGrasp(b.joint_angles[0], contacts, float(b.epsilon[0]), float(b.volume[0]),
+                          bool(b.collision_at_start[0]), b.hand_pose[0],
+                          None if b.lifted is None else bool(b.lifted[0]),
+                          None if b.lifted is None else float(b.lift_displacement[0]))
 
     def grasp_batch(self, xyyaw, spread: Optional[float] = None, lift: bool = False,
-                    threads: int = 0) -> dict:
-        """N top grasps ((N, 3) rows x, y, yaw in the object frame) in C++ threads.
-
-        Returns the simulator's batch dict plus ``epsilon`` and ``volume`` (N,) (0 when the hand
-        started in collision), and ``lifted`` / ``lift_displacement`` (N,) when ``lift`` is set
-        (else None).
-        """
+                    threads: int = 0) -> WorldGraspBatch:
+        """N top grasps ((N, 3) rows x, y, yaw in the object frame) in C++ threads: the
+        simulator's batch plus ``epsilon`` and ``volume`` (0 when the hand started in
+        collision), and ``lifted`` / ``lift_displacement`` when ``lift`` is set (else None)."""
         world = self.to_world(xyyaw)
         spread = self.spread if spread is None else float(spread)
         b = self.sim.top_grasp_batch(world, spread=spread, standoff=self.standoff, threads=threads)
-        c = b["contacts"]
-        on_obj = ~np.asarray(c["on_table"], dtype=bool)
-        counts = np.diff(c["offsets"])
+        c = b.contacts
+        on_obj = ~c.on_table
+        counts = np.diff(c.offsets)
         # Quality on object contacts only, grasp by grasp in one C++ batch call.
         grasp_of = np.repeat(np.arange(len(counts)), counts)
         obj_counts = np.bincount(grasp_of[on_obj], minlength=len(counts))
-        eps, vol = quality.epsilon_volume_batch(c["point"][on_obj], c["normal"][on_obj], self.com,
+        eps, vol = quality.epsilon_volume_batch(c.point[on_obj], c.normal[on_obj], self.com,
                                                 self.torque_scale, mu=self.mu, counts=obj_counts,
                                                 threads=threads)
-        eps, vol = np.asarray(eps, dtype=float), np.asarray(vol, dtype=float)
-        start = np.asarray(b["collision_at_start"], dtype=bool)
+        eps, vol = np.array(eps, dtype=float), np.array(vol, dtype=float)
+        start = b.collision_at_start
         eps[start], vol[start] = 0.0, 0.0
-        b["epsilon"], b["volume"] = eps, vol
-        b["lifted"], b["lift_displacement"] = None, None
+        lifted = displacement = None
         if lift:
-            r = self.lift_tester().run_batch(b["hand_pose"], b["joint_angles"], threads=threads)
-            lifted = np.asarray(r["lifted"], dtype=bool) & ~start
-            b["lifted"], b["lift_displacement"] = lifted, np.asarray(r["displacement"], dtype=float)
-        return b
+            r = self.lift_tester().run_batch(b.hand_pose, b.joint_angles, threads=threads)
+            lifted, displacement = r.lifted & ~start, np.array(r.displacement, dtype=float)
+        return WorldGraspBatch(b.joint_angles, c, eps, vol, start, b.hand_pose, b.link_contact, b.table_contact,
+                               b.distance_queries, lifted, displacement)
 
     def lift_tester(self) -> physics.LiftTester:
         if self._lift is None:
@@ -155,30 +203,3 @@ class World:
             self._lift = physics.LiftTester(self.hand.path, self.vertices, self.faces, convex_pieces=pieces,
                                             mu=self.mu, density=self.object.density)
         return self._lift
-
-    # ---- pictures -----------------------------------------------------------------------
-    def hand_meshes(self, joint_angles, hand_pose, color="tab:gray", alpha: float = 1.0) -> list:
-        """The hand's collision shapes as ``(V, F, color, alpha)`` meshes for :mod:`bayesgrasp.viz`."""
-        from . import viz
-
-        items = []
-        for s in self.hand.link_geometry(joint_angles, hand_pose):
-            if s["type"] == "capsule":
-                V, F = viz.capsule_mesh(s["p0"], s["p1"], s["radius"])
-            else:
-                T = np.eye(4)
-                T[:3, :3], T[:3, 3] = s["rotation"], s["center"]
-                V, F = viz.box_mesh(T, s["half_extents"])
-            items.append((V, F, color, alpha))
-        return items
-
-    def plot_grasp(self, grasp: dict, path, title: Optional[str] = None):
-        """PNG of the scene with the hand closed as in ``grasp`` (a :meth:`grasp` result) and
-        its object contacts marked."""
-        from . import viz
-
-        pts = np.array([c["point"] for c in grasp["contacts"] if not c["on_table"]]).reshape(-1, 3)
-        return viz.plot_scene(
-            self.scene, path, title=title,
-            extra_meshes=self.hand_meshes(grasp["joint_angles"], grasp["hand_pose"], alpha=0.9),
-            extra=(lambda ax: viz.draw_points(ax, pts, color="red", size=25)) if len(pts) else None)

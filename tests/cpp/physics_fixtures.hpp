@@ -1,4 +1,4 @@
-// Shared by tests/cpp/test_physics.cpp and bench/bench_physics.cpp: the Barrett hand, a box
+// Shared by tests/cpp/test_physics.cpp, tests/cpp/test_sim_approach.cpp and bench/bench_physics.cpp: the Barrett hand, a box
 // and a cup (or pot) as closed meshes, the cup's hand-made convex decomposition and signed
 // distance, and closing a finger until it touches an object given by its signed distance.
 #pragma once

@@ -56,7 +56,7 @@ TEST(Hand, BarrettSpreadAndClosing) {
   EXPECT_NEAR(h.fingers()[0].t_max(), 144 * kDeg, 1e-9);  // distal reaches 90 at t = 144 deg
 }
 
-TEST(Hand, LinkPosesAreConsistent) {
+TEST(Hand, LinkPosesMatchThePlanarChain) {
   const HandModel h = HandModel::from_file(kBarrett);
   const Iso3 T = HandModel::top_grasp_pose(0.1, 0.2, 0.3, 0.25);
   const Eigen::VectorXd q = h.coupled_joints(0.4, 1.0);
@@ -66,12 +66,29 @@ TEST(Hand, LinkPosesAreConsistent) {
   // Palm down: hand +z is world -z.
   EXPECT_TRUE((T.linear() * Vec3::UnitZ()).isApprox(-Vec3::UnitZ(), 1e-12));
   for (int f = 0; f < 3; ++f) {
-    const int distal = h.fingers()[f].phalanges[1].link;
-    EXPECT_TRUE(poses[distal].isApprox(h.phalanx_pose(T, f, 1, q), 1e-12));
-    // The distal joint is 70 mm from the proximal joint.
-    const int prox = h.fingers()[f].phalanges[0].link;
-    EXPECT_NEAR((poses[distal].translation() - poses[prox].translation()).norm(), 0.07, 1e-12);
-    EXPECT_TRUE((poses[distal] * Vec3(0.055, 0, 0)).isApprox(h.fingertip(T, f, q), 1e-12));
+    // Oracle: each finger is a planar chain in the plane spanned by its outward direction d
+    // (yaw = base_yaw + spread_sign * spread) and the hand's +z. The proximal joint sits at
+    // base + knuckle * d, the distal joint 70 mm further along the proximal direction
+    // (cumulative angle q1), the fingertip 55 mm along the distal direction (angle q1 + q2).
+    const Finger& F = h.fingers()[f];
+    const double yaw = F.base_yaw + F.spread_sign * q[0];
+    const Vec3 d(std::cos(yaw), std::sin(yaw), 0.0);
+    const double a1 = q[F.first_joint], a2 = a1 + q[F.first_joint + 1];
+    const Vec3 x1 = std::cos(a1) * d + std::sin(a1) * Vec3::UnitZ();
+    const Vec3 x2 = std::cos(a2) * d + std::sin(a2) * Vec3::UnitZ();
+    const Vec3 prox_joint = F.base + F.knuckle_length * d;
+    const Vec3 dist_joint = prox_joint + 0.07 * x1;
+    const int prox = F.phalanges[0].link, distal = F.phalanges[1].link;
+    EXPECT_TRUE(poses[prox].translation().isApprox(T * prox_joint, 1e-12));
+    EXPECT_TRUE(poses[distal].translation().isApprox(T * dist_joint, 1e-12));
+    EXPECT_TRUE(poses[distal].linear().col(0).isApprox(T.linear() * x2, 1e-12));
+    EXPECT_TRUE(poses[distal].linear().col(1).isApprox(T.linear() * d.cross(Vec3::UnitZ()), 1e-12));
+    EXPECT_TRUE(h.phalanx_pose(T, f, 1, q).translation().isApprox(T * dist_joint, 1e-12));
+    EXPECT_TRUE(h.fingertip(T, f, q).isApprox(T * (dist_joint + 0.055 * x2), 1e-12));
+    Iso3 chain[2];
+    h.phalanx_poses(T, f, q[0], q.data() + F.first_joint, chain);
+    EXPECT_TRUE(chain[1].translation().isApprox(T * dist_joint, 1e-12));
+    EXPECT_TRUE(chain[0].linear().col(0).isApprox(T.linear() * x1, 1e-12));
   }
 }
 
@@ -85,4 +102,8 @@ TEST(Hand, RejectsBadFilesAndJoints) {
   q[1] = 3.0;
   EXPECT_THROW(h.check_joints(q), std::invalid_argument);
   EXPECT_THROW(h.check_joints(Eigen::VectorXd::Zero(3)), std::invalid_argument);
+  EXPECT_NO_THROW(h.check_spread(M_PI));
+  EXPECT_THROW(h.check_spread(M_PI + 1e-6), std::invalid_argument);
+  EXPECT_THROW(h.check_spread(NAN), std::invalid_argument);
+  EXPECT_THROW(h.phalanx_pose(Iso3::Identity(), 0, 2, q), std::invalid_argument);
 }

@@ -35,8 +35,8 @@ def test_grasp_json_on_cube_has_the_documented_keys_and_contacts_on_the_surface(
 def test_grasp_relative_to_the_object_pose_is_invariant():
     a = World.single("cylinder", pose=(0.0, 0.0, 0.0)).grasp(0.01, 0.0, 0.2)
     b = World.single("cylinder", pose=(0.1, -0.05, 0.7)).grasp(0.01, 0.0, 0.2)
-    np.testing.assert_allclose(a["joint_angles"], b["joint_angles"], atol=1e-3)
-    assert len(a["contacts"]) == len(b["contacts"])
+    np.testing.assert_allclose(a.joint_angles, b.joint_angles, atol=1e-3)
+    assert len(a.contacts) == len(b.contacts)
     # (epsilon is not compared: a link lying across the cylinder's rim touches it along a
     # segment, and which point of it is reported as the one contact depends on round-off)
 

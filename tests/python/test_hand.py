@@ -42,16 +42,20 @@ def test_link_geometry_in_world_frame():
     T = Hand.top_grasp_pose(0.1, 0.2, 0.0, 0.3)  # palm down, palm face at z = 0.3
     q = h.open_joints(0.0)
     parts = h.link_geometry(q, T)
-    names = {p["name"] for p in parts}
+    names = {p.name for p in parts}
     assert "finger3/distal" in names and "palm" in names
-    palm = next(p for p in parts if p["name"] == "palm")
+    palm = next(p for p in parts if p.name == "palm")
     # palm box centre 30 mm behind the palm face: above it in the world
-    np.testing.assert_allclose(palm["center"], [0.1, 0.2, 0.33], atol=1e-12)
-    prox3 = next(p for p in parts if p["name"] == "finger3/proximal")
+    assert palm.type == "box" and palm.p0 is None
+    np.testing.assert_allclose(palm.center, [0.1, 0.2, 0.33], atol=1e-12)
+    np.testing.assert_allclose(palm.rotation, T[:3, :3], atol=1e-15)
+    prox3 = next(p for p in parts if p.name == "finger3/proximal")
     # finger 3 (hand -y) lies along world +y after the flip about x; the capsule spans 70 mm
-    np.testing.assert_allclose(prox3["p0"], [0.1, 0.2 + 0.05, 0.3], atol=1e-12)
-    np.testing.assert_allclose(prox3["p1"], [0.1, 0.2 + 0.12, 0.3], atol=1e-12)
-    assert prox3["radius"] == pytest.approx(0.0125)
+    np.testing.assert_allclose(prox3.p0, [0.1, 0.2 + 0.05, 0.3], atol=1e-12)
+    np.testing.assert_allclose(prox3.p1, [0.1, 0.2 + 0.12, 0.3], atol=1e-12)
+    assert prox3.type == "capsule" and prox3.radius == pytest.approx(0.0125)
+    shapes = h.link_shapes()
+    assert len(shapes) == 9 and shapes[0][0].type == "box"
     poses = h.link_poses(q, T)
     assert poses.shape == (9, 4, 4)
     np.testing.assert_allclose(poses[0], T)

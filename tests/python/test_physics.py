@@ -27,12 +27,13 @@ OPEN = np.array([0.0] + [0.0, np.radians(42)] * 3)
 
 def test_held_box_is_lifted_and_open_hand_leaves_it():
     r = physics.lift_test(None, POSE, GOOD, V, F, density=400.0)
-    assert r["finite"] and r["lifted"]
-    assert r["displacement"] < 0.01
-    assert abs(r["height_gain"] - 0.1) <= r["displacement"] + r["squeeze_displacement"] + 1e-9
+    assert isinstance(r, physics.LiftResult)
+    assert r.finite and r.lifted
+    assert r.displacement < 0.01
+    assert abs(r.height_gain - 0.1) <= r.displacement + r.squeeze_displacement + 1e-9
     r = physics.lift_test(physics.BARRETT_HAND, POSE, OPEN, V, F, density=400.0)
-    assert not r["lifted"]
-    assert abs(r["height_gain"]) < 2e-3  # still on the table
+    assert not r.lifted
+    assert abs(r.height_gain) < 2e-3  # still on the table
 
 
 def test_tester_batch_equals_single_runs():
@@ -40,11 +41,17 @@ def test_tester_batch_equals_single_runs():
     assert t.mass == pytest.approx(400.0 * 0.08 * 0.05 * 0.12)
     assert t.shape == "hull"
     out = t.run_batch(np.stack([POSE, POSE]), np.stack([GOOD, OPEN]), threads=2)
+    assert isinstance(out, physics.LiftBatch) and len(out) == 2
     for i, q in enumerate([GOOD, OPEN]):
         r = t.run(POSE, q)
-        assert out["lifted"][i] == r["lifted"]
-        assert out["displacement"][i] == r["displacement"]
-    assert out["lifted"].tolist() == [True, False]
+        assert out.lifted[i] == r.lifted
+        assert out.displacement[i] == r.displacement
+        assert out.rotation[i] == r.rotation and out.steps[i] == r.steps
+        assert out[i].height_gain == r.height_gain
+    assert out.lifted.tolist() == [True, False]
+    assert out.shape == ["hull", "hull"]
+    with pytest.raises(ValueError):
+        out.lifted[0] = False  # read-only view of the results
 
 
 def test_options_and_shapes():
@@ -152,8 +159,8 @@ def test_decomposition_cache(tmp_path):
 def test_decomposed_mug_gives_the_tetrahedra_verdicts_when_the_hand_reaches_into_it():
     # Two top grasps of the bench grid (bench/bench_physics_concave.py) over the mug's opening,
     # where a finger starts inside the mug's hull (Auto needs a concave shape): 1.1 cm from
-    # the body's axis away from the handle, yaw 90 deg - both shapes lift it (displacements
-    # 13.4 and 13.6 mm); 2.6 cm from it, y -1.3 cm, yaw 45 deg - both drop it.
+    # the body's axis away from the handle, yaw 90 deg - both shapes lift it; 2.6 cm from it,
+    # y -1.3 cm, yaw 45 deg - both drop it.
     from bayesgrasp.world import World
     w = World.single("mug")
     lo, hi = w.object.vertices.min(0), w.object.vertices.max(0)
@@ -164,20 +171,20 @@ def test_decomposed_mug_gives_the_tetrahedra_verdicts_when_the_hand_reaches_into
     assert dec.shape == "decomposition" and dec.concave and dec.num_pieces > 0
     tets = physics.LiftTester(None, w.vertices, w.faces, shape="tetrahedra", mu=w.mu, density=w.object.density)
     b = w.grasp_batch(CONCAVE_GRASPS, threads=1)
-    assert not np.any(b["collision_at_start"])
-    rd = dec.run_batch(b["hand_pose"], b["joint_angles"])
-    rt = tets.run_batch(b["hand_pose"], b["joint_angles"])
-    assert rd["shape"] == ["decomposition"] * len(CONCAVE_GRASPS)  # the hand reaches into the hull
-    assert rd["lifted"].tolist() == rt["lifted"].tolist() == CONCAVE_LIFTED
-    assert abs(rd["displacement"][0] - rt["displacement"][0]) < 5e-3
+    assert not np.any(b.collision_at_start)
+    rd = dec.run_batch(b.hand_pose, b.joint_angles)
+    rt = tets.run_batch(b.hand_pose, b.joint_angles)
+    assert rd.shape == ["decomposition"] * len(CONCAVE_GRASPS)  # the hand reaches into the hull
+    assert rd.lifted.tolist() == rt.lifted.tolist() == CONCAVE_LIFTED
+    assert abs(rd.displacement[0] - rt.displacement[0]) < 5e-3
     # Skipping the narrowphase for pairs proven apart (the default) changes nothing.
     obj, T = w.object, w.scene.object_pose(w.object_index)
     pieces = [p @ T[:3, :3].T + T[:3, 3] for p in physics.convex_decomposition(obj.vertices, obj.faces)]
     off = physics.LiftTester(None, w.vertices, w.faces, convex_pieces=pieces, mu=w.mu, density=w.object.density,
                              skip_separated_pairs=False)
-    ro = off.run_batch(b["hand_pose"], b["joint_angles"])
-    assert ro["displacement"].tolist() == rd["displacement"].tolist()
-    assert ro["rotation"].tolist() == rd["rotation"].tolist()
+    ro = off.run_batch(b.hand_pose, b.joint_angles)
+    assert ro.displacement.tolist() == rd.displacement.tolist()
+    assert ro.rotation.tolist() == rd.rotation.tolist()
 
 
 def test_decomposition_bad_input():
@@ -202,20 +209,20 @@ def test_box_as_its_own_single_piece_is_lifted_like_its_hull():
     t = physics.LiftTester(None, V, F, shape="decomposition", convex_pieces=[V], density=400.0)
     assert t.shape == "decomposition" and t.num_pieces == 1 and not t.concave
     r, h = t.run(POSE, GOOD), physics.lift_test(None, POSE, GOOD, V, F, density=400.0, shape="hull")
-    assert r["shape"] == "decomposition" and r["lifted"] and h["lifted"]
-    assert r["displacement"] == pytest.approx(h["displacement"], abs=1e-3)
-    assert not t.run(POSE, OPEN)["lifted"]
+    assert r.shape == "decomposition" and r.lifted and h.lifted
+    assert r.displacement == pytest.approx(h.displacement, abs=1e-3)
+    assert not t.run(POSE, OPEN).lifted
 
 
 def test_side_contacts_hold_a_cylinder_with_friction_in_both_tangent_directions():
     # A centred 60-degree top grasp of the cylinder (epsilon 0.96, mu 2): its fingertip contacts
     # press on the side wall and must hold the weight by friction along the vertical tangent.
-    # With friction along one tangent per contact (Bullet's default) it slid out (5.6 cm).
+    # (With friction along one tangent per contact, Bullet's default, it slides out.)
     from bayesgrasp.world import World
     w = World.single("cylinder", spread=np.radians(60), mu=2.0)
     g = w.grasp(0.0, 0.0, 3 * np.pi / 4)
-    assert not g["collision_at_start"] and g["epsilon"] > 0.5
-    r = w.lift_tester().run_batch(np.asarray([g["hand_pose"]]), np.asarray([g["joint_angles"]]))
-    assert r["lifted"][0], r["displacement"][0]
-    assert r["displacement"][0] < 0.01
-    assert r["height_gain"][0] > 0.09
+    assert not g.collision_at_start and g.epsilon > 0.5
+    r = w.lift_tester().run_batch(np.asarray([g.hand_pose]), np.asarray([g.joint_angles]))
+    assert r.lifted[0], r.displacement[0]
+    assert r.displacement[0] < 0.01
+    assert r.height_gain[0] > 0.09

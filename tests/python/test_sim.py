@@ -4,7 +4,7 @@ import pytest
 from scipy.optimize import brentq
 
 from bayesgrasp.hand import Hand
-from bayesgrasp.sim import GraspResult, GraspSimulator
+from bayesgrasp.sim import GraspBatch, GraspResult, GraspSimulator, SimOptions, make_options
 
 DEG = np.pi / 180
 
@@ -69,8 +69,9 @@ def test_table_stops_fingers(barrett):
     g = sim.close(Hand.top_grasp_pose(0, 0, 0, 0.08), 90 * DEG)
     th = brentq(lambda t: 0.07 * np.sin(t) + 0.045 * np.sin(t + t / 3 + 42 * DEG) + 0.01 - 0.08, 0.0, 60 * DEG)
     np.testing.assert_allclose(g.joint_angles[[1, 3, 5]] / DEG, th / DEG, atol=0.5)
-    assert g.contact_on_table.all() and len(g.contact_links) == 3
-    np.testing.assert_allclose(g.contact_points[:, 2], 0.0, atol=1e-12)
+    assert g.contacts.on_table.all() and len(g.contacts.link) == 3 and len(g.contacts) == 3
+    np.testing.assert_allclose(g.contacts.point[:, 2], 0.0, atol=1e-12)
+    np.testing.assert_allclose(g.contacts.normal, np.tile([0.0, 0.0, 1.0], (3, 1)))
     assert g.table_contact[[3, 6, 8]].all()  # the three distal links
 
 
@@ -87,19 +88,27 @@ def test_batch_equals_serial_and_is_deterministic(barrett):
     xyyaw = np.c_[rng.uniform(-0.04, 0.04, (12, 2)), rng.uniform(-np.pi, np.pi, 12)]
     b1 = sim.top_grasp_batch(xyyaw, spread=0.7, threads=1)
     b2 = sim.top_grasp_batch(xyyaw, spread=0.7, threads=2)
-    np.testing.assert_array_equal(b1["joint_angles"], b2["joint_angles"])
-    np.testing.assert_array_equal(b1["contacts"]["point"], b2["contacts"]["point"])
-    assert b1["joint_angles"].shape == (12, 7) and b1["link_contact"].shape == (12, 9)
-    assert b1["hand_pose"].shape == (12, 4, 4)
-    per = GraspSimulator.split_contacts(b1)
+    assert isinstance(b1, GraspBatch) and len(b1) == 12
+    np.testing.assert_array_equal(b1.joint_angles, b2.joint_angles)
+    np.testing.assert_array_equal(b1.contacts.point, b2.contacts.point)
+    assert b1.joint_angles.shape == (12, 7) and b1.link_contact.shape == (12, 9)
+    assert b1.hand_pose.shape == (12, 4, 4) and b1.link_contact.dtype == bool
+    off = b1.contacts.offsets
     for i in range(12):
         g = sim.top_grasp(*xyyaw[i], spread=0.7)
-        np.testing.assert_array_equal(g.joint_angles, b1["joint_angles"][i])
-        np.testing.assert_array_equal(g.contact_points, per[i]["point"])
-        assert (b1["contacts"]["grasp"][b1["contacts"]["offsets"][i]:b1["contacts"]["offsets"][i + 1]] == i).all()
+        np.testing.assert_array_equal(g.joint_angles, b1.joint_angles[i])
+        np.testing.assert_array_equal(g.contacts.point, b1.grasp_contacts(i).point)
+        np.testing.assert_array_equal(g.contacts.link, b1.contacts.link[off[i]:off[i + 1]])
+        np.testing.assert_array_equal(g.hand_pose, b1.hand_pose[i])
+        np.testing.assert_array_equal(g.link_contact, b1.link_contact[i])
+        assert g.collision_at_start == b1.collision_at_start[i]
+        assert (b1.contacts.grasp[off[i]:off[i + 1]] == i).all()
     # close_batch from the reached poses gives the same grasps
-    c = sim.close_batch(b1["hand_pose"], 0.7, threads=2)
-    np.testing.assert_allclose(c["joint_angles"], b1["joint_angles"], atol=1e-6)
+    c = sim.close_batch(b1.hand_pose, 0.7, threads=2)
+    np.testing.assert_allclose(c.joint_angles, b1.joint_angles, atol=1e-6)
+    # results are read-only views
+    with pytest.raises(ValueError):
+        b1.joint_angles[0, 0] = 1.0
 
 
 def test_robotiq_closes_on_a_box():
@@ -110,7 +119,7 @@ def test_robotiq_closes_on_a_box():
     sim = GraspSimulator(hand, V, F)
     g = sim.top_grasp(0.0, 0.0, 0.0, spread=0.0)
     assert not g.collision_at_start
-    fingers_touching = {hand.core.link_fingers[l] for l, t in zip(g.contact_links, g.contact_on_table)
+    fingers_touching = {hand.core.link_fingers[l] for l, t in zip(g.contacts.link, g.contacts.on_table)
                         if not t and l > 0}
     assert fingers_touching == {0, 1, 2}
     pts, nrm = g.object_contacts()
@@ -151,5 +160,37 @@ def test_bad_input_raises_value_error(barrett):
         GraspSimulator(barrett, V, np.zeros((0, 3), dtype=int))
     with pytest.raises(ValueError, match="hand"):
         GraspSimulator(42, V, F)
+    with pytest.raises(ValueError, match="contact_tolerance"):
+        GraspSimulator(barrett, V, F, contact_tolerance=-1e-3)
+    with pytest.raises(ValueError, match="box_skip"):
+        GraspSimulator(barrett, V, F, box_skip=1e-4)
+    with pytest.raises(ValueError, match="rel_err"):
+        GraspSimulator(barrett, V, F, rel_err=1.0)
+    with pytest.raises(ValueError, match="max_iterations"):
+        GraspSimulator(barrett, V, F, max_iterations=0)
+    with pytest.raises(ValueError, match="table_clearance"):
+        GraspSimulator(barrett, V, F, table_clearance=np.nan)
+    with pytest.raises(ValueError, match="not_an_option"):
+        GraspSimulator(barrett, V, F, not_an_option=1)
+    with pytest.raises(ValueError, match="q"):
+        sim.link_object_distance(np.eye(4), np.zeros(3), 1)
+    with pytest.raises(ValueError, match="link"):
+        sim.link_object_distance(np.eye(4), barrett.open_joints(0.0), 99)
     # empty batch is fine
-    assert sim.top_grasp_batch(np.zeros((0, 3)), spread=0.0)["joint_angles"].shape == (0, 7)
+    b = sim.top_grasp_batch(np.zeros((0, 3)), spread=0.0)
+    assert b.joint_angles.shape == (0, 7) and b.contacts.point.shape == (0, 3) and b.contacts.offsets.tolist() == [0]
+
+
+def test_every_option_reaches_the_simulator(barrett):
+    V, F = box([-0.03, -0.03, 0], [0.03, 0.03, 0.06])
+    o = make_options(table=False, contact_tolerance=5e-4, rel_err=0.01, bv=SimOptions.BoundingVolume.RSS,
+                     links=SimOptions.LinkGeometry.Primitives, max_iterations=321, table_clearance=-1.0,
+                     prune_queries=False)
+    assert o.box_skip == pytest.approx(2.5 * 5e-4)  # raised above the tolerance
+    got = GraspSimulator(barrett, V, F, options=o).options
+    for k in ["table", "contact_tolerance", "rel_err", "box_skip", "bv", "links", "max_iterations", "table_clearance",
+              "prune_queries"]:
+        assert getattr(got, k) == getattr(o, k), k
+    # without a table, a hand closing in the air touches nothing
+    g = GraspSimulator(barrett, V, F, options=o).close(Hand.top_grasp_pose(0.5, 0.5, 0, 0.02), 0.0)
+    assert g.num_contacts == 0 and not g.table_contact.any()

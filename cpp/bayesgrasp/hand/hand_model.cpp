@@ -75,6 +75,22 @@ std::vector<Shape> shapes(const json& j, const std::string& where) {
   return out;
 }
 
+/// One phalanx of a finger from its JSON object (`where` names it in errors).
+Phalanx parse_phalanx(const json& j, size_t p, const std::string& where) {
+  Phalanx phalanx;
+  phalanx.name = j.contains("name") ? j.at("name").get<std::string>() : "phalanx" + std::to_string(p);
+  phalanx.length = number(j, "length", where);
+  if (!(phalanx.length > 0)) fail(where, "length must be positive");
+  phalanx.lower = number(j, "lower_deg", where) * kDeg;
+  phalanx.upper = number(j, "upper_deg", where) * kDeg;
+  if (phalanx.lower > phalanx.upper) fail(where, "lower_deg > upper_deg");
+  phalanx.offset = number_or(j, "offset_deg", j.contains("lower_deg") ? number(j, "lower_deg", where) : 0.0, where) * kDeg;
+  phalanx.ratio = number_or(j, "ratio", 1.0, where);
+  if (phalanx.ratio < 0) fail(where, "ratio must be >= 0");
+  phalanx.shapes = shapes(j, where);
+  return phalanx;
+}
+
 Eigen::Matrix3d link_rotation(const Vec3& d, double theta) {
   const Vec3 z = Vec3::UnitZ();
   const Vec3 a = d.cross(z);
@@ -147,18 +163,7 @@ HandModel HandModel::from_json(const std::string& json_text) {
     if (!ph.is_array() || ph.empty()) fail(w, "'phalanges' must be a non-empty list");
     finger.first_joint = joint;
     for (size_t p = 0; p < ph.size(); ++p) {
-      const std::string wp = w + ".phalanges[" + std::to_string(p) + "]";
-      Phalanx phalanx;
-      phalanx.name = ph[p].contains("name") ? ph[p].at("name").get<std::string>() : "phalanx" + std::to_string(p);
-      phalanx.length = number(ph[p], "length", wp);
-      if (!(phalanx.length > 0)) fail(wp, "length must be positive");
-      phalanx.lower = number(ph[p], "lower_deg", wp) * kDeg;
-      phalanx.upper = number(ph[p], "upper_deg", wp) * kDeg;
-      if (phalanx.lower > phalanx.upper) fail(wp, "lower_deg > upper_deg");
-      phalanx.offset = number_or(ph[p], "offset_deg", ph[p].contains("lower_deg") ? number(ph[p], "lower_deg", wp) : 0.0, wp) * kDeg;
-      phalanx.ratio = number_or(ph[p], "ratio", 1.0, wp);
-      if (phalanx.ratio < 0) fail(wp, "ratio must be >= 0");
-      phalanx.shapes = shapes(ph[p], wp);
+      Phalanx phalanx = parse_phalanx(ph[p], p, w + ".phalanges[" + std::to_string(p) + "]");
       Link link;
       link.name = finger.name + "/" + phalanx.name;
       link.finger = static_cast<int>(f);
@@ -207,19 +212,26 @@ Eigen::VectorXd HandModel::coupled_joints(double spread, const Eigen::VectorXd& 
   return q;
 }
 
-void HandModel::check_joints(const Eigen::VectorXd& q, double tol) const {
+void HandModel::check_joints(const Eigen::VectorXd& q, double tol, const char* name) const {
+  const std::string n(name);
   if (q.size() != num_joints_)
-    throw std::invalid_argument("joints: expected " + std::to_string(num_joints_) + " values, got " +
+    throw std::invalid_argument(n + ": expected " + std::to_string(num_joints_) + " values, got " +
                                 std::to_string(q.size()));
-  if (!q.allFinite()) throw std::invalid_argument("joints: contain NaN or infinity");
+  if (!q.allFinite()) throw std::invalid_argument(n + ": contain NaN or infinity");
   if (q[0] < spread_lower_ - tol || q[0] > spread_upper_ + tol)
-    throw std::invalid_argument("joints: spread outside its limits");
+    throw std::invalid_argument(n + ": spread outside its limits");
   for (const Finger& f : fingers_)
     for (size_t p = 0; p < f.phalanges.size(); ++p) {
       const double v = q[f.first_joint + static_cast<int>(p)];
       if (v < f.phalanges[p].lower - tol || v > f.phalanges[p].upper + tol)
-        throw std::invalid_argument("joints: " + f.name + "/" + f.phalanges[p].name + " outside its limits");
+        throw std::invalid_argument(n + ": " + f.name + "/" + f.phalanges[p].name + " outside its limits");
     }
+}
+
+void HandModel::check_spread(double s, const char* name) const {
+  if (!std::isfinite(s) || s < spread_lower_ - 1e-12 || s > spread_upper_ + 1e-12)
+    throw std::invalid_argument(std::string(name) + ": must lie in [" + std::to_string(spread_lower_) + ", " +
+                                std::to_string(spread_upper_) + "] rad, got " + std::to_string(s));
 }
 
 Vec3 HandModel::finger_direction(int f, double spread) const {
@@ -228,44 +240,47 @@ Vec3 HandModel::finger_direction(int f, double spread) const {
   return Vec3(std::cos(yaw), std::sin(yaw), 0.0);
 }
 
+void HandModel::phalanx_poses(const Iso3& hand_pose, int f, double spread, const double* angles, Iso3* out,
+                              int count) const {
+  const Finger& finger = fingers_.at(f);
+  const int n = count < 0 ? static_cast<int>(finger.phalanges.size()) : count;
+  const Vec3 d = finger_direction(f, spread);
+  Vec3 joint = finger.base + finger.knuckle_length * d;
+  double theta = 0.0;  // cumulative phalanx angle
+  Iso3 local = Iso3::Identity();
+  for (int p = 0; p < n; ++p) {
+    theta += angles[p];
+    local.linear() = link_rotation(d, theta);
+    local.translation() = joint;
+    out[p] = hand_pose * local;
+    joint += finger.phalanges[p].length * local.linear().col(0);
+  }
+}
+
 std::vector<Iso3> HandModel::link_poses(const Iso3& hand_pose, const Eigen::VectorXd& q) const {
   std::vector<Iso3> poses(links_.size(), hand_pose);
+  std::vector<Iso3> phalanges;
   for (size_t f = 0; f < fingers_.size(); ++f) {
     const Finger& finger = fingers_[f];
-    const Vec3 d = finger_direction(static_cast<int>(f), q[0]);
     if (finger.knuckle_link >= 0) {
       Iso3 local = Iso3::Identity();
-      local.linear() = link_rotation(d, 0.0);
+      local.linear() = link_rotation(finger_direction(static_cast<int>(f), q[0]), 0.0);
       local.translation() = finger.base;
       poses[finger.knuckle_link] = hand_pose * local;
     }
-    Vec3 joint = finger.base + finger.knuckle_length * d;
-    double theta = 0.0;
-    for (size_t p = 0; p < finger.phalanges.size(); ++p) {
-      theta += q[finger.first_joint + static_cast<int>(p)];
-      Iso3 local = Iso3::Identity();
-      local.linear() = link_rotation(d, theta);
-      local.translation() = joint;
-      poses[finger.phalanges[p].link] = hand_pose * local;
-      joint += finger.phalanges[p].length * local.linear().col(0);
-    }
+    phalanges.resize(finger.phalanges.size());
+    phalanx_poses(hand_pose, static_cast<int>(f), q[0], q.data() + finger.first_joint, phalanges.data());
+    for (size_t p = 0; p < finger.phalanges.size(); ++p) poses[finger.phalanges[p].link] = phalanges[p];
   }
   return poses;
 }
 
 Iso3 HandModel::phalanx_pose(const Iso3& hand_pose, int f, int p, const Eigen::VectorXd& q) const {
   const Finger& finger = fingers_.at(f);
-  const Vec3 d = finger_direction(f, q[0]);
-  Vec3 joint = finger.base + finger.knuckle_length * d;
-  double theta = 0.0;
-  Iso3 local = Iso3::Identity();
-  for (int i = 0; i <= p; ++i) {
-    theta += q[finger.first_joint + i];
-    local.linear() = link_rotation(d, theta);
-    local.translation() = joint;
-    joint += finger.phalanges[i].length * local.linear().col(0);
-  }
-  return hand_pose * local;
+  if (p < 0 || p >= static_cast<int>(finger.phalanges.size())) throw std::invalid_argument("phalanx: out of range");
+  std::vector<Iso3> poses(static_cast<size_t>(p) + 1);
+  phalanx_poses(hand_pose, f, q[0], q.data() + finger.first_joint, poses.data(), p + 1);
+  return poses.back();
 }
 
 Vec3 HandModel::fingertip(const Iso3& hand_pose, int f, const Eigen::VectorXd& q) const {

@@ -95,9 +95,12 @@ class HandModel {
   /// Phalanx j of finger f at actuator parameter t (coupling law, clamped to limits).
   double coupled_angle(int finger, int phalanx, double t) const;
 
-  /// Throws std::invalid_argument if q has the wrong size, is not finite, or is outside
-  /// the joint limits by more than `tol`.
-  void check_joints(const Eigen::VectorXd& q, double tol = 1e-9) const;
+  /// Throws std::invalid_argument (naming `name`) if q has the wrong size, is not finite, or
+  /// is outside the joint limits by more than `tol`.
+  void check_joints(const Eigen::VectorXd& q, double tol = 1e-9, const char* name = "joints") const;
+  /// Throws std::invalid_argument (naming `name`) unless the spread is finite and within its
+  /// limits (1e-12 rad of slack).
+  void check_spread(double spread, const char* name = "spread") const;
 
   /// Outward direction of finger f at spread s (hand frame, unit, in the palm plane).
   Vec3 finger_direction(int finger, double spread) const;
@@ -105,6 +108,12 @@ class HandModel {
   /// Poses of every link in the frame of `hand_pose` (world if hand_pose is the hand's
   /// world pose), indexed like links().
   std::vector<Iso3> link_poses(const Iso3& hand_pose, const Eigen::VectorXd& q) const;
+  /// Poses of the first `count` phalanges of one finger (all of them if count < 0) in the frame
+  /// of `hand_pose`, at spread `spread` and the finger's relative phalanx angles `angles`
+  /// (its entries of q, from Finger::first_joint). `out` has room for them. No allocation:
+  /// the simulator calls it at every step. link_poses() and phalanx_pose() use it too.
+  void phalanx_poses(const Iso3& hand_pose, int finger, double spread, const double* angles, Iso3* out,
+                     int count = -1) const;
   /// Pose of one finger's phalanx j (and its predecessors) - cheaper than all links.
   Iso3 phalanx_pose(const Iso3& hand_pose, int finger, int phalanx, const Eigen::VectorXd& q) const;
   /// Fingertip (end of the last phalanx) of finger f.

@@ -17,17 +17,12 @@
 //    `table`); gravity is -9.81 m/s^2 along z.
 // Friction: two friction directions per contact (Bullet's SOLVER_USE_2_FRICTION_DIRECTIONS).
 // Bullet's default solves friction along one tangent only (the sliding direction, or an
-// arbitrary tangent for a contact at rest), so an object held at rest by side contacts slid
-// freely along the other tangent: a centred 60-degree top grasp of the cylinder (epsilon 0.96,
-// mu 2, 23 N of normal force against 3 N of weight) slid out at 3 cm/s with its friction far
-// from saturated. With both directions the share of force-closure grasps held rose from 3/56
-// to 22/56 (cylinder), 10/30 to 26/30 (cube), 3/17 to 13/17 (mug), mu 0.5, at 1/720 s.
-// Time step. Verdicts near the 2 cm threshold depend on the step (velocity-level contacts
-// and iterative joints): on 165 force-closure top grasps of the cube, cylinder and mug, the
-// verdicts at 1/960, 1/720, 1/480 and 1/360 s agree with those at 1/1440 s on 90%, 85%, 82%
-// and 82% of grasps, and the median displacement of a held cube is 3.4 mm at 1/1440 s,
-// 3.8 mm at 1/720 s, 4.9 mm at 1/480 s. The default, 1/480 s, costs two thirds of 1/720 s
-// for about the same agreement with the fine step; pass a finer step for a closer answer.
+// arbitrary tangent for a contact at rest), so an object held at rest by side contacts slides
+// freely along the other tangent with its friction far from saturated; with both directions
+// far more force-closure grasps are held (see BENCHMARKS.md).
+// Time step. Verdicts near the 2 cm threshold depend on the step (velocity-level contacts and
+// iterative joints); the default, 1/480 s, trades agreement with a fine step (1/1440 s) for
+// speed (BENCHMARKS.md gives the agreement per step); pass a finer step for a closer answer.
 // Script (fixed time step, no randomness: deterministic):
 //   squeeze  `squeeze_time` s, the palm still (the fingers tighten, the object may settle);
 //   lift     the palm rises `lift_height` (10 cm) in `lift_time` s (smooth cosine profile);
@@ -60,16 +55,21 @@
 //    where hull and mesh agree near the contacts), else the concave shape (the hand is in a
 //    concavity: a mug's opening or handle): Decomposition if pieces were given, else
 //    Tetrahedra. See bench/bench_physics.cpp and BENCHMARKS.md for the costs (hull and
-//    decomposition ~tens of tests/s, tetrahedra ~0.5/s on a 512-triangle cup).
+//    decomposition are far cheaper than tetrahedra).
 // Collision margins are `margin` (0.5 mm) on every shape (Bullet's default 4 cm is meant for
 // metre-sized bodies).
 // Speed. Bullet runs a GJK query at every step for every pair of child shapes (a hand link's
 // capsule or box, one convex piece of the object) whose bounding boxes overlap; with a finger
-// inside a mug that is most of the 7 x 24 pairs, nearly all of them apart. With
+// inside a mug that is most of the pairs, nearly all of them apart. With
 // `skip_separated_pairs` a pair found apart keeps a separating axis and a lower bound on its
 // separation that is updated from the two shapes' motion; while the bound exceeds the
 // contact-breaking distance and the pair has no contact point, Bullet's query (which would
-// add no point) is skipped. Same results, 2-2.5x faster on the built-in mugs and pitcher.
+// add no point) is skipped (physics/separated_pair_skip.hpp). Same results, faster on concave
+// objects (see BENCHMARKS.md).
+//
+// Files: lift_object (object preparation, per-grasp shape, the object's body), hand_bodies
+// (palm, phalanges, hinges and motors), lift_script (trajectory and outcome), bullet_world
+// (the world and its ownership), separated_pair_skip (the narrowphase skip).
 //
 // Thread safety: LiftTester is immutable after construction; each run builds its own Bullet
 // world, so run() may be called from many threads at once.
@@ -157,9 +157,9 @@ class LiftTester {
   /// size / outside the limits.
   LiftResult run(const Iso3& hand_pose, const Eigen::VectorXd& joints) const;
 
-  /// N lift tests (row i of `joints` with poses[i]) in `threads` threads (<= 0: all
-  /// hardware threads), each with its own Bullet world. Results in input order, identical
-  /// to run() one by one.
+  /// N lift tests (row i of `joints` with poses[i]) in `threads` threads (0 = all cores,
+  /// common/parallel.hpp thread_count; negative is an error), each with its own Bullet
+  /// world. Results in input order, identical to run() one by one.
   std::vector<LiftResult> run_batch(const std::vector<Iso3>& poses,
                                     const Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>& joints,
                                     int threads = 1) const;
@@ -167,6 +167,7 @@ class LiftTester {
   struct Impl;
 
  private:
+  LiftResult simulate(const Iso3& hand_pose, const Eigen::VectorXd& joints) const;  // validated input
   std::unique_ptr<Impl> impl_;
 };
 

@@ -1,43 +1,35 @@
 // Contact simulation: a hand (HandModel) closing on a static triangle-mesh object standing on
 // an optional infinite table (z = 0), with FCL distance queries.
 //
-// Closing (auto-grasp). Every finger starts at its open preshape (actuator t = 0) and closes
-// by conservative advancement: with d the distance between the moving links and the obstacles
-// and v an upper bound on how fast any point of those links moves per unit of t (sum over the
-// moving joints i <= j of ratio_i times the largest distance of link j's points from joint i's
-// axis, capsule radius included), the step dt = (d - tol / 2) / v can never make a link
-// penetrate. Steps repeat until a link is within `contact_tolerance` (0.2 mm) of the object or
-// the table; then the breakaway rule of HandModel applies (the touching phalanx and all
-// earlier ones of its finger freeze, the later ones keep closing; a phalanx reaching its
-// upper limit stops alone). Each finger advances independently (fingers do not collide with
-// each other). A link within the tolerance whose motion is not clearly into the obstacle
-// (e.g. a capsule resting on a rim and rotating along it) is not stopped: it advances by
-// trial steps of 2 mm of travel, checked by a distance query and refined by bisection when
-// blocked (GraspIt!-style), so that only approaching contacts stop a phalanx.
-// Cheap lower bounds replace FCL queries when they exceed `box_skip`: the gap between the
-// link's and the object's axis-aligned boxes and the separating-axis bound over the object's
-// 26-DOP; fingers whose whole reach cannot touch the object only see the table (closed form).
-// FCL geometry: the object is a BVHModel<OBBRSS> (or RSS); by default each capsule is its axis
-// as a sliver triangle (FCL's analytic triangle-triangle distance, radius subtracted), boxes
-// are 12-triangle meshes: about 6x faster than FCL's capsule/box primitives (GJK per triangle).
+// Closing (auto-grasp; sim/closing.cpp). Every finger starts at its open preshape (actuator
+// t = 0) and closes by conservative advancement: with d the distance between the moving links
+// and the obstacles and v an upper bound on how fast any point of those links moves per unit of
+// t (sim/finger_motion.hpp), the step dt = (d - tol / 2) / v can never make a link penetrate.
+// Steps repeat until a link is within `contact_tolerance` of the object or the table; then the
+// breakaway rule of HandModel applies (the touching phalanx and all earlier ones of its finger
+// freeze, the later ones keep closing; a phalanx reaching its upper limit stops alone). Each
+// finger advances independently (fingers do not collide with each other). A link within the
+// tolerance whose motion is not clearly into the obstacle (e.g. a capsule resting on a rim and
+// rotating along it) is not stopped: it advances by trial steps of 2 mm of travel, checked by a
+// distance query and refined by bisection when blocked (GraspIt!-style), so that only
+// approaching contacts stop a phalanx.
 //
-// Top grasps: the hand, palm down (HandModel::top_grasp_pose), starts above the object and
-// descends along -z by conservative advancement (speed bound 1) until any link is within the
+// Distances (sim/distance_bounds.hpp, sim/distance_queries.hpp). Cheap lower bounds replace
+// FCL queries when they exceed `box_skip`: the gap between the link's and the object's
+// axis-aligned boxes and the separating-axis bound over the object's 26-DOP; fingers whose
+// whole reach cannot touch the object only see the table (closed form). FCL geometry: the
+// object is a BVHModel<OBBRSS> (or RSS); by default each capsule is its axis as a sliver
+// triangle (FCL's analytic triangle-triangle distance, radius subtracted) and boxes are
+// 12-triangle meshes, which is faster than FCL's capsule/box primitives (GJK per triangle; see
+// BENCHMARKS.md). Query pruning (sim/query_pruning.hpp) skips the queries whose answer cannot
+// change the step or the contacts.
+//
+// Top grasps (sim/approach.hpp): the hand, palm down (HandModel::top_grasp_pose), starts above
+// the object and moves along -z by conservative advancement until any link is within the
 // tolerance of the object or the table; it is then raised by `standoff` and closed. With a
 // table, the palm is kept at least `table_clearance` above the deepest point the closing
-// fingers sweep (the coupled closing path, sampled every 0.5 deg): on an object lower than
-// the fingers are long, the fingers then wrap it near its base instead of striking the table
-// (a hand descending to the object's top would otherwise only ever grasp the table).
-//
-// Query pruning (SimOptions::prune_queries). Almost all the time goes to FCL distance queries,
-// and most of them only confirm that a link is not the one limiting the step. Every link keeps
-// a lower bound on its object distance, carried between steps (its last distance minus the
-// most it can have moved since). A step is the minimum over the links' terms; a link whose
-// bound already gives a term no smaller than the others' is not queried, and a link that is
-// queried gets a capped query (FCL searches only below the distance that would change the
-// minimum). Queries of links that may touch (bound below the tolerance) and final contact
-// queries (capped at the tolerance) are made as before. The steps, contact decisions and
-// contacts are therefore those of the unpruned algorithm, up to round-off.
+// fingers sweep, so that on an object lower than the fingers are long the fingers wrap it near
+// its base instead of striking the table. The approach step itself takes any direction.
 //
 // Thread safety: all queries are const and keep their state on the stack, so one simulator
 // can serve many threads (FCL's BVH model is only read by distance queries).
@@ -71,15 +63,14 @@ struct SimOptions {
   /// tessellated capsules circumscribing the real ones. Boolean checks always use primitives.
   enum class LinkGeometry { Segments, Primitives, Meshes };
   LinkGeometry links = LinkGeometry::Segments;
-  int max_iterations = 5000;  // per finger and per descent (a safety net; never hit in practice)
+  int max_iterations = 5000;  // per finger and per approach (a safety net), >= 1
   /// Top grasps with a table: minimum height of the fingers' closing sweep above the table (m);
   /// negative disables the rule (the hand then stops at the first contact).
   double table_clearance = 0.005;
   /// Skip FCL queries whose answer cannot change the result (same joint angles and contacts up
-  /// to round-off; see "Query pruning" in grasp_simulator.cpp): lower bounds carried between
-  /// advancement steps, and queries capped at the only distance that matters. false = one
-  /// query per link near the object and step, as before (for tests and benchmarks). Only
-  /// applies with rel_err = 0.
+  /// to round-off; see sim/query_pruning.hpp): lower bounds carried between advancement steps,
+  /// and queries capped at the only distance that matters. false = one query per link near the
+  /// object and step (for tests and benchmarks). Only applies with rel_err = 0.
   bool prune_queries = true;
 };
 
@@ -92,7 +83,7 @@ struct GraspResult {
   Iso3 hand_pose = Iso3::Identity();
   // statistics
   int distance_queries = 0;  // FCL distance calls
-  int iterations = 0;        // advancement steps (all fingers + descent)
+  int iterations = 0;        // advancement steps (all fingers + approach)
 };
 
 /// N results as flat arrays (row i = grasp i); contacts of grasp i are
@@ -109,9 +100,14 @@ struct GraspBatch {
   std::vector<int> distance_queries;        // N
 };
 
+namespace sim {
+struct SimScene;
+}
+
 class GraspSimulator {
  public:
-  /// `object` is in the world frame and static; throws std::invalid_argument for a bad mesh.
+  /// `object` is in the world frame and static; throws std::invalid_argument for a bad mesh
+  /// or an option out of range (naming it).
   GraspSimulator(const HandModel& hand, const TriMesh& object, const SimOptions& options = {});
   ~GraspSimulator();
   GraspSimulator(GraspSimulator&&) noexcept;
@@ -126,7 +122,7 @@ class GraspSimulator {
   GraspResult close(const Iso3& hand_pose, double spread) const;
 
   /// Palm-down approach at (x, y, yaw) along -z, stop `standoff` (>= 0, m) above the first
-  /// contact of any link, then close.
+  /// contact of any link (and the table clearance), then close.
   GraspResult top_grasp(double x, double y, double yaw, double spread, double standoff = 0.0) const;
 
   /// The same auto-grasp done GraspIt!-style: the actuator advances in fixed steps of `step`
@@ -134,7 +130,8 @@ class GraspSimulator {
   /// located by bisection to `contact_tolerance` of link travel. For comparison only.
   GraspResult close_fixed_step(const Iso3& hand_pose, double spread, double step = 0.01) const;
 
-  /// Batches; threads <= 0 means all hardware threads. Results in input order.
+  /// Batches in `threads` threads (0 = all cores, see common/parallel.hpp thread_count;
+  /// negative is an error). Results in input order, the same for any thread count.
   GraspBatch close_batch(const std::vector<Iso3>& poses, const std::vector<double>& spreads,
                          int threads = 1) const;
   /// xyyaw: N x 3 rows (x, y, yaw).
@@ -144,6 +141,9 @@ class GraspSimulator {
   /// Exact distance from link `link` at joint vector q (hand at hand_pose) to the object
   /// (ignores the table); negative if penetrating. For tests and diagnostics.
   double link_object_distance(const Iso3& hand_pose, const Eigen::VectorXd& q, int link) const;
+
+  /// The prepared geometry the steps in sim/*.hpp work on (for tests and new steps).
+  const sim::SimScene& scene() const;
 
   struct Impl;
 

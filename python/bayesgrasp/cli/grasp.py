@@ -29,7 +29,7 @@ def run(args) -> int:
     pose = floats(args.object_pose, 3, "--object-pose")
     # load_object names the problem (unknown name, missing file, not a mesh) in a ValueError
     world = World.single(args.object, pose=pose, keep_origin=args.keep_origin, hand=args.hand)
-    g = world.grasp(*top, spread=args.spread, lift=not args.no_lift)
+    g = world.grasp(*top, spread=args.spread, lift=not args.no_lift).to_dict()
     out = {
         "object": args.object, "object_pose": pose, "top": top, "hand": world.hand.name,
         "joint_angles": [float(v) for v in g["joint_angles"]],

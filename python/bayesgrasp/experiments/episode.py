@@ -74,13 +74,13 @@ def execute(world: World, models: GraspModels, action: np.ndarray, true_pose: np
     rel = relative_top_grasps(action, true_pose)[0, 0]
     by_lift = ctx.success == "lift"
     g = world.grasp_batch(rel[None, :], spread=models.spread, lift=by_lift)
-    eps = float(g["epsilon"][0])
+    eps = float(g.epsilon[0])
     stable = eps > models.settings.eps_stable
-    lifted = bool(g["lifted"][0]) if by_lift else None
+    lifted = bool(g.lifted[0]) if by_lift else None
     if not by_lift and ctx.lift and stable:
-        lifted = bool(world.grasp_batch(rel[None, :], spread=models.spread, lift=True)["lifted"][0])
+        lifted = bool(world.grasp_batch(rel[None, :], spread=models.spread, lift=True).lifted[0])
     return Execution(rel, eps, bool(stable), lifted, bool(lifted) if by_lift else bool(stable),
-                     bool(g["collision_at_start"][0]), np.asarray(g["joint_angles"][0], dtype=float))
+                     bool(g.collision_at_start[0]), np.asarray(g.joint_angles[0], dtype=float))
 
 
 def read_fingers(execution: Execution, models: GraspModels, noise: float, rng: np.random.Generator) -> np.ndarray:

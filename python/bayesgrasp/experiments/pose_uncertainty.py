@@ -103,7 +103,7 @@ def _reweighted(planner, models, world, pose, action):
     """Executes ``action`` at the true pose and reweights the planner's particles by the
     measurement likelihood (no resampling): (weight entropy, posterior-mean position error)."""
     rel = relative_top_grasps(action, pose)[0, 0]
-    q = np.asarray(world.grasp_batch(rel[None, :], spread=models.spread)["joint_angles"][0])
+    q = np.asarray(world.grasp_batch(rel[None, :], spread=models.spread).joint_angles[0])
     q = q[models.joint_index]
     P = planner.belief.particles
     lw = planner.belief.log_weights + models.log_likelihood(relative_planar_pose(np.asarray(action)[None, :], P), q)

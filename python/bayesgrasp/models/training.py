@@ -28,8 +28,8 @@ def simulate_training_data(world: World, settings: ModelSettings, seed_offset: i
     rel = random_relative_grasps(rng, n, settings.xy_range)
     spread = settings.spread if spread is None else spread
     b = world.grasp_batch(rel, spread=spread, threads=0)
-    ok = ~np.asarray(b["collision_at_start"], dtype=bool)
-    return rel[ok], np.asarray(b["joint_angles"])[ok], np.asarray(b["epsilon"])[ok]
+    ok = ~np.asarray(b.collision_at_start, dtype=bool)
+    return rel[ok], np.asarray(b.joint_angles)[ok], np.asarray(b.epsilon)[ok]
 
 
 def lift_outcomes(world: World, rel: np.ndarray, spread: float) -> np.ndarray:
@@ -37,11 +37,11 @@ def lift_outcomes(world: World, rel: np.ndarray, spread: float) -> np.ndarray:
     the object cannot hold it and is not simulated."""
     rel = np.atleast_2d(np.asarray(rel, dtype=float))
     b = world.grasp_batch(rel, spread=spread, threads=0)
-    touches = np.asarray(b["link_contact"], dtype=bool).any(axis=1) & ~np.asarray(b["collision_at_start"], bool)
+    touches = np.asarray(b.link_contact, dtype=bool).any(axis=1) & ~np.asarray(b.collision_at_start, bool)
     lifted = np.zeros(len(rel), dtype=bool)
     idx = np.flatnonzero(touches)
     if len(idx):
-        lifted[idx] = np.asarray(world.grasp_batch(rel[idx], spread=spread, lift=True, threads=0)["lifted"], bool)
+        lifted[idx] = np.asarray(world.grasp_batch(rel[idx], spread=spread, lift=True, threads=0).lifted, bool)
     return lifted
 
 
@@ -66,15 +66,15 @@ def choose_spread(world: World, settings: ModelSettings, say=lambda m: None) -> 
     table, scores = {}, []
     for sp in AUTO_SPREADS:
         b = world.grasp_batch(rel, spread=sp, threads=0)
-        free = ~np.asarray(b["collision_at_start"], dtype=bool)
+        free = ~np.asarray(b.collision_at_start, dtype=bool)
         if settings.success == "lift":
-            ok = free & np.asarray(b["link_contact"], dtype=bool).any(axis=1)
+            ok = free & np.asarray(b.link_contact, dtype=bool).any(axis=1)
             what = "touch the object"
         else:
-            ok = free & (np.asarray(b["epsilon"]) > settings.eps_stable)
+            ok = free & (np.asarray(b.epsilon) > settings.eps_stable)
             what = "stable"
         idx = np.flatnonzero(ok)[:settings.n_pilot_lifts]
-        lifted = int(np.sum(world.grasp_batch(rel[idx], spread=sp, lift=True, threads=0)["lifted"])) if len(idx) else 0
+        lifted = int(np.sum(world.grasp_batch(rel[idx], spread=sp, lift=True, threads=0).lifted)) if len(idx) else 0
         frac = float(np.mean(ok))
         table[round(float(np.degrees(sp)))] = (frac, lifted, int(len(idx)))
         scores.append((frac * (lifted / len(idx) if len(idx) else 0.0), frac))

@@ -1,0 +1,55 @@
+#include "bayesgrasp/physics/bullet_world.hpp"
+
+namespace bayesgrasp::physics {
+
+BulletWorld::BulletWorld(const LiftOptions& o)
+    : config_(separated_pair_skip_config()),
+      skip_funcs_(o.skip_separated_pairs ? make_skip_funcs() : SkipFuncs{}) {
+  world_.setGravity(btVector3(0, 0, btScalar(-9.81)));
+  world_.getSolverInfo().m_numIterations = o.solver_iterations;
+  world_.getSolverInfo().m_solverMode |= SOLVER_USE_2_FRICTION_DIRECTIONS;
+}
+
+BulletWorld::~BulletWorld() {
+  for (auto& c : constraints_) world_.removeConstraint(c.get());
+  for (auto& b : bodies_) world_.removeRigidBody(b.get());
+}
+
+// The hand's shapes (capsules, boxes) against the object's convex shapes go through
+// SeparatedPairSkip.
+BulletWorld::SkipFuncs BulletWorld::make_skip_funcs() {
+  SkipFuncs fs;
+  for (int h : {CAPSULE_SHAPE_PROXYTYPE, BOX_SHAPE_PROXYTYPE})
+    for (int o : {CONVEX_HULL_SHAPE_PROXYTYPE, TETRAHEDRAL_SHAPE_PROXYTYPE})
+      for (int swap = 0; swap < 2; ++swap) {
+        const int t0 = swap ? o : h, t1 = swap ? h : o;
+        fs.emplace_back(new SeparatedPairSkip::CreateFunc(config_.getCollisionAlgorithmCreateFunc(t0, t1), &skipped_));
+        dispatcher_.registerCollisionCreateFunc(t0, t1, fs.back().get());
+      }
+  return fs;
+}
+
+btCollisionShape* BulletWorld::keep(btCollisionShape* s) {
+  shapes_.emplace_back(s);
+  return s;
+}
+
+btRigidBody* BulletWorld::add_body(btCollisionShape* shape, double mass, const btVector3& inertia, const btTransform& T,
+                                   int group, int mask, double friction) {
+  states_.emplace_back(new btDefaultMotionState(T));
+  btRigidBody::btRigidBodyConstructionInfo info(btScalar(mass), states_.back().get(), shape, inertia);
+  info.m_friction = btScalar(friction);
+  info.m_restitution = 0;
+  bodies_.emplace_back(new btRigidBody(info));
+  btRigidBody* body = bodies_.back().get();
+  body->setActivationState(DISABLE_DEACTIVATION);
+  world_.addRigidBody(body, group, mask);
+  return body;
+}
+
+void BulletWorld::add_constraint(btTypedConstraint* c) {
+  constraints_.emplace_back(c);
+  world_.addConstraint(c, true);
+}
+
+}  // namespace bayesgrasp::physics

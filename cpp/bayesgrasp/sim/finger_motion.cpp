@@ -1,0 +1,48 @@
+#include "bayesgrasp/sim/finger_motion.hpp"
+
+#include <algorithm>
+#include <stdexcept>
+#include <string>
+
+namespace bayesgrasp::sim {
+
+std::vector<FingerMotion> make_finger_motion(const HandModel& hand, const LinkShapes& links) {
+  std::vector<FingerMotion> out(hand.fingers().size());
+  for (size_t f = 0; f < hand.fingers().size(); ++f) {
+    const Finger& F = hand.fingers()[f];
+    const int n = static_cast<int>(F.phalanges.size());
+    if (n > kMaxPhalanges)
+      throw std::invalid_argument("hand: at most " + std::to_string(kMaxPhalanges) + " phalanges per finger");
+    FingerMotion& m = out[f];
+    m.arm.assign(n, std::vector<double>(n, 0.0));
+    for (int i = 0; i < n; ++i) {
+      double along = 0.0;
+      for (int j = i; j < n; ++j) {
+        m.arm[i][j] = along + link_reach(links[F.phalanges[j].link]);
+        along += F.phalanges[j].length;
+      }
+      m.reach = std::max(m.reach, m.arm[0][i]);
+    }
+  }
+  return out;
+}
+
+int moving_phalanges(const Finger& F, const bool* frozen, const double* angles, bool* moving) {
+  const int n = static_cast<int>(F.phalanges.size());
+  int first = n;
+  for (int i = 0; i < n; ++i) {
+    const Phalanx& P = F.phalanges[i];
+    moving[i] = !frozen[i] && P.ratio > 0 && angles[i] < P.upper;
+    if (moving[i] && first == n) first = i;
+  }
+  return first;
+}
+
+double link_speed(const Finger& F, const FingerMotion& motion, const bool* moving, int first, int j) {
+  double v = 0.0;
+  for (int i = first; i <= j; ++i)
+    if (moving[i]) v += F.phalanges[i].ratio * motion.arm[i][j];
+  return v;
+}
+
+}  // namespace bayesgrasp::sim
