@@ -169,6 +169,17 @@ offset_j + ratio_j * t, clamped to its limits (the coupling), with breakaway.)do
           },
           py::arg("x"), py::arg("y"), py::arg("yaw"), py::arg("z"),
           "4x4 world pose of a palm-down hand at (x, y, yaw) with its palm face at height z.")
+      .def_static(
+          "approach_pose",
+          [](const DArray& direction, double roll, const DArray& palm) {
+            return to_numpy(HandModel::approach_pose(vec3(direction, "direction"), roll, vec3(palm, "palm")));
+          },
+          py::arg("direction"), py::arg("roll"), py::arg("palm"),
+          R"doc(4x4 world pose of a hand approaching along `direction` (its +z, normalised) with
+`roll`, palm centre at `palm`. Roll: the palm-down top-grasp hand at yaw = roll tilted by the
+smallest rotation taking world -z onto the direction (a right-handed turn about -direction;
+for direction -z exactly top_grasp_pose; for +z the tilt is a half turn about world x).
+ValueError naming `direction` (zero or not finite), `roll` or `palm`.)doc")
       .def("__repr__", [](const HandModel& h) {
         return "<Hand '" + h.name() + "': " + std::to_string(h.fingers().size()) + " fingers, " +
                std::to_string(h.num_joints()) + " joints>";

@@ -70,6 +70,9 @@ consumes. Read-only views of the result they belong to.)doc")
                              "within the tolerance).")
       .def_property_readonly("on_table", column(&Contact::on_table),
                              "on_table : numpy.ndarray (K,) bool\n    The contact is with the table, not the object.")
+      .def_property_readonly("triangle", column(&Contact::triangle),
+                             "triangle : numpy.ndarray (K,) int32\n    Index of the object's triangle nearest to the "
+                             "link (a row of the simulator's faces; -1 for the table).")
       .def("__len__", [](const ContactArrays& c) { return c.count; });
 
   py::class_<BatchContactArrays, ContactArrays>(m, "BatchContacts", R"doc(The contacts of a batch of grasps,
@@ -159,9 +162,13 @@ void bind_result(py::module_& m) {
       .def_readonly("collision_at_start", &R::collision_at_start,
                     "collision_at_start : bool\n    The open hand penetrated the object or the table (the fingers "
                     "then stay open and there are no contacts).")
+      .def_readonly("stopped_by_table", &R::stopped_by_table,
+                    "stopped_by_table : bool\n    The approach stopped on the table without touching the object "
+                    "(False for closing at a given pose).")
       .def_property_readonly(
           "hand_pose", [](const py::object& self) { return pose_view(self.cast<const R&>().hand_pose, self); },
-          "hand_pose : numpy.ndarray (4, 4) float\n    World pose of the hand (where a top grasp stopped).")
+          "hand_pose : numpy.ndarray (4, 4) float\n    World pose of the hand while closing (where an approach "
+          "stopped, after the stand-off).")
       .def_readonly("distance_queries", &R::distance_queries, "distance_queries : int\n    FCL distance calls spent.")
       .def_readonly("iterations", &R::iterations, "iterations : int\n    Advancement steps (fingers and approach).")
       .def_property_readonly(
@@ -219,12 +226,18 @@ void bind_batch(py::module_& m) {
           [](const py::object& self) { return flags_view(self.cast<const B&>().collision_at_start, self); },
           "collision_at_start : numpy.ndarray (N,) bool\n    The open hand penetrated the object or the table.")
       .def_property_readonly(
+          "stopped_by_table",
+          [](const py::object& self) { return flags_view(self.cast<const B&>().stopped_by_table, self); },
+          "stopped_by_table : numpy.ndarray (N,) bool\n    The approach stopped on the table without touching "
+          "the object.")
+      .def_property_readonly(
           "hand_pose",
           [](const py::object& self) {
             const B& b = self.cast<const B&>();
             return poses_view(b.hand_poses.data(), b.hand_poses.size(), self);
           },
-          "hand_pose : numpy.ndarray (N, 4, 4) float\n    World poses of the hand (where the top grasps stopped).")
+          "hand_pose : numpy.ndarray (N, 4, 4) float\n    World poses of the hand while closing (where the "
+          "approaches stopped, after the stand-off).")
       .def_property_readonly(
           "distance_queries",
           [](const py::object& self) {
@@ -234,6 +247,71 @@ void bind_batch(py::module_& m) {
           },
           "distance_queries : numpy.ndarray (N,) int32\n    FCL distance calls per grasp.")
       .def("__len__", [](const B& b) { return b.num_grasps; });
+}
+
+/// A number or an (N,) array as N values (`name` in errors).
+std::vector<double> values(const py::object& x, const char* name, size_t n) {
+  if (py::isinstance<py::float_>(x) || py::isinstance<py::int_>(x)) return std::vector<double>(n, x.cast<double>());
+  const Eigen::VectorXd v = vector(x.cast<DArray>(), name);
+  if (static_cast<size_t>(v.size()) != n)
+    throw py::value_error(std::string(name) + ": need a number or one per approach (" + std::to_string(n) + "), got " +
+                          std::to_string(v.size()));
+  return std::vector<double>(v.data(), v.data() + v.size());
+}
+
+/// N approaches from (N, 3) directions and targets and N rolls (not checked: the core checks them).
+std::vector<ApproachSpec> approaches(const DArray& directions, const DArray& targets, const py::object& rolls) {
+  const auto rows = [](const DArray& a, const char* name) {
+    if (a.ndim() != 2 || a.shape(1) != 3)
+      throw py::value_error(std::string(name) + ": expected shape (N, 3), got " + shape_str(a));
+    return Eigen::Map<const RowMatrixXd>(a.data(), a.shape(0), 3);
+  };
+  const auto D = rows(directions, "directions");
+  const auto P = rows(targets, "targets");
+  if (P.rows() != D.rows())
+    throw py::value_error("targets: need one per direction (" + std::to_string(D.rows()) + "), got " +
+                          std::to_string(P.rows()));
+  const std::vector<double> R = values(rolls, "rolls", static_cast<size_t>(D.rows()));
+  std::vector<ApproachSpec> out(static_cast<size_t>(D.rows()));
+  for (size_t i = 0; i < out.size(); ++i) out[i] = {D.row(i).transpose(), R[i], P.row(i).transpose()};
+  return out;
+}
+
+/// The approach calls (GIL released).
+void def_approaches(py::class_<GraspSimulator>& sim) {
+  sim.def(
+         "approach",
+         [](const GraspSimulator& s, const DArray& direction, const DArray& target, double roll, double spread,
+            double standoff) {
+           const ApproachSpec a{vec3(direction, "direction"), roll, vec3(target, "target")};
+           py::gil_scoped_release release;
+           return s.approach(a, spread, standoff);
+         },
+         py::arg("direction"), py::arg("target"), py::arg("roll"), py::arg("spread"), py::arg("standoff") = 0.0,
+         R"doc(Approach, then auto-grasp (world frame; a GraspResult).
+
+The open hand, oriented by `direction` (its +z; normalised) and `roll` (rad, right-handed
+about -direction: the palm-down top-grasp hand at yaw = roll tilted by the smallest rotation
+taking -z onto the direction; see Hand.approach_pose), starts on the line through `target`
+along the direction, clear of the object and the table, moves along it until a link is
+within the contact tolerance of the object or of the table (when moving down onto it), backs
+off by `standoff` (m) and closes. stopped_by_table says the table stopped it;
+collision_at_start that the open hand started in the table (no grasp). ValueError naming
+`direction` (zero or not finite), `roll`, `target` (not finite, below the table), `spread`,
+`standoff`.)doc")
+      .def(
+          "approach_batch",
+          [](const GraspSimulator& s, const DArray& directions, const DArray& targets, const py::object& rolls,
+             double spread, double standoff, int threads) {
+            const std::vector<ApproachSpec> a = approaches(directions, targets, rolls);
+            py::gil_scoped_release release;
+            return s.approach_batch(a, spread, standoff, threads);
+          },
+          py::arg("directions"), py::arg("targets"), py::arg("rolls"), py::arg("spread"),
+          py::arg("standoff") = 0.0, py::arg("threads") = 1,
+          R"doc(N approaches: directions and targets (N, 3), rolls a number or (N,), in `threads` C++
+threads (0 = all cores), without the GIL; a GraspBatch (errors name the entry, e.g.
+`directions[2]`).)doc");
 }
 
 /// The batch calls (GIL released; threads: 0 = all cores).
@@ -325,6 +403,7 @@ where the hand stopped.)doc")
           py::arg("hand_pose"), py::arg("q"), py::arg("link"),
           "Exact distance (m) from one link to the object (not the table); <= 0 when penetrating.");
   def_batches(sim);
+  def_approaches(sim);
 }
 
 }  // namespace bayesgrasp::bind

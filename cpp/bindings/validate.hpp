@@ -49,6 +49,13 @@ inline Eigen::VectorXd vector(const DArray& a, const char* name, py::ssize_t n =
   return v;
 }
 
+/// A 3-vector from a (3,) float array (shape checked; the core checks the values).
+inline Vec3 vec3(const DArray& a, const char* name) {
+  if (a.ndim() != 1 || a.shape(0) != 3)
+    throw py::value_error(std::string(name) + ": expected shape (3,), got " + shape_str(a));
+  return Vec3(a.data()[0], a.data()[1], a.data()[2]);
+}
+
 inline double finite(double x, const char* name) {
   if (!std::isfinite(x)) throw py::value_error(std::string(name) + ": must be finite, got " + std::to_string(x));
   return x;

@@ -128,6 +128,16 @@ class Hand:
         """4x4 pose of a palm-down hand at (x, y, yaw), palm face at height z."""
         return _core.hand.Hand.top_grasp_pose(float(x), float(y), float(yaw), float(z))
 
+    @staticmethod
+    def approach_pose(direction, roll: float, palm) -> np.ndarray:
+        """4x4 pose of a hand approaching along ``direction`` (its +z; normalised) with ``roll``,
+        palm centre at ``palm``. Roll convention: the palm-down top-grasp hand at yaw = roll,
+        tilted by the smallest rotation taking world -z onto the direction (a right-handed turn
+        about -direction); ``approach_pose((0, 0, -1), yaw, (x, y, z)) == top_grasp_pose(x, y,
+        yaw, z)``. For direction +z the tilt is a half turn about world x."""
+        return _core.hand.Hand.approach_pose(np.asarray(direction, dtype=float), float(roll),
+                                             np.asarray(palm, dtype=float))
+
     def link_shapes(self) -> list:
         """Per link, its collision shapes (``_core.hand.Shape``: type, center, half_extents, p0,
         p1, radius) in the link frame."""

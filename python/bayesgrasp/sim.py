@@ -3,19 +3,25 @@
 Fingers close from the open preshape by conservative advancement with FCL distance queries;
 each phalanx stops within ``contact_tolerance`` (0.2 mm) of the object or the table, with
 breakaway (a stopped phalanx freezes itself and the earlier phalanges of its finger; the later
-ones keep closing). Top grasps approach palm-down along -z until the first contact of any
-link, rise by ``standoff`` (default 0) and close::
+ones keep closing). An approach moves the open hand along a direction (its +z) on the line
+through a target point, from clear of the object and the table, until the first contact of any
+link with the object or with the table (when moving down onto it), backs off by ``standoff``
+(default 0) along the direction and closes; the roll turns the hand about -direction
+(:meth:`Hand.approach_pose`). Top grasps are the approach along -z with roll = yaw::
 
     hand = Hand.load("barrett_bh8")
     sim = GraspSimulator(hand, vertices, faces)            # table at z = 0 by default
     g = sim.top_grasp(0.0, 0.0, 0.3, spread=np.pi / 2)      # -> GraspResult
     b = sim.top_grasp_batch(xyyaw, spread=0.5, threads=0)  # -> GraspBatch (N rows)
+    s = sim.approach([1, 0, 0], [0, 0, 0.05], roll=0.0)     # a side grasp
+    a = sim.approach_batch(directions, targets, rolls, threads=0)
 
 Results are the core's classes (:class:`GraspResult`, :class:`GraspBatch`); their array fields
 are read-only numpy views: ``joint_angles``, ``link_contact`` / ``table_contact``,
-``collision_at_start``, ``hand_pose``, ``distance_queries`` and ``contacts`` with
-``point``/``normal`` (K, 3), ``link``, ``penetration``, ``on_table`` (and, for batches, ``grasp``
-(K,) and ``offsets`` (N + 1,)). Normals are the object's outward surface normals (+z for the
+``collision_at_start``, ``stopped_by_table``, ``hand_pose``, ``distance_queries`` and
+``contacts`` with ``point``/``normal`` (K, 3), ``link``, ``penetration``, ``on_table``,
+``triangle`` (the object's triangle, -1 for the table) (and, for batches, ``grasp`` (K,) and
+``offsets`` (N + 1,)). Normals are the object's outward surface normals (+z for the
 table): what :mod:`bayesgrasp.quality` consumes. Options are a :class:`SimOptions`.
 """
 from __future__ import annotations
@@ -122,6 +128,21 @@ class GraspSimulator:
         """Top grasps at the rows (x, y, yaw) of an (N, 3) array."""
         return self.core.top_grasp_batch(np.asarray(xyyaw, dtype=float), self._spread(spread), float(standoff),
                                          int(threads))
+
+    def approach(self, direction, target, roll: float = 0.0, spread: float | None = None,
+                 standoff: float = 0.0) -> GraspResult:
+        """Approach along ``direction`` (3,) on the line through ``target`` (3,) with ``roll``
+        (world frame; see :meth:`bayesgrasp.hand.Hand.approach_pose`), stop at the first contact
+        with the object or the table, back off by ``standoff`` (m) along the direction, close."""
+        return self.core.approach(np.asarray(direction, dtype=float), np.asarray(target, dtype=float), float(roll),
+                                  self._spread(spread), float(standoff))
+
+    def approach_batch(self, directions, targets, rolls=0.0, spread: float | None = None, standoff: float = 0.0,
+                       threads: int = 1) -> GraspBatch:
+        """N approaches: directions and targets (N, 3), rolls a number or (N,)."""
+        rolls = float(rolls) if np.isscalar(rolls) else np.asarray(rolls, dtype=float)
+        return self.core.approach_batch(np.asarray(directions, dtype=float), np.asarray(targets, dtype=float), rolls,
+                                        self._spread(spread), float(standoff), int(threads))
 
     def link_object_distance(self, hand_pose, q, link: int) -> float:
         """Exact distance from one link to the object (m), <= 0 when penetrating."""

@@ -1,31 +1,53 @@
 """The robot's world: a hand, a table-top scene, the contact simulator, grasp quality and the
 lift test, in one object.
 
-A top grasp is given relative to the object frame (see :mod:`bayesgrasp.objects.scene`): the
-hand, palm down, at (x, y) in the object frame with yaw relative to the object's yaw, descends
-along -z to the first contact and closes::
+Grasps are given in the object frame (see :mod:`bayesgrasp.objects.scene`) unless
+``frame="world"``. Three kinds:
+
+* top grasps (x, y, yaw): the hand, palm down at (x, y) with yaw relative to the object's yaw,
+  descends along -z to the first contact and closes;
+* approaches (direction, target, roll): the open hand moves along the direction (its +z) on the
+  line through the target until the first contact with the object or the table, backs off by
+  the stand-off along the direction and closes. Roll is a right-handed turn about -direction:
+  the palm-down top-grasp hand at yaw = roll, tilted by the smallest rotation taking -z onto the
+  direction (:meth:`bayesgrasp.hand.Hand.approach_pose`); the top grasp at (x, y, yaw) is the
+  approach along -z with roll = yaw through (x, y, any z);
+* hand poses (4x4): the hand closes where it is.
+
+::
 
     world = World.single("mug", pose=(0.1, 0.0, 0.3))
-    g = world.grasp(0.0, 0.0, 0.0)                # one grasp: a WorldGrasp (joints, contacts, epsilon, ...)
-    b = world.grasp_batch(xyyaw, threads=0)       # N grasps: a WorldGraspBatch of arrays
+    g = world.grasp(0.0, 0.0, 0.0)                         # a WorldGrasp (joints, contacts, epsilon, ...)
+    b = world.grasp_batch(xyyaw, threads=0)                # N top grasps: a WorldGraspBatch of arrays
+    s = world.approach([1, 0, 0], [0, 0, 0.05], roll=0.0)  # a side grasp
+    a = world.approach_batch(directions, targets, rolls)   # N approaches
+    p = world.grasp_poses(hand_poses)                      # N 4x4 hand poses
+
+Bad input is a ValueError naming the argument: a direction of zero length or not finite, a
+target below the table or off the table (its (x, y) outside the scene's table grown by
+TABLE_MARGIN on every side), a 4x4 that is not a rigid transform. A hand that starts in the table
+or the object is reported (``collision_at_start``), not an error.
 
 Pictures of a grasp are in :mod:`bayesgrasp.viz` (``viz.plot_grasp(world, g, path)``).
 """
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import List, Optional, Sequence, Union
+from typing import List, Optional, Sequence, Tuple, Union
 
 import numpy as np
 
 from . import physics, quality
 from .hand import Hand
 from .objects import ObjectModel, Scene
+from .objects.scene import planar_pose_matrix
 from .sim import GraspSimulator
 
-__all__ = ["World", "WorldGrasp", "WorldGraspBatch", "ContactRecord", "DEFAULT_FRICTION"]
+__all__ = ["World", "WorldGrasp", "WorldGraspBatch", "ContactRecord", "DEFAULT_FRICTION", "TABLE_MARGIN", "FRAMES"]
 
 DEFAULT_FRICTION = quality.DEFAULT_FRICTION
+TABLE_MARGIN = 0.25  # m: approach targets may lie this far outside the table's rectangle
+FRAMES = ("object", "world")
 
 
 @dataclass(frozen=True)
@@ -38,47 +60,63 @@ class ContactRecord:
     link_name: str
     penetration: float     # >= 0 (m)
     on_table: bool
+    triangle: int = -1             # the object's triangle (row of its faces); -1 for the table
+    part: Optional[str] = None     # the triangle's part name, when the object has part labels
 
     def to_dict(self) -> dict:
         return {"point": self.point, "normal": self.normal, "link": self.link, "link_name": self.link_name,
-                "penetration": self.penetration, "on_table": self.on_table}
+                "penetration": self.penetration, "on_table": self.on_table, "triangle": self.triangle,
+                "part": self.part}
 
 
 @dataclass(frozen=True)
 class WorldGrasp:
-    """One grasp tried in a :class:`World` (see :meth:`World.grasp`)."""
+    """One grasp tried in a :class:`World` (see :meth:`World.grasp`, :meth:`World.approach`,
+    :meth:`World.grasp_pose`)."""
 
     joint_angles: np.ndarray          # (J,) closed joint angles (rad)
     contacts: List[ContactRecord]
     epsilon: float                    # GWS epsilon on the object contacts (0 when collision_at_start)
     volume: float                     # GWS volume
     collision_at_start: bool          # the open hand started in collision (no grasp)
-    hand_pose: np.ndarray             # (4, 4) world pose where the hand stopped
+    hand_pose: np.ndarray             # (4, 4) world pose of the hand while closing
     lifted: Optional[bool] = None     # lift-test verdict (None unless lifted)
     lift_displacement: Optional[float] = None  # m, the lift test's displacement
+    stopped_by_table: bool = False    # the approach stopped on the table without touching the object
+    hand_pose_object: Optional[np.ndarray] = None  # (4, 4) the same pose in the object frame
+    joint_names: Tuple[str, ...] = ()  # names of the entries of joint_angles
 
     def to_dict(self) -> dict:
         """The grasp as a dict of these fields (contacts as dicts)."""
         return {"joint_angles": self.joint_angles, "contacts": [c.to_dict() for c in self.contacts],
                 "epsilon": self.epsilon, "volume": self.volume, "collision_at_start": self.collision_at_start,
-                "hand_pose": self.hand_pose, "lifted": self.lifted, "lift_displacement": self.lift_displacement}
+                "hand_pose": self.hand_pose, "lifted": self.lifted, "lift_displacement": self.lift_displacement,
+                "stopped_by_table": self.stopped_by_table, "hand_pose_object": self.hand_pose_object,
+                "joint_names": list(self.joint_names)}
 
 
 @dataclass(frozen=True)
 class WorldGraspBatch:
-    """N grasps tried in a :class:`World` (see :meth:`World.grasp_batch`); row i = grasp i."""
+    """N grasps tried in a :class:`World` (see :meth:`World.grasp_batch`,
+    :meth:`World.approach_batch`, :meth:`World.grasp_poses`); row i = grasp i."""
 
     joint_angles: np.ndarray        # (N, J)
-    contacts: object                # sim BatchContacts: point, normal, link, penetration, on_table, grasp, offsets
+    contacts: object                # sim BatchContacts: point, normal, link, penetration, on_table, triangle,
+                                    # grasp, offsets
     epsilon: np.ndarray             # (N,) GWS epsilon (0 when collision_at_start)
     volume: np.ndarray              # (N,) GWS volume
     collision_at_start: np.ndarray  # (N,) bool
-    hand_pose: np.ndarray           # (N, 4, 4)
+    hand_pose: np.ndarray           # (N, 4, 4) world poses of the hand while closing
     link_contact: np.ndarray        # (N, L) bool
     table_contact: np.ndarray       # (N, L) bool
     distance_queries: np.ndarray    # (N,) FCL distance calls
     lifted: Optional[np.ndarray] = None             # (N,) bool when lift-tested, else None
     lift_displacement: Optional[np.ndarray] = None  # (N,) m when lift-tested, else None
+    stopped_by_table: Optional[np.ndarray] = None   # (N,) bool
+    hand_pose_object: Optional[np.ndarray] = None   # (N, 4, 4) the hand poses in the object frame
+    joint_names: Tuple[str, ...] = ()               # names of the columns of joint_angles
+    contact_part: Optional[np.ndarray] = None       # (K,) part name per contact (None on the table), or
+                                                    # None when the object has no part labels
 
     def __len__(self) -> int:
         return len(self.epsilon)
@@ -136,6 +174,16 @@ class World:
     def object(self) -> ObjectModel:
         return self.scene.canonical_object(self.object_index)
 
+    def _planar(self, frame: str) -> Tuple[float, float, float]:
+        """(x, y, yaw) of the grasp frame in the world: the object's planar pose or the world's."""
+        if frame not in FRAMES:
+            raise ValueError(f"frame: must be one of {', '.join(FRAMES)}, got {frame!r}")
+        return self.scene.planar_pose(self.object_index) if frame == "object" else (0.0, 0.0, 0.0)
+
+    def _frame_pose(self, frame: str) -> np.ndarray:
+        """4x4 transform from the grasp frame to the world."""
+        return planar_pose_matrix(*self._planar(frame))
+
     def to_world(self, xyyaw) -> np.ndarray:
         """(N, 3) top grasps (x, y, yaw) in the object frame -> world frame."""
         g = np.atleast_2d(np.asarray(xyyaw, dtype=float))
@@ -144,27 +192,36 @@ class World:
         if not np.all(np.isfinite(g)):
             raise ValueError("grasps: contain NaN or infinity")
         ox, oy, oyaw = self.scene.planar_pose(self.object_index)
-        c, s = np.cos(oyaw), np.sin(oyaw)
         out = np.empty_like(g)
-        out[:, 0] = ox + c * g[:, 0] - s * g[:, 1]
-        out[:, 1] = oy + s * g[:, 0] + c * g[:, 1]
+        out[:, :2] = _turn_xy(g[:, :2], oyaw, ox, oy)
         out[:, 2] = g[:, 2] + oyaw
         return out
+
+    def _approaches_to_world(self, directions, targets, rolls, frame: str, names: Tuple[str, str]):
+        """(N, 3) directions and targets and (N,) rolls (a number or (N,)) in `frame` -> world;
+        the targets' (x, y) must lie on the table grown by TABLE_MARGIN (`names` in errors)."""
+        D, P = (_rows3(a, n) for a, n in zip((directions, targets), names))
+        if len(P) != len(D):
+            raise ValueError(f"{names[1]}: need one per direction ({len(D)}), got {len(P)}")
+        ox, oy, oyaw = self._planar(frame)
+        Dw, Pw = np.empty_like(D), np.empty_like(P)
+        Dw[:, :2], Dw[:, 2] = _turn_xy(D[:, :2], oyaw), D[:, 2]
+        Pw[:, :2], Pw[:, 2] = _turn_xy(P[:, :2], oyaw, ox, oy), P[:, 2]
+        hx, hy = self.scene.table_size[0] / 2 + TABLE_MARGIN, self.scene.table_size[1] / 2 + TABLE_MARGIN
+        off = np.flatnonzero((np.abs(Pw[:, 0]) > hx) | (np.abs(Pw[:, 1]) > hy))
+        if len(off):
+            i = int(off[0])
+            where = names[1] if names[1] == "target" else f"{names[1]}[{i}]"
+            raise ValueError(f"{where}: off the table: world (x, y) = ({Pw[i, 0]:.3f}, {Pw[i, 1]:.3f}) m is outside "
+                             f"[-{hx:g}, {hx:g}] x [-{hy:g}, {hy:g}] (the table grown by {TABLE_MARGIN} m)")
+        r = np.asarray(rolls, dtype=float)
+        return Dw, Pw, (float(r) + oyaw if r.ndim == 0 else r + oyaw)
 
     # ---- grasps -------------------------------------------------------------------------
     def grasp(self, x: float, y: float, yaw: float, spread: Optional[float] = None,
               lift: bool = False) -> WorldGrasp:
         """One top grasp at (x, y, yaw) in the object frame: simulate, score, optionally lift."""
-        b = self.grasp_batch([[x, y, yaw]], spread=spread, lift=lift)
-        names = self.hand.core.link_names
-        c = b.contacts
-        contacts = [ContactRecord(c.point[k].tolist(), c.normal[k].tolist(), int(c.link[k]), names[int(c.link[k])],
-                                  float(c.penetration[k]), bool(c.on_table[k]))
-                    for k in range(len(c.link))]
-        return WorldGrasp(b.joint_angles[0], contacts, float(b.epsilon[0]), float(b.volume[0]),
-                          bool(b.collision_at_start[0]), b.hand_pose[0],
-                          None if b.lifted is None else bool(b.lifted[0]),
-                          None if b.lifted is None else float(b.lift_displacement[0]))
+        return self._one(self.grasp_batch([[x, y, yaw]], spread=spread, lift=lift))
 
     def grasp_batch(self, xyyaw, spread: Optional[float] = None, lift: bool = False,
                     threads: int = 0) -> WorldGraspBatch:
@@ -172,11 +229,65 @@ class World:
         simulator's batch plus ``epsilon`` and ``volume`` (0 when the hand started in
         collision), and ``lifted`` / ``lift_displacement`` when ``lift`` is set (else None)."""
         world = self.to_world(xyyaw)
-        spread = self.spread if spread is None else float(spread)
-        b = self.sim.top_grasp_batch(world, spread=spread, standoff=self.standoff, threads=threads)
-        c = b.contacts
-        on_obj = ~c.on_table
-        counts = np.diff(c.offsets)
+        b = self.sim.top_grasp_batch(world, spread=self._spread(spread), standoff=self.standoff, threads=threads)
+        return self._score(b, b.contacts, np.diff(b.contacts.offsets), lift, threads)
+
+    def approach(self, direction, target, roll: float = 0.0, spread: Optional[float] = None,
+                 standoff: Optional[float] = None, frame: str = "object", lift: bool = False) -> WorldGrasp:
+        """One approach (see the module docs) in ``frame`` ('object' or 'world'): the hand moves
+        along ``direction`` (3,) on the line through ``target`` (3,) with ``roll`` (rad), backs
+        off by ``standoff`` (default: the world's) and closes; scored and optionally lifted."""
+        if np.ndim(roll) != 0:
+            raise ValueError(f"roll: expected a number, got shape {np.shape(roll)}")
+        D, P, r = self._approaches_to_world(_vec3(direction, "direction"), _vec3(target, "target"), roll, frame,
+                                            ("direction", "target"))
+        g = self.sim.approach(D[0], P[0], r, spread=self._spread(spread), standoff=self._standoff(standoff))
+        return self._one(self._score(_BatchOfOne(g), g.contacts, [g.num_contacts], lift, 1))
+
+    def approach_batch(self, directions, targets, rolls=0.0, spread: Optional[float] = None,
+                       standoff: Optional[float] = None, frame: str = "object", lift: bool = False,
+                       threads: int = 0) -> WorldGraspBatch:
+        """N approaches: ``directions`` and ``targets`` (N, 3), ``rolls`` a number or (N,), in
+        ``frame``, in C++ threads; a WorldGraspBatch (errors name the entry, e.g. ``directions[2]``)."""
+        D, P, r = self._approaches_to_world(directions, targets, rolls, frame, ("directions", "targets"))
+        b = self.sim.approach_batch(D, P, r, spread=self._spread(spread), standoff=self._standoff(standoff),
+                                    threads=threads)
+        return self._score(b, b.contacts, np.diff(b.contacts.offsets), lift, threads)
+
+    def grasp_pose(self, hand_pose, spread: Optional[float] = None, frame: str = "object",
+                   lift: bool = False) -> WorldGrasp:
+        """The hand closed at one 4x4 ``hand_pose`` in ``frame`` (no approach); a start in
+        collision is reported (``collision_at_start``); a pose that is not a rigid transform is a
+        ValueError naming ``hand_pose``."""
+        H = np.asarray(hand_pose, dtype=float)
+        if H.shape != (4, 4):
+            raise ValueError(f"hand_pose: expected shape (4, 4), got {H.shape}")
+        g = self.sim.close(self._frame_pose(frame) @ H, self._spread(spread))
+        return self._one(self._score(_BatchOfOne(g), g.contacts, [g.num_contacts], lift, 1))
+
+    def grasp_poses(self, hand_poses, spread: Optional[float] = None, frame: str = "object",
+                    lift: bool = False, threads: int = 0) -> WorldGraspBatch:
+        """The hand closed at N 4x4 poses ((N, 4, 4) in ``frame``) in C++ threads; errors name the
+        pose (``hand_poses[i]``)."""
+        H = np.asarray(hand_poses, dtype=float)
+        if H.ndim != 3 or H.shape[1:] != (4, 4):
+            raise ValueError(f"hand_poses: expected shape (N, 4, 4), got {H.shape}")
+        b = self.sim.close_batch(self._frame_pose(frame) @ H, self._spread(spread), threads=threads)
+        return self._score(b, b.contacts, np.diff(b.contacts.offsets), lift, threads)
+
+    def _spread(self, spread: Optional[float]) -> float:
+        return self.spread if spread is None else float(spread)
+
+    def _standoff(self, standoff: Optional[float]) -> float:
+        return self.standoff if standoff is None else float(standoff)
+
+    def _score(self, b, contacts, counts, lift: bool, threads: int) -> WorldGraspBatch:
+        """The simulated grasps `b` (a GraspBatch or _BatchOfOne, with its contacts and their
+        number per grasp) with epsilon and volume (0 when the hand started in collision), the
+        object-frame poses, the contacts' parts and, when `lift` is set, the lift test."""
+        c = contacts
+        on_obj = ~np.asarray(c.on_table, dtype=bool)
+        counts = np.asarray(counts, dtype=np.int64)
         # Quality on object contacts only, grasp by grasp in one C++ batch call.
         grasp_of = np.repeat(np.arange(len(counts)), counts)
         obj_counts = np.bincount(grasp_of[on_obj], minlength=len(counts))
@@ -184,14 +295,35 @@ class World:
                                                 self.torque_scale, mu=self.mu, counts=obj_counts,
                                                 threads=threads)
         eps, vol = np.array(eps, dtype=float), np.array(vol, dtype=float)
-        start = b.collision_at_start
+        start = np.asarray(b.collision_at_start, dtype=bool)
         eps[start], vol[start] = 0.0, 0.0
         lifted = displacement = None
         if lift:
             r = self.lift_tester().run_batch(b.hand_pose, b.joint_angles, threads=threads)
             lifted, displacement = r.lifted & ~start, np.array(r.displacement, dtype=float)
+        parts = None
+        obj = self.object
+        if obj.parts is not None:
+            parts = np.full(len(on_obj), None, dtype=object)
+            parts[on_obj] = obj.part_of_faces(np.asarray(c.triangle)[on_obj])
         return WorldGraspBatch(b.joint_angles, c, eps, vol, start, b.hand_pose, b.link_contact, b.table_contact,
-                               b.distance_queries, lifted, displacement)
+                               b.distance_queries, lifted, displacement, np.asarray(b.stopped_by_table, dtype=bool),
+                               _rigid_inverse(self._frame_pose("object")) @ b.hand_pose,
+                               tuple(self.hand.joint_names), parts)
+
+    def _one(self, b: WorldGraspBatch) -> WorldGrasp:
+        """Grasp 0 of a batch of one as a WorldGrasp."""
+        names = self.hand.links
+        c = b.contacts
+        part = (lambda k: None) if b.contact_part is None else (lambda k: b.contact_part[k])
+        contacts = [ContactRecord(c.point[k].tolist(), c.normal[k].tolist(), int(c.link[k]), names[int(c.link[k])],
+                                  float(c.penetration[k]), bool(c.on_table[k]), int(c.triangle[k]), part(k))
+                    for k in range(len(c.link))]
+        return WorldGrasp(b.joint_angles[0], contacts, float(b.epsilon[0]), float(b.volume[0]),
+                          bool(b.collision_at_start[0]), b.hand_pose[0],
+                          None if b.lifted is None else bool(b.lifted[0]),
+                          None if b.lifted is None else float(b.lift_displacement[0]),
+                          bool(b.stopped_by_table[0]), b.hand_pose_object[0], b.joint_names)
 
     def lift_tester(self) -> physics.LiftTester:
         if self._lift is None:
@@ -203,3 +335,52 @@ class World:
             self._lift = physics.LiftTester(self.hand.path, self.vertices, self.faces, convex_pieces=pieces,
                                             mu=self.mu, density=self.object.density)
         return self._lift
+
+
+class _BatchOfOne:
+    """A simulator GraspResult seen as a batch of one (the fields World._score reads)."""
+
+    def __init__(self, g):
+        self.joint_angles = g.joint_angles[None]
+        self.collision_at_start = np.array([g.collision_at_start])
+        self.stopped_by_table = np.array([g.stopped_by_table])
+        self.hand_pose = g.hand_pose[None]
+        self.link_contact = g.link_contact[None]
+        self.table_contact = g.table_contact[None]
+        self.distance_queries = np.array([g.distance_queries], dtype=np.int32)
+
+
+def _turn_xy(xy: np.ndarray, yaw: float, x0: float = 0.0, y0: float = 0.0) -> np.ndarray:
+    """(N, 2) points turned by yaw about the origin, then moved by (x0, y0)."""
+    c, s = np.cos(yaw), np.sin(yaw)
+    return np.column_stack([x0 + c * xy[:, 0] - s * xy[:, 1], y0 + s * xy[:, 0] + c * xy[:, 1]])
+
+
+def _floats(a, name: str) -> np.ndarray:
+    try:
+        return np.asarray(a, dtype=float)
+    except (TypeError, ValueError):
+        raise ValueError(f"{name}: expected numbers, got {a!r}") from None
+
+
+def _rows3(a, name: str) -> np.ndarray:
+    """An (N, 3) float array (the simulator checks the values)."""
+    A = _floats(a, name)
+    if A.ndim != 2 or A.shape[1] != 3:
+        raise ValueError(f"{name}: expected shape (N, 3), got {A.shape}")
+    return A
+
+
+def _vec3(a, name: str) -> np.ndarray:
+    """A (3,) float array as one (1, 3) row."""
+    A = _floats(a, name)
+    if A.shape != (3,):
+        raise ValueError(f"{name}: expected 3 numbers, got shape {A.shape}")
+    return A[None]
+
+
+def _rigid_inverse(T: np.ndarray) -> np.ndarray:
+    out = np.eye(4)
+    out[:3, :3] = T[:3, :3].T
+    out[:3, 3] = -T[:3, :3].T @ T[:3, 3]
+    return out

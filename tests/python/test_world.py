@@ -103,10 +103,12 @@ def test_grasp_result_as_dict():
     g = world.grasp(0.0, 0.0, 0.2)
     d = g.to_dict()
     assert list(d) == ["joint_angles", "contacts", "epsilon", "volume", "collision_at_start", "hand_pose",
-                       "lifted", "lift_displacement"]
-    assert d["lifted"] is None and d["lift_displacement"] is None
+                       "lifted", "lift_displacement", "stopped_by_table", "hand_pose_object", "joint_names"]
+    assert d["lifted"] is None and d["lift_displacement"] is None and d["stopped_by_table"] is False
+    assert d["joint_names"] == world.hand.joint_names
     assert all(isinstance(c, ContactRecord) for c in g.contacts)
-    assert [list(c) for c in d["contacts"]] == [["point", "normal", "link", "link_name", "penetration", "on_table"]] * len(g.contacts)
+    assert [list(c) for c in d["contacts"]] == [["point", "normal", "link", "link_name", "penetration", "on_table",
+                                                 "triangle", "part"]] * len(g.contacts)
     assert d["contacts"][0]["link_name"] == world.hand.links[d["contacts"][0]["link"]]
     assert isinstance(d["contacts"][0]["point"], list) and isinstance(d["epsilon"], float)
 

@@ -14,6 +14,7 @@ struct Contact {
   int link = -1;               // index of the hand link in contact (0 = palm)
   double penetration = 0.0;    // >= 0, depth of overlap (m); 0 for touching within tolerance
   bool on_table = false;       // true if the contact is with the table, not the object
+  int triangle = -1;           // the object's triangle nearest to the link (-1 for the table)
 };
 
 using Contacts = std::vector<Contact>;

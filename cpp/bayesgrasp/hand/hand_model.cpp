@@ -298,4 +298,27 @@ Iso3 HandModel::top_grasp_pose(double x, double y, double yaw, double z) {
   return T;
 }
 
+Vec3 unit_direction(const Vec3& d, const char* name) {
+  if (!d.allFinite()) throw std::invalid_argument(std::string(name) + ": contains NaN or infinity");
+  const double n = d.norm();
+  if (!(n > 1e-12))
+    throw std::invalid_argument(std::string(name) + ": must be a non-zero vector, got length " + std::to_string(n));
+  return d / n;
+}
+
+Iso3 HandModel::approach_pose(const Vec3& direction, double roll, const Vec3& palm) {
+  const Vec3 d = unit_direction(direction);
+  if (!std::isfinite(roll)) throw std::invalid_argument("roll: must be finite");
+  if (!palm.allFinite()) throw std::invalid_argument("palm: contains NaN or infinity");
+  Iso3 T = top_grasp_pose(palm.x(), palm.y(), roll, palm.z());
+  // The tilt taking -z onto d: about the axis (-z) x d = (d_y, -d_x, 0) by the angle between them.
+  const Vec3 axis(d.y(), -d.x(), 0.0);
+  const double s = axis.norm();
+  if (s == 0.0 && d.z() < 0.0) return T;  // d = -z: the top grasp itself
+  const Mat3 tilt = s == 0.0 ? Eigen::AngleAxisd(M_PI, Vec3::UnitX()).toRotationMatrix()
+                             : Eigen::AngleAxisd(std::atan2(s, -d.z()), axis / s).toRotationMatrix();
+  T.linear() = tilt * T.linear();
+  return T;
+}
+
 }  // namespace bayesgrasp

@@ -73,6 +73,10 @@ struct Link {
   std::vector<Shape> shapes;
 };
 
+/// `d` normalised; throws std::invalid_argument naming `name` if d is not finite or of zero
+/// length (below 1e-12).
+Vec3 unit_direction(const Vec3& d, const char* name = "direction");
+
 class HandModel {
  public:
   /// Parses the JSON text of a hand file; throws std::invalid_argument naming what is wrong.
@@ -122,6 +126,15 @@ class HandModel {
   /// World pose of a palm-down hand above the table at (x, y, yaw), palm face at height z:
   /// hand +z = world -z, hand x = world Rz(yaw) x.
   static Iso3 top_grasp_pose(double x, double y, double yaw, double z);
+
+  /// World pose of a hand approaching along `direction` (hand +z; normalised here) with `roll`,
+  /// palm centre at `palm`. Roll convention: the palm-down top-grasp hand at yaw = roll
+  /// (top_grasp_pose) tilted by the smallest rotation taking world -z onto the direction;
+  /// equivalently, roll turns the hand right-handedly about -direction (for direction -z it is
+  /// the top grasp's yaw, exactly: the same matrix). For direction +z (from below) the tilt is a
+  /// half turn about world x. Throws std::invalid_argument naming `direction` (zero or not
+  /// finite), `roll` or `palm` (not finite).
+  static Iso3 approach_pose(const Vec3& direction, double roll, const Vec3& palm);
 
  private:
   std::string name_;

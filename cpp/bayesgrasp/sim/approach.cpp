@@ -4,39 +4,58 @@
 #include <cmath>
 
 #include "bayesgrasp/sim/closing.hpp"
+#include "bayesgrasp/sim/distance_bounds.hpp"
 
 namespace bayesgrasp::sim {
 
 namespace {
 
+constexpr double kStartGap = 0.01;  // the open hand starts this far before the object's box (m)
+
 /// The link distances of one approach step.
 struct StepDistances {
-  bool touch = false;                  // a link is within the tolerance of the object or the table
-  double smallest = kInf;              // smallest known distance (deferred queries aside)
+  bool object_touch = false;            // a link is within the tolerance of the object
+  bool table_touch = false;             // ... of the table, moving down onto it
+  double smallest = kInf;               // smallest known travel to a contact (deferred queries aside)
   std::vector<LinkDistance*> deferred;  // links whose object query is deferred
   std::vector<int> deferred_link;
 };
 
+/// What an approach knows about the obstacles ahead: `descent` = -d_z (the table is reached
+/// after a travel of height / descent when it is positive) and the object's smallest
+/// coordinate along the direction (the object lies beyond that plane).
+struct Ahead {
+  double descent = 0.0;
+  double object_near = -kInf;
+  Vec3 back = Vec3::UnitZ();  // -direction
+};
+
 /// Evaluates every link at the hand pose H (poses: the link poses, filled here).
-StepDistances evaluate_links(const SimScene& s, const Iso3& H, const std::vector<Iso3>& local, Approach& a,
-                             std::vector<Iso3>& poses) {
-  const double tol = s.options.contact_tolerance;
+StepDistances evaluate_links(const SimScene& s, const Iso3& H, const std::vector<Iso3>& local, const Ahead& ahead,
+                             Approach& a, std::vector<Iso3>& poses) {
+  const double tol = s.options.contact_tolerance, descent = ahead.descent;
   StepDistances d;
   for (int l = 0; l < s.hand.num_links(); ++l) poses[l] = H * local[l];
   for (int l = 0; l < s.hand.num_links(); ++l) {
     if (s.links[l].empty()) continue;
     LinkDistance& c = a.distances[l];
-    evaluate_link(s, l, poses[l], c, a.queries);
-    d.smallest = std::min(d.smallest, c.table);
+    // separating plane: the link's deepest point along the direction to the object's plane
+    const double plane =
+        ahead.object_near > -kInf ? link_min_along(s.links[l], poses[l], ahead.back) + ahead.object_near : -kInf;
+    evaluate_link(s, l, poses[l], c, a.queries, plane);
+    if (descent > 0.0) {
+      d.smallest = std::min(d.smallest, c.table / descent);
+      if (c.table < tol) d.table_touch = true;
+    }
     if (c.deferred) d.deferred.push_back(&c), d.deferred_link.push_back(l);
     else d.smallest = std::min(d.smallest, c.lower);
-    if (c.upper < tol || c.table < tol) d.touch = true;
+    if (c.upper < tol) d.object_touch = true;
   }
   return d;
 }
 
-/// The safe travel: every point moves at speed 1 along the direction, so a link's term is its
-/// distance itself; deferred queries are resolved against the smallest known distance.
+/// The safe travel: every point moves at speed 1 along the direction, so a link's object term
+/// is its distance itself; deferred queries are resolved against the smallest known travel.
 double safe_travel(const SimScene& s, StepDistances& d, const std::vector<Iso3>& poses, Approach& a) {
   return resolve_deferred(
       d.deferred.data(), static_cast<int>(d.deferred.size()), d.smallest, [](int, double x) { return x; },
@@ -47,11 +66,26 @@ double safe_travel(const SimScene& s, StepDistances& d, const std::vector<Iso3>&
       });
 }
 
+/// Height of the open hand's lowest point above the table at hand pose H.
+double lowest_height(const SimScene& s, const Iso3& H, const Eigen::VectorXd& open_joints) {
+  const std::vector<Iso3> poses = s.hand.link_poses(H, open_joints);
+  double h = kInf;
+  for (int l = 0; l < s.hand.num_links(); ++l)
+    if (!s.links[l].empty()) h = std::min(h, table_distance(s.links[l], poses[l]));
+  return h;
+}
+
 }  // namespace
 
 Approach approach_until_contact(const SimScene& s, const Iso3& start, const Vec3& direction, const Vec3& last,
                                 const Eigen::VectorXd& open_joints) {
   const double tol = s.options.contact_tolerance;
+  Ahead ahead;
+  ahead.descent = s.options.table ? -direction.z() : 0.0;
+  ahead.back = -direction;
+  // Along -z the 26-DOP holds this plane already.
+  if (direction != -Vec3::UnitZ()) ahead.object_near = (s.mesh.V * direction).minCoeff();
+  const double descent = ahead.descent;
   Approach a;
   a.pose = start;
   a.direction = direction;
@@ -63,9 +97,12 @@ Approach approach_until_contact(const SimScene& s, const Iso3& start, const Vec3
   Vec3 position = start.translation();
   for (int it = 0; it < s.options.max_iterations; ++it) {
     a.pose.translation() = position;
-    StepDistances d = evaluate_links(s, a.pose, local, a, poses);
-    if (d.touch) break;
-    if (!s.options.table && direction.dot(position) > limit) break;
+    StepDistances d = evaluate_links(s, a.pose, local, ahead, a, poses);
+    if (d.object_touch || d.table_touch) {
+      a.stopped_by_table = !d.object_touch;
+      break;
+    }
+    if (!(descent > 0.0) && direction.dot(position) > limit) break;
     const double travel = safe_travel(s, d, poses, a);
     ++a.iterations;
     const double dz = std::max(travel - 0.5 * tol, 0.0);
@@ -98,23 +135,49 @@ double closing_sweep_depth(const HandModel& hand, const LinkShapes& links, doubl
   return depth;
 }
 
-GraspResult top_grasp(const SimScene& s, double x, double y, double yaw, double spread, double standoff) {
+ApproachLine approach_line(const SimScene& s, const ApproachSpec& a, const Eigen::VectorXd& open_joints,
+                           double depth) {
+  const Vec3& d = a.direction;
+  // The object's box along d: the coordinates of its nearest and farthest corners.
+  double nearest = kInf, farthest = -kInf;
+  for (int k = 0; k < 8; ++k) {
+    const double u = d.dot(s.object.box.corner(static_cast<Eigen::AlignedBox3d::CornerType>(k)));
+    nearest = std::min(nearest, u), farthest = std::max(farthest, u);
+  }
+  const Vec3 foot = a.target - d.dot(a.target) * d;  // the palm's line at coordinate 0 along d
+  ApproachLine line;
+  line.start = HandModel::approach_pose(d, a.roll, foot + (nearest - depth - kStartGap) * d);
+  if (s.options.table) {
+    line.start_height = lowest_height(s, line.start, open_joints);
+    if (d.z() < 0.0 && line.start_height < 0.5 * kStartGap) {
+      line.start.translation() += ((kStartGap - line.start_height) / d.z()) * d;
+      line.start_height = lowest_height(s, line.start, open_joints);
+    }
+  }
+  line.last = foot + (farthest + 0.5 * depth) * d;
+  return line;
+}
+
+GraspResult approach_grasp(const SimScene& s, const ApproachSpec& a, double spread, double standoff) {
   const SimOptions& o = s.options;
   const Eigen::VectorXd open = s.hand.coupled_joints(spread, 0.0);
-  // Start with the open hand's lowest point 1 cm above the object (and the table).
-  const double depth = depth_below_palm(s.hand, s.links, open);
-  const double z0 = std::max(s.object.box.max().z(), o.table ? 0.0 : -kInf) + depth + 0.01;
-  const double z_floor = s.object.box.min().z() - 0.5 * depth;  // without a table: give up below the object
-  Approach a = approach_until_contact(s, HandModel::top_grasp_pose(x, y, yaw, z0), -Vec3::UnitZ(),
-                                      Vec3(x, y, z_floor), open);
-  // Keep the closing fingers' sweep above the table (see approach.hpp).
-  double raise = standoff;
-  if (o.table && o.table_clearance >= 0.0)
-    raise = std::max(raise, s.sweep_depth + o.table_clearance - a.pose.translation().z());
-  back_off(s, a, raise);
-  GraspResult r = close_hand(s, a.pose, spread, &a.distances);
-  r.distance_queries += a.queries;
-  r.iterations += a.iterations;
+  const ApproachLine line = approach_line(s, a, open, depth_below_palm(s.hand, s.links, open));
+  GraspResult r = open_hand(s, line.start, spread);
+  // The start is clear of the object (behind its box along the direction); only the table can
+  // hold the open hand (when the direction does not descend).
+  if (line.start_height < -1e-9) {
+    mark_collision_at_start(s, r);
+    return r;
+  }
+  Approach m = approach_until_contact(s, line.start, a.direction, line.last, open);
+  double back = standoff;
+  if (o.table && o.table_clearance >= 0.0 && a.direction == -Vec3::UnitZ())  // keep the sweep above the table
+    back = std::max(back, s.sweep_depth + o.table_clearance - m.pose.translation().z());
+  back_off(s, m, back);
+  r = close_hand(s, m.pose, spread, &m.distances);
+  r.stopped_by_table = m.stopped_by_table;
+  r.distance_queries += m.queries;
+  r.iterations += m.iterations;
   return r;
 }
 

@@ -14,8 +14,11 @@ namespace bayesgrasp::sim {
 GraspResult open_hand(const SimScene& s, const Iso3& H, double spread);
 
 /// Whether a link of the open hand `r` penetrates the object or the table; if so, marks r as
-/// collision_at_start with no contacts (its fingers stay open).
+/// collision_at_start (mark_collision_at_start).
 bool starts_in_collision(const SimScene& s, GraspResult& r);
+
+/// Marks r as collision_at_start with no contacts (its fingers stay open).
+void mark_collision_at_start(const SimScene& s, GraspResult& r);
 
 /// The contacts of r at its joints and hand pose (at most one object and one table contact
 /// per link). `known` holds what the closing knows about each link's distances.

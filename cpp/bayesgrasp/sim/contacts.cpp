@@ -24,6 +24,7 @@ void add_object_contact(const SimScene& s, int l, const Iso3& T, const LinkDista
   k.normal = contact_normal(s, e);
   k.link = l;
   k.penetration = std::max(0.0, -e.distance);
+  k.triangle = e.triangle;
   r.contacts.push_back(k);
   r.link_contact[l] = 1;
 }
@@ -55,12 +56,16 @@ bool starts_in_collision(const SimScene& s, GraspResult& r) {
   const int L = s.hand.num_links();
   for (int l = 0; l < L; ++l) {
     if (s.links[l].empty() || !penetrates(s, l, poses[l], r.distance_queries)) continue;
-    r.collision_at_start = true;
-    r.link_contact.assign(L, 0);
-    r.table_contact.assign(L, 0);
+    mark_collision_at_start(s, r);
     return true;
   }
   return false;
+}
+
+void mark_collision_at_start(const SimScene& s, GraspResult& r) {
+  r.collision_at_start = true;
+  r.link_contact.assign(s.hand.num_links(), 0);
+  r.table_contact.assign(s.hand.num_links(), 0);
 }
 
 void collect_contacts(const SimScene& s, const std::vector<LinkDistance>& known, GraspResult& r) {

@@ -60,20 +60,22 @@ double box_distance(const std::vector<LinkShape>& shapes, const Iso3& T, const O
   const Vec3 gap = (box.min() - b.max()).cwiseMax(b.min() - box.max()).cwiseMax(0.0);
   double lb = gap.norm();
   // separating-axis bound over the object's 26-DOP (tighter than the box off its corners)
-  for (int k = 0; k < ObjectGeometry::kDop; ++k) {
-    const Vec3& n = object.dop_directions[k];
-    double lo = kInf;
-    for (const LinkShape& s : shapes) {
-      if (s.capsule) {
-        lo = std::min(lo, std::min(n.dot(T * s.p0), n.dot(T * s.p1)) - s.radius);
-      } else {
-        const Vec3 nl = T.linear().transpose() * n;
-        lo = std::min(lo, n.dot(T * s.center) - nl.cwiseAbs().dot(s.half_extents));
-      }
-    }
-    lb = std::max(lb, lo - object.dop_extent[k]);
-  }
+  for (int k = 0; k < ObjectGeometry::kDop; ++k)
+    lb = std::max(lb, link_min_along(shapes, T, object.dop_directions[k]) - object.dop_extent[k]);
   return lb;
+}
+
+double link_min_along(const std::vector<LinkShape>& shapes, const Iso3& T, const Vec3& n) {
+  double lo = kInf;
+  for (const LinkShape& s : shapes) {
+    if (s.capsule) {
+      lo = std::min(lo, std::min(n.dot(T * s.p0), n.dot(T * s.p1)) - s.radius);
+    } else {
+      const Vec3 nl = T.linear().transpose() * n;
+      lo = std::min(lo, n.dot(T * s.center) - nl.cwiseAbs().dot(s.half_extents));
+    }
+  }
+  return lo;
 }
 
 }  // namespace bayesgrasp::sim

@@ -26,4 +26,7 @@ inline Vec3 table_point(const std::vector<LinkShape>& shapes, const Iso3& T) {
 /// Lower bound on the distance from the link at T to the object (box gap, 26-DOP).
 double box_distance(const std::vector<LinkShape>& shapes, const Iso3& T, const ObjectGeometry& object);
 
+/// The smallest coordinate along unit n of the link's points at T.
+double link_min_along(const std::vector<LinkShape>& shapes, const Iso3& T, const Vec3& n);
+
 }  // namespace bayesgrasp::sim

@@ -103,9 +103,8 @@ double distance_below(const SimScene& s, int link, const Iso3& T, double cap, in
   return d;
 }
 
-void advancing_bounds(const SimScene& s, int link, const Iso3& T, double carried_lower, double& lower,
+void advancing_bounds(const SimScene& s, int link, const Iso3& T, double bd, double carried_lower, double& lower,
                       double& upper, int& queries) {
-  const double bd = box_distance(s.links[link], T, s.object);
   if (bd > s.options.box_skip) {
     lower = bd;
     upper = kInf;

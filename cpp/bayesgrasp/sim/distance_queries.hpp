@@ -38,11 +38,11 @@ double distance_below(const SimScene& s, int link, const Iso3& T, double cap, in
                       WarmStart* warm = nullptr);
 
 /// Bounds on the link-object distance for an advancement step without query pruning: lower
-/// (for the step) and upper (for the contact decision). The box bound replaces FCL when it
-/// exceeds box_skip; else FCL with the absolute error allowance rel_err * (a lower bound on the
-/// distance: the box bound or `carried_lower`), so that the true distance is at least the
-/// result minus the allowance.
-void advancing_bounds(const SimScene& s, int link, const Iso3& T, double carried_lower, double& lower,
+/// (for the step) and upper (for the contact decision). The lower bound `bd` (box_distance or
+/// better) replaces FCL when it exceeds box_skip; else FCL with the absolute error allowance
+/// rel_err * (a lower bound on the distance: bd or `carried_lower`), so that the true distance
+/// is at least the result minus the allowance.
+void advancing_bounds(const SimScene& s, int link, const Iso3& T, double bd, double carried_lower, double& lower,
                       double& upper, int& queries);
 
 /// The object's outward normal at a contact: the direction from the object's nearest point to

@@ -13,6 +13,7 @@ GraspBatch make_batch(const std::vector<GraspResult>& results, int J, int L) {
   b.link_contact.setZero(N, L);
   b.table_contact.setZero(N, L);
   b.collision_at_start.resize(N);
+  b.stopped_by_table.resize(N);
   b.hand_poses.resize(N);
   b.offsets.assign(N + 1, 0);
   b.distance_queries.resize(N);
@@ -26,6 +27,7 @@ GraspBatch make_batch(const std::vector<GraspResult>& results, int J, int L) {
       b.table_contact(i, l) = r.table_contact[l];
     }
     b.collision_at_start[i] = r.collision_at_start;
+    b.stopped_by_table[i] = r.stopped_by_table;
     b.hand_poses[i] = r.hand_pose;
     b.distance_queries[i] = r.distance_queries;
     b.contacts.insert(b.contacts.end(), r.contacts.begin(), r.contacts.end());

@@ -1,5 +1,5 @@
 // GraspSimulator: the public entry points. Arguments are validated here, once; the steps live
-// in sim_scene / link_geometry (preparation), approach (top grasps), closing and
+// in sim_scene / link_geometry (preparation), approach (approaches and top grasps), closing and
 // fixed_step_closing, and grasp_batch (many grasps in threads).
 #include "bayesgrasp/sim/grasp_simulator.hpp"
 
@@ -63,6 +63,21 @@ void check_standoff(double standoff) {
     throw std::invalid_argument("standoff: must be >= 0 and finite, got " + std::to_string(standoff));
 }
 
+std::string indexed(const char* name, int i) { return i < 0 ? name : std::string(name) + "[" + std::to_string(i) + "]"; }
+
+/// `a` with its direction normalised; errors name `direction`, `roll`, `target` (with [i] for
+/// entry i of a batch, i >= 0). With a table, a target below it (z < 0) is an error.
+ApproachSpec checked_approach(const ApproachSpec& a, bool table, int i = -1) {
+  ApproachSpec out = a;
+  out.direction = unit_direction(a.direction, indexed(i < 0 ? "direction" : "directions", i).c_str());
+  if (!std::isfinite(a.roll)) throw std::invalid_argument(indexed(i < 0 ? "roll" : "rolls", i) + ": must be finite");
+  const std::string target = indexed(i < 0 ? "target" : "targets", i);
+  if (!a.target.allFinite()) throw std::invalid_argument(target + ": contains NaN or infinity");
+  if (table && a.target.z() < 0.0)
+    throw std::invalid_argument(target + ": below the table (z = " + std::to_string(a.target.z()) + " < 0)");
+  return out;
+}
+
 }  // namespace
 
 GraspSimulator::GraspSimulator(const HandModel& hand, const TriMesh& object, const SimOptions& options)
@@ -97,7 +112,14 @@ GraspResult GraspSimulator::top_grasp(double x, double y, double yaw, double spr
   if (!std::isfinite(yaw)) throw std::invalid_argument("yaw: must be finite");
   hand().check_spread(spread);
   check_standoff(standoff);
-  return sim::top_grasp(impl_->scene, x, y, yaw, spread, standoff);
+  return sim::approach_grasp(impl_->scene, {-Vec3::UnitZ(), yaw, Vec3(x, y, 0.0)}, spread, standoff);
+}
+
+GraspResult GraspSimulator::approach(const ApproachSpec& approach, double spread, double standoff) const {
+  const ApproachSpec a = checked_approach(approach, options().table);
+  hand().check_spread(spread);
+  check_standoff(standoff);
+  return sim::approach_grasp(impl_->scene, a, spread, standoff);
 }
 
 double GraspSimulator::link_object_distance(const Iso3& hand_pose, const Eigen::VectorXd& q, int link) const {
@@ -133,8 +155,20 @@ GraspBatch GraspSimulator::top_grasp_batch(const Eigen::Matrix<double, Eigen::Dy
   check_standoff(standoff);
   const sim::SimScene& s = impl_->scene;
   return sim::grasp_batch(s, static_cast<int>(xyyaw.rows()), threads, [&](int i) {
-    return sim::top_grasp(s, xyyaw(i, 0), xyyaw(i, 1), xyyaw(i, 2), spread, standoff);
+    return sim::approach_grasp(s, {-Vec3::UnitZ(), xyyaw(i, 2), Vec3(xyyaw(i, 0), xyyaw(i, 1), 0.0)}, spread, standoff);
   });
+}
+
+GraspBatch GraspSimulator::approach_batch(const std::vector<ApproachSpec>& approaches, double spread,
+                                          double standoff, int threads) const {
+  std::vector<ApproachSpec> checked(approaches.size());
+  for (size_t i = 0; i < approaches.size(); ++i)
+    checked[i] = checked_approach(approaches[i], options().table, static_cast<int>(i));
+  hand().check_spread(spread);
+  check_standoff(standoff);
+  const sim::SimScene& s = impl_->scene;
+  return sim::grasp_batch(s, static_cast<int>(checked.size()), threads,
+                          [&](int i) { return sim::approach_grasp(s, checked[i], spread, standoff); });
 }
 
 }  // namespace bayesgrasp

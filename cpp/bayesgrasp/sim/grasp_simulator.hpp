@@ -24,12 +24,14 @@
 // BENCHMARKS.md). Query pruning (sim/query_pruning.hpp) skips the queries whose answer cannot
 // change the step or the contacts.
 //
-// Top grasps (sim/approach.hpp): the hand, palm down (HandModel::top_grasp_pose), starts above
-// the object and moves along -z by conservative advancement until any link is within the
-// tolerance of the object or the table; it is then raised by `standoff` and closed. With a
-// table, the palm is kept at least `table_clearance` above the deepest point the closing
-// fingers sweep, so that on an object lower than the fingers are long the fingers wrap it near
-// its base instead of striking the table. The approach step itself takes any direction.
+// Approaches (sim/approach.hpp): the open hand, oriented by the approach direction d (hand +z)
+// and a roll about it (HandModel::approach_pose), starts on the line through a target point,
+// clear of the object and the table, and moves along d by conservative advancement until any
+// link is within the tolerance of the object or of a table it moves towards; it then backs off
+// by `standoff` along d and closes. Top grasps are the approach along d = -z with roll = yaw.
+// Along d = -z with a table (and only then), the palm is also kept at least `table_clearance`
+// above the deepest point the closing fingers sweep, so that on an object lower than the
+// fingers are long the fingers wrap it near its base instead of striking the table.
 //
 // Thread safety: all queries are const and keep their state on the stack, so one simulator
 // can serve many threads (FCL's BVH model is only read by distance queries).
@@ -74,12 +76,20 @@ struct SimOptions {
   bool prune_queries = true;
 };
 
+/// One approach (world frame; see GraspSimulator::approach).
+struct ApproachSpec {
+  Vec3 direction = -Vec3::UnitZ();  // direction of motion = hand +z (normalised by the simulator)
+  double roll = 0.0;                // rad, about -direction (HandModel::approach_pose)
+  Vec3 target = Vec3::Zero();       // a point on the palm centre's line of motion (m)
+};
+
 struct GraspResult {
   Eigen::VectorXd joints;           // HandModel layout
   Contacts contacts;                // at most one object and one table contact per link
   std::vector<uint8_t> link_contact;   // per link: touches the object
   std::vector<uint8_t> table_contact;  // per link: touches the table
   bool collision_at_start = false;  // the open hand penetrated the object or the table
+  bool stopped_by_table = false;    // an approach stopped on the table without touching the object
   Iso3 hand_pose = Iso3::Identity();
   // statistics
   int distance_queries = 0;  // FCL distance calls
@@ -94,6 +104,7 @@ struct GraspBatch {
   Eigen::Matrix<uint8_t, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor> link_contact;   // N x L
   Eigen::Matrix<uint8_t, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor> table_contact;  // N x L
   std::vector<uint8_t> collision_at_start;  // N
+  std::vector<uint8_t> stopped_by_table;    // N
   std::vector<Iso3> hand_poses;             // N
   Contacts contacts;                        // concatenated
   std::vector<int64_t> offsets;             // N + 1
@@ -121,8 +132,21 @@ class GraspSimulator {
   /// for a non-finite pose or a spread outside the hand's limits.
   GraspResult close(const Iso3& hand_pose, double spread) const;
 
-  /// Palm-down approach at (x, y, yaw) along -z, stop `standoff` (>= 0, m) above the first
-  /// contact of any link (and the table clearance), then close.
+  /// Approach, then auto-grasp. The open hand (preshape `spread`) at
+  /// HandModel::approach_pose(direction, roll, .) starts on the line through `target` along the
+  /// direction, 1 cm before the object's bounding box (its deepest point along the direction
+  /// behind the box's nearest corner), and, if the direction descends, at least 5 mm above the
+  /// table; it moves along the direction until a link is within the contact tolerance of the
+  /// object or of the table (only when moving down onto it), backs off by `standoff` (>= 0, m)
+  /// along the direction and closes. It gives up (and closes where it is) once the palm has
+  /// passed the object's box by half the open hand's depth with no table ahead. d = -z keeps
+  /// the table-clearance rule of top grasps. A start in collision (the open hand in the table)
+  /// is reported (collision_at_start), not an error. Throws std::invalid_argument naming
+  /// `direction` (zero or not finite), `roll`, `target` (not finite, or below a table), `spread`
+  /// or `standoff`.
+  GraspResult approach(const ApproachSpec& approach, double spread, double standoff = 0.0) const;
+
+  /// Palm-down approach at (x, y, yaw): approach({-z, yaw, (x, y, 0)}, spread, standoff).
   GraspResult top_grasp(double x, double y, double yaw, double spread, double standoff = 0.0) const;
 
   /// The same auto-grasp done GraspIt!-style: the actuator advances in fixed steps of `step`
@@ -137,6 +161,9 @@ class GraspSimulator {
   /// xyyaw: N x 3 rows (x, y, yaw).
   GraspBatch top_grasp_batch(const Eigen::Matrix<double, Eigen::Dynamic, 3, Eigen::RowMajor>& xyyaw,
                              double spread, double standoff = 0.0, int threads = 1) const;
+  /// approach() for each entry; errors name the entry (`directions[i]`, `targets[i]`, `rolls[i]`).
+  GraspBatch approach_batch(const std::vector<ApproachSpec>& approaches, double spread, double standoff = 0.0,
+                            int threads = 1) const;
 
   /// Exact distance from link `link` at joint vector q (hand at hand_pose) to the object
   /// (ignores the table); negative if penetrating. For tests and diagnostics.

@@ -112,6 +112,7 @@ LinkShape capsule_shape(const Shape& s, const SimOptions& options) {
     const Vertices lv = {fcl::Vector3d(0, 0, -0.5 * len), fcl::Vector3d(0, 0, 0.5 * len), fcl::Vector3d(w, 0, 0)};
     g.geometry = make_mesh_geometry(lv, {fcl::Triangle(0, 1, 2)}, options.bv, g.mesh);
     g.offset = s.radius + w;
+    g.sliver = true;
   } else {
     g.geometry = g.primitive;
   }

@@ -32,6 +32,7 @@ struct LinkShape {
   MeshView mesh;                        // geometry's triangles when it is a BVH (warm starts), else empty
   Iso3 geometry_frame = Iso3::Identity();  // geometry frame in the link frame
   double offset = 0.0;                  // subtracted from geometry distances (segment: the capsule radius)
+  bool sliver = false;                  // geometry is a capsule's axis as one sliver triangle (cheap queries)
   FclGeometry primitive;                // FCL capsule, sphere or box (boolean collision checks)
   Iso3 primitive_frame = Iso3::Identity();
   bool capsule = true;

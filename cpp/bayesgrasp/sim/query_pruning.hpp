@@ -7,8 +7,10 @@
 // the others' is not queried (its query is deferred), and a link that is queried gets a capped
 // query (FCL searches only below the distance that would change the minimum). Links that may
 // touch (bound below the tolerance) and the final contact queries (capped at the tolerance)
-// are always queried. The steps, contact decisions and contacts are therefore those of the
-// unpruned algorithm, up to round-off.
+// are always queried; a link with a box (or a capsule not represented by its axis) first by a
+// query capped at the tolerance, as an uncapped query of a box next to a large surface
+// traverses most of the object's tree: a larger distance waits, deferred. The steps, contact
+// decisions and contacts are therefore those of the unpruned algorithm, up to round-off.
 #pragma once
 
 #include <cstdint>
@@ -30,8 +32,9 @@ struct LinkDistance {
 };
 
 /// Evaluates the link's distances at pose T (c.current becomes true). With pruning, an FCL query
-/// whose answer cannot make the link touch is deferred; without, advancing_bounds().
-void evaluate_link(const SimScene& s, int link, const Iso3& T, LinkDistance& c, int& queries);
+/// whose answer cannot make the link touch is deferred; without, advancing_bounds(). `bound`: a
+/// further lower bound on the object distance, used like the box bound (the larger one counts).
+void evaluate_link(const SimScene& s, int link, const Iso3& T, LinkDistance& c, int& queries, double bound = -kInf);
 
 /// Resolves deferred queries. `limit` is the minimum of the step terms known so far; deferred
 /// link k (entry *c[k]) has the term term(k, d) for object distance d (increasing in d), and
