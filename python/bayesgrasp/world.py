@@ -353,7 +353,8 @@ class _BatchOfOne:
 def _turn_xy(xy: np.ndarray, yaw: float, x0: float = 0.0, y0: float = 0.0) -> np.ndarray:
     """(N, 2) points turned by yaw about the origin, then moved by (x0, y0)."""
     c, s = np.cos(yaw), np.sin(yaw)
-    return np.column_stack([x0 + c * xy[:, 0] - s * xy[:, 1], y0 + s * xy[:, 0] + c * xy[:, 1]])
+    with np.errstate(invalid="ignore"):  # an infinite entry gives NaN, which the simulator rejects
+        return np.column_stack([x0 + c * xy[:, 0] - s * xy[:, 1], y0 + s * xy[:, 0] + c * xy[:, 1]])
 
 
 def _floats(a, name: str) -> np.ndarray:

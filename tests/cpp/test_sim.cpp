@@ -396,6 +396,20 @@ TEST(Sim, QueryPruningKeepsTheResult) {
     qa += ga.distance_queries, qb += gb.distance_queries;
   }
   EXPECT_LT(qa, qb);
+  // approaches from tilted directions (separating-plane bound, box queries capped first)
+  int on_object = 0;
+  for (int i = 0; i < 40; ++i) {
+    const Vec3 d(0.8 * U(rng), 0.8 * U(rng), -1.0);
+    const ApproachSpec s{d, M_PI * U(rng), Vec3(0.01 * U(rng), 0.01 * U(rng), 0.06 + 0.03 * U(rng))};
+    const double spread = (0.5 + 0.5 * U(rng)) * M_PI / 2;
+    const GraspResult ga = a.approach(s, spread), gb = b.approach(s, spread);
+    EXPECT_LT((ga.joints - gb.joints).cwiseAbs().maxCoeff(), 1e-6) << "approach " << i;
+    EXPECT_LT((ga.hand_pose.translation() - gb.hand_pose.translation()).norm(), 1e-9) << "approach " << i;
+    EXPECT_EQ(ga.link_contact, gb.link_contact) << "approach " << i;
+    EXPECT_EQ(ga.stopped_by_table, gb.stopped_by_table) << "approach " << i;
+    on_object += !ga.stopped_by_table;
+  }
+  EXPECT_GT(on_object, 10);
 }
 
 // A palm resting on a cylinder's top face pushes along +z: its contact normal is the top face's,

@@ -87,3 +87,24 @@ def test_bad_hand_input():
         h.link_poses(h.open_joints(), np.eye(3))
     with pytest.raises(ValueError, match="spread"):
         h.coupled_joints(4.0)
+
+
+def test_approach_pose_convention():
+    # along -z: the top grasp's pose itself; roll = yaw
+    np.testing.assert_array_equal(Hand.approach_pose([0, 0, -1], 0.7, [0.1, -0.2, 0.3]),
+                                  Hand.top_grasp_pose(0.1, -0.2, 0.7, 0.3))
+    # along +x at roll 0: hand z = +x, hand x = +z (the palm-down hand tilted about -y), y = -y
+    T = Hand.approach_pose([3.0, 0, 0], 0.0, [0, 0, 0.05])
+    np.testing.assert_allclose(T[:3, :3], [[0, 0, 1], [0, -1, 0], [1, 0, 0]], atol=1e-15)
+    # roll: a right-handed turn about -direction (Rodrigues)
+    d = np.array([0.3, -0.5, -0.8]) / np.linalg.norm([0.3, -0.5, -0.8])
+    a, r = -d, 1.1
+    K = np.array([[0, -a[2], a[1]], [a[2], 0, -a[0]], [-a[1], a[0], 0]])
+    turn = np.eye(3) + np.sin(r) * K + (1 - np.cos(r)) * K @ K
+    np.testing.assert_allclose(Hand.approach_pose(d, r, [0, 0, 0])[:3, :3],
+                               turn @ Hand.approach_pose(d, 0.0, [0, 0, 0])[:3, :3], atol=1e-12)
+    for bad, needle in [([0, 0, 0], "direction"), ([np.nan, 0, 1], "direction"), ([0, 0], "direction")]:
+        with pytest.raises(ValueError, match=needle):
+            Hand.approach_pose(bad, 0.0, [0, 0, 0])
+    with pytest.raises(ValueError, match="palm"):
+        Hand.approach_pose([0, 0, -1], 0.0, [0, np.inf, 0])

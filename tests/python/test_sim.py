@@ -181,6 +181,36 @@ def test_bad_input_raises_value_error(barrett):
     assert b.joint_angles.shape == (0, 7) and b.contacts.point.shape == (0, 3) and b.contacts.offsets.tolist() == [0]
 
 
+def test_approach_bindings_check_shapes_and_name_the_argument(barrett):
+    V, F = box([-0.03, -0.03, 0], [0.03, 0.03, 0.06])
+    sim = GraspSimulator(barrett, V, F)
+    D, P = np.array([[0, 0, -1.0], [1.0, 0, -1.0]]), np.array([[0, 0, 0.03], [0, 0, 0.03]])
+    for call, needle in [
+        (lambda: sim.approach([0, 0], [0, 0, 0.03]), "direction"),
+        (lambda: sim.approach([0, 0, -1], np.zeros((1, 3))), "target"),
+        (lambda: sim.approach([0, 0, 0], [0, 0, 0.03]), "direction"),
+        (lambda: sim.approach_batch(D[:, :2], P), "directions"),
+        (lambda: sim.approach_batch(D, P[:1]), "targets"),
+        (lambda: sim.approach_batch(D, P, rolls=np.zeros(3)), "rolls"),
+        (lambda: sim.approach_batch(D, P, threads=-1), "threads"),
+    ]:
+        with pytest.raises(ValueError, match=f"^{needle}"):
+            call()
+    # rolls: a number is every approach's roll
+    b1 = sim.approach_batch(D, P, rolls=0.4, spread=0.3)
+    b2 = sim.approach_batch(D, P, rolls=[0.4, 0.4], spread=0.3, threads=2)
+    np.testing.assert_array_equal(b1.joint_angles, b2.joint_angles)
+    g = sim.approach(D[1], P[1], roll=0.4, spread=0.3)
+    assert isinstance(g, GraspResult) and isinstance(b1, GraspBatch)
+    np.testing.assert_array_equal(g.joint_angles, b1.joint_angles[1])
+    assert g.stopped_by_table == b1.stopped_by_table[1] and b1.stopped_by_table.shape == (2,)
+    # contacts carry their triangle (-1 on the table)
+    t = sim.top_grasp(0.0, 0.0, 0.0, spread=0.0)
+    c = t.contacts
+    assert c.triangle.dtype == np.int32 and len(c.triangle) == len(c.point)
+    assert np.all((c.triangle == -1) == c.on_table) and np.all(c.triangle < len(F))
+
+
 def test_every_option_reaches_the_simulator(barrett):
     V, F = box([-0.03, -0.03, 0], [0.03, 0.03, 0.06])
     o = make_options(table=False, contact_tolerance=5e-4, rel_err=0.01, bv=SimOptions.BoundingVolume.RSS,

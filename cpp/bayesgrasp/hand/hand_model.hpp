@@ -132,7 +132,7 @@ class HandModel {
   /// (top_grasp_pose) tilted by the smallest rotation taking world -z onto the direction;
   /// equivalently, roll turns the hand right-handedly about -direction (for direction -z it is
   /// the top grasp's yaw, exactly: the same matrix). For direction +z (from below) the tilt is a
-  /// half turn about world x. Throws std::invalid_argument naming `direction` (zero or not
+  /// half turn about world x (the hand's rotation is then Rz(-roll)). Throws std::invalid_argument naming `direction` (zero or not
   /// finite), `roll` or `palm` (not finite).
   static Iso3 approach_pose(const Vec3& direction, double roll, const Vec3& palm);
 
