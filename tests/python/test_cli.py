@@ -161,3 +161,91 @@ def test_captured_view_of_an_object_sees_only_that_object():
     assert np.all(np.abs(p[:, :2]) < half[:2] + 0.006) and np.all(p[:, 2] > 0.003)
     with pytest.raises(ValueError, match="pose"):
         capture_view("cube", (1.0, 2.0))
+
+
+# ---- grasp: approaches and hand poses ------------------------------------------------------------
+
+TOP_KEYS = ["object", "object_pose", "top", "hand", "joint_angles", "joint_names", "contacts", "epsilon", "volume",
+            "lifted", "lift_displacement", "collision_at_start", "hand_pose"]
+
+
+def grasp_json(capsys, *args):
+    assert main(["grasp", *args, "--no-lift", "--json"]) == 0
+    return json.loads(capsys.readouterr().out)
+
+
+def test_grasp_top_json_keeps_its_keys_and_equals_the_approach_along_minus_z(capsys):
+    top = grasp_json(capsys, "--object", "mug", "--top", "0.01,0,0.3", "--object-pose", "0.05,0,0")
+    assert list(top)[:len(TOP_KEYS)] == TOP_KEYS
+    assert top["mode"] == "top" and top["approach"] is None and top["stopped_by_table"] is False
+    world = grasp_json(capsys, "--object", "mug", "--top", "0.06,0,0.3", "--object-pose", "0.05,0,0",
+                       "--frame", "world")
+    a = grasp_json(capsys, "--object", "mug", "--approach", "0,0,-1", "--roll", "0.3", "--at", "0.06,0,0",
+                   "--object-pose", "0.05,0,0", "--frame", "world")
+    assert world["joint_angles"] == a["joint_angles"] and world["hand_pose"] == a["hand_pose"]
+    # the object frame's top grasp at (0.01, 0, 0.3) is the world's at (0.06, 0, 0.3)
+    np.testing.assert_allclose(top["joint_angles"], world["joint_angles"], atol=1e-9)
+
+
+def test_grasp_side_approach_of_the_cylinder(capsys, tmp_path):
+    png = tmp_path / "side.png"
+    assert main(["grasp", "--object", "cylinder", "--approach", "2,0,0", "--at", "0,0,0.06", "--spread", "0",
+                 "--no-lift", "--json", "--png", str(png)]) == 0
+    d = json.loads(capsys.readouterr().out)
+    assert set(TOP_KEYS) <= set(d) and d["mode"] == "approach" and d["frame"] == "object"
+    assert d["approach"] == {"direction": [2.0, 0.0, 0.0], "roll": 0.0, "target": [0.0, 0.0, 0.06]}
+    H = np.array(d["hand_pose"])
+    np.testing.assert_allclose(H[:3, 2], [1, 0, 0], atol=1e-12)             # approaching along +x
+    assert -0.035 - 2e-4 < H[0, 3] < -0.035 and d["collision_at_start"] is False
+    assert {c["link_name"] for c in d["contacts"]} >= {"palm", "finger1/distal", "finger2/distal", "finger3/distal"}
+    assert all(c["part"] == "body" and c["triangle"] >= 0 for c in d["contacts"])
+    assert png.exists() and png.stat().st_size > 1000
+
+
+def test_grasp_from_a_pose_file(capsys, tmp_path):
+    T = [[1, 0, 0, 0.0], [0, -1, 0, 0.0], [0, 0, -1, 0.2], [0, 0, 0, 1]]   # palm down 20 cm above the origin
+    (tmp_path / "list.json").write_text(json.dumps(T))
+    (tmp_path / "dict.json").write_text(json.dumps({"pose": T}))
+    a = grasp_json(capsys, "--object", "cube", "--pose", str(tmp_path / "list.json"), "--object-pose", "0.1,0,0")
+    b = grasp_json(capsys, "--object", "cube", "--pose", str(tmp_path / "dict.json"), "--object-pose", "0.1,0,0")
+    assert a["mode"] == "pose" and a["pose"] == T and a["joint_angles"] == b["joint_angles"]
+    np.testing.assert_allclose(a["hand_pose_object"], T, atol=1e-12)
+    np.testing.assert_allclose(np.array(a["hand_pose"])[:3, 3], [0.1, 0.0, 0.2], atol=1e-12)
+    w = grasp_json(capsys, "--object", "cube", "--pose", str(tmp_path / "list.json"), "--object-pose", "0.1,0,0",
+                   "--frame", "world")
+    np.testing.assert_allclose(w["hand_pose"], T, atol=1e-12)
+
+
+@pytest.mark.parametrize("args, needle", [
+    (["--approach", "0,0,0"], "--approach: direction"),
+    (["--approach", "0,0,-1", "--at", "0,0,-0.05"], "--approach: target: below the table"),
+    (["--approach", "0,0,-1", "--at", "2,0,0.05"], "--approach: target: off the table"),
+    (["--approach", "0,0"], "--approach"),
+    (["--top", "0,0,0", "--roll", "1"], "--roll: only with --approach"),
+    (["--pose", "NOFILE"], "--pose: cannot read"),
+    (["--pose", "BAD"], "--pose: hand_pose: pose rotation"),
+    (["--pose", "SHAPE"], "--pose: .* must hold a 4x4"),
+])
+def test_grasp_bad_input_is_a_clear_error(args, needle, tmp_path, capsys):
+    (tmp_path / "bad.json").write_text(json.dumps([[2, 0, 0, 0], [0, 1, 0, 0], [0, 0, 1, 0.2], [0, 0, 0, 1]]))
+    (tmp_path / "shape.json").write_text(json.dumps({"pose": [[1, 0, 0], [0, 1, 0]]}))
+    files = {"NOFILE": str(tmp_path / "none.json"), "BAD": str(tmp_path / "bad.json"), "SHAPE": str(tmp_path / "shape.json")}
+    assert main(["grasp", "--object", "cube", "--no-lift", *[files.get(a, a) for a in args]]) == 2
+    err = capsys.readouterr().err
+    import re
+    assert re.search(needle, err), err
+
+
+@pytest.mark.parametrize("args, needle", [
+    ([], "one of the arguments --top --approach --pose is required"),
+    (["--top", "0,0,0", "--approach", "0,0,-1"], "not allowed with"),
+])
+def test_grasp_needs_exactly_one_of_top_approach_pose(args, needle, capsys):
+    with pytest.raises(SystemExit) as e:
+        main(["grasp", "--object", "cube", *args])
+    assert e.value.code == 2 and needle in capsys.readouterr().err
+
+
+def test_grasp_start_in_the_table_is_reported_not_an_error(capsys):
+    d = grasp_json(capsys, "--object", "cube", "--approach", "1,0,0", "--at", "0,0,0.01")
+    assert d["collision_at_start"] is True and d["contacts"] == [] and d["epsilon"] == 0.0

@@ -1,60 +1,170 @@
-"""``bayesgrasp grasp``: close the hand on an object at a top-grasp pose; quality and lift test."""
+"""``bayesgrasp grasp``: close the hand on an object from a top grasp, an approach direction or a
+given hand pose; quality and lift test.
+
+Exactly one of:
+
+* ``--top X,Y,YAW``: palm down at (x, y) with yaw, descending along -z to the first contact;
+* ``--approach DX,DY,DZ [--roll R] [--at X,Y,Z]``: the open hand moves along the direction (its
+  +z) on the line through the target (default: the centre of the object's bounding box) until the
+  first contact with the object or the table, then closes; the roll turns the hand about
+  -direction (roll 0: the palm-down top-grasp hand tilted by the smallest rotation taking -z
+  onto the direction; ``--approach 0,0,-1 --roll YAW --at X,Y,0`` is ``--top X,Y,YAW``);
+* ``--pose FILE.json``: the hand closes at a 4x4 pose (a JSON list of 4 rows, or
+  ``{"pose": [...]}``).
+
+Everything is in the object's frame unless ``--frame world``.
+"""
 from __future__ import annotations
 
 import json
+from pathlib import Path
 
 import numpy as np
 
-from .args import floats
+from .args import CliError, floats, output_file
 
 
 def add(sub) -> None:
-    g = sub.add_parser("grasp", help="close the hand at a top-grasp pose and report the result")
+    g = sub.add_parser("grasp", help="close the hand from a top grasp, an approach or a hand pose and report the result",
+                       description=__doc__)
     g.add_argument("--object", required=True, help="built-in object name (see `bayesgrasp objects`) or mesh file")
-    g.add_argument("--top", required=True, metavar="X,Y,YAW",
-                   help="top grasp relative to the object's origin: metres, metres, radians")
+    mode = g.add_mutually_exclusive_group(required=True)
+    mode.add_argument("--top", metavar="X,Y,YAW", help="top grasp: metres, metres, radians")
+    mode.add_argument("--approach", metavar="DX,DY,DZ", help="approach direction (any length but zero)")
+    mode.add_argument("--pose", metavar="FILE.json", help="4x4 hand pose: a JSON list of 4 rows or {\"pose\": ...}")
+    g.add_argument("--roll", type=float, default=None, help="with --approach: roll about -direction (radians; default 0)")
+    g.add_argument("--at", metavar="X,Y,Z", default=None,
+                   help="with --approach: a point on the palm's line of motion (default: the centre of the object's "
+                        "bounding box)")
+    g.add_argument("--frame", choices=["object", "world"], default="object",
+                   help="frame of --top, --approach/--roll/--at and --pose (default: the object's)")
     g.add_argument("--object-pose", default="0,0,0", metavar="X,Y,YAW", help="object pose on the table")
     g.add_argument("--spread", type=float, default=None, help="finger spread (radians); default: the hand's")
+    g.add_argument("--standoff", type=float, default=0.0,
+                   help="with --top / --approach: back off this far from the first contact before closing (m)")
     g.add_argument("--hand", default="barrett_bh8", help="hand file name or path")
     g.add_argument("--keep-origin", action="store_true", help="keep a loaded mesh's own origin")
     g.add_argument("--no-lift", action="store_true", help="skip the physical lift test")
     g.add_argument("--json", action="store_true", help="print one JSON object")
+    g.add_argument("--png", default=None, metavar="FILE", help="write a PNG of the hand, the object and the contacts")
     g.set_defaults(run=run)
 
 
 def run(args) -> int:
     from ..world import World
 
-    top = floats(args.top, 3, "--top")
+    if args.approach is None and (args.roll is not None or args.at is not None):
+        raise CliError(f"{'--roll' if args.roll is not None else '--at'}: only with --approach")
+    png = output_file(args.png, "--png")
     pose = floats(args.object_pose, 3, "--object-pose")
+    request = _request(args)
     # load_object names the problem (unknown name, missing file, not a mesh) in a ValueError
-    world = World.single(args.object, pose=pose, keep_origin=args.keep_origin, hand=args.hand)
-    g = world.grasp(*top, spread=args.spread, lift=not args.no_lift).to_dict()
+    world = World.single(args.object, pose=pose, keep_origin=args.keep_origin, hand=args.hand,
+                         standoff=args.standoff)
+    grasp = _grasp(world, args, request)
+    g = grasp.to_dict()
     out = {
-        "object": args.object, "object_pose": pose, "top": top, "hand": world.hand.name,
+        "object": args.object, "object_pose": pose, "top": request.get("top"), "hand": world.hand.name,
         "joint_angles": [float(v) for v in g["joint_angles"]],
         "joint_names": list(world.hand.core.joint_names),
         "contacts": g["contacts"], "epsilon": g["epsilon"], "volume": g["volume"],
         "lifted": g["lifted"], "lift_displacement": g["lift_displacement"],
         "collision_at_start": g["collision_at_start"],
         "hand_pose": np.asarray(g["hand_pose"]).tolist(),
+        "mode": request["mode"], "frame": args.frame, "approach": request.get("approach"), "pose": request.get("pose"),
+        "stopped_by_table": g["stopped_by_table"], "hand_pose_object": np.asarray(g["hand_pose_object"]).tolist(),
     }
     if args.json:
         print(json.dumps(out))
     else:
-        _print(out, args.object, pose, top)
+        _print(out, args.object, pose)
+    if png:
+        from ..viz import plot_grasp
+
+        plot_grasp(world, grasp, png, title=f"{world.hand.name} on {args.object}: {_describe(out)}")
+        if not args.json:
+            print(f"saved {png}")
     return 0
 
 
-def _print(out: dict, name: str, pose, top) -> None:
-    print(f"{out['hand']} on {name} at object pose {pose}, top grasp {top}")
+def _request(args) -> dict:
+    """What to do, parsed from the options (CliError naming the option)."""
+    if args.top is not None:
+        return {"mode": "top", "top": floats(args.top, 3, "--top")}
+    if args.approach is not None:
+        direction = floats(args.approach, 3, "--approach")
+        target = None if args.at is None else floats(args.at, 3, "--at")
+        return {"mode": "approach", "approach": {"direction": direction, "roll": float(args.roll or 0.0),
+                                                 "target": target}}
+    return {"mode": "pose", "pose": _read_pose(args.pose)}
+
+
+def _read_pose(path: str) -> list:
+    try:
+        doc = json.loads(Path(path).read_text())
+    except OSError as e:
+        raise CliError(f"--pose: cannot read {path}: {e.strerror or e}") from None
+    except ValueError as e:
+        raise CliError(f"--pose: {path} is not JSON: {e}") from None
+    m = doc.get("pose") if isinstance(doc, dict) else doc
+    try:
+        M = np.asarray(m, dtype=float)
+    except (TypeError, ValueError):
+        M = np.zeros(0)
+    if M.shape != (4, 4):
+        raise CliError(f"--pose: {path} must hold a 4x4 matrix (a list of 4 rows of 4 numbers, or {{\"pose\": ...}})")
+    return M.tolist()
+
+
+def _grasp(world, args, request):
+    """The world's grasp for the request; the world's ValueErrors (direction of zero length,
+    target off the table, a pose that is not rigid, ...) are prefixed with the option."""
+    lift = not args.no_lift
+    try:
+        if request["mode"] == "top":
+            x, y, yaw = request["top"]
+            if args.frame == "object":
+                return world.grasp(x, y, yaw, spread=args.spread, lift=lift)
+            return world.approach([0.0, 0.0, -1.0], [x, y, 0.0], roll=yaw, spread=args.spread, frame="world", lift=lift)
+        if request["mode"] == "approach":
+            a = request["approach"]
+            if a["target"] is None:
+                a["target"] = _box_centre(world, args.frame)
+            return world.approach(a["direction"], a["target"], roll=a["roll"], spread=args.spread, frame=args.frame,
+                                  lift=lift)
+        return world.grasp_pose(request["pose"], spread=args.spread, frame=args.frame, lift=lift)
+    except ValueError as e:
+        option = {"top": "--top", "approach": "--approach", "pose": "--pose"}[request["mode"]]
+        raise CliError(f"{option}: {e}") from None
+
+
+def _box_centre(world, frame: str) -> list:
+    """Centre of the object's bounding box in the frame."""
+    V = world.object.vertices if frame == "object" else world.vertices
+    return ((V.min(axis=0) + V.max(axis=0)) / 2).tolist()
+
+
+def _describe(out: dict) -> str:
+    if out["mode"] == "top":
+        return f"top grasp {out['top']}"
+    if out["mode"] == "approach":
+        a = out["approach"]
+        fmt = lambda v: "(" + ", ".join(f"{x:.3g}" for x in v) + ")"  # noqa: E731
+        return f"approach {fmt(a['direction'])}, roll {a['roll']:.3g}, through {fmt(a['target'])}"
+    return "closing at the given pose"
+
+
+def _print(out: dict, name: str, pose) -> None:
+    print(f"{out['hand']} on {name} at object pose {pose}, {_describe(out)} ({out['frame']} frame)")
     if out["collision_at_start"]:
         print("  the open hand starts in collision: no grasp")
+    if out["stopped_by_table"]:
+        print("  the approach was stopped by the table before it touched the object")
     print("  joint angles (deg): " + ", ".join(f"{n}={np.degrees(v):.1f}"
                                                  for n, v in zip(out["joint_names"], out["joint_angles"])))
     print(f"  contacts: {len(out['contacts'])}")
     for c in out["contacts"]:
-        where = "table" if c["on_table"] else "object"
+        where = "table" if c["on_table"] else (c["part"] or "object")
         p = ", ".join(f"{v:.4f}" for v in c["point"])
         n = ", ".join(f"{v:.3f}" for v in c["normal"])
         print(f"    {c['link_name']:<18} {where:<6} point ({p})  normal ({n})  penetration {c['penetration']:.2e}")
