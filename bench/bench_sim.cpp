@@ -6,6 +6,12 @@
 //   CloseFixedStep    the same closing GraspIt!-style: 0.01-rad actuator steps with an FCL
 //                     collision check each, bisection on a hit (same FCL backend, same grasps)
 //   TopGraspBatch/threads:2   the batch call with two threads (wall-clock time)
+//   Approach/0        approaches from random directions on the upper hemisphere (the hand
+//                     moves down along -u for u uniform on the upper unit hemisphere), random
+//                     rolls in [-pi, pi), targets within 1 cm of the object's box centre, then
+//                     closing; many stop on the table (counter table_stops) because the open
+//                     hand is wider than the mug is tall
+//   Approach/1        the same approaches restricted to those that reach the object
 // Single-core figures are per CPU second (the process's CPU time), so that other load on the
 // machine does not distort them; the thread benchmark uses wall-clock time.
 // Variants compare FCL representations: OBBRSS vs RSS bounding volumes for the object,
@@ -14,11 +20,14 @@
 // without the box / 26-DOP lower-bound culling.
 //
 // Extra flags (before Google Benchmark's own):
-//   --grasps=N          number of random top grasps (default 256, seed 1)
+//   --grasps=N          number of random top grasps and approaches (default 256, seed 1)
+//   --mesh=FILE         the object (an OBJ file) instead of the default mug below
 //   --export=DIR        write DIR/mug.obj and DIR/sim_grasps.csv (hand pose, spread, our and
 //                       the fixed-step joint angles) for the pybullet peer, and
 //                       DIR/sim_agreement.json (joint-angle agreement, queries per grasp)
-// The mesh is bench/data/mug.obj if it exists, else a generated closed mug-like mesh.
+// The mesh is --mesh, else bench/data/mug.obj if it exists, else a generated closed mug-like
+// mesh. bench/run_sim.sh runs the approach benchmarks on the built-in mug (exported by
+// bench/world_export_mesh.py).
 #include <benchmark/benchmark.h>
 
 #include <algorithm>
@@ -28,6 +37,7 @@
 #include <iostream>
 #include <random>
 #include <sstream>
+#include <stdexcept>
 #include <string>
 
 #include "bayesgrasp/sim/grasp_simulator.hpp"
@@ -143,13 +153,35 @@ struct Setup {
   Eigen::Matrix<double, Eigen::Dynamic, 3, Eigen::RowMajor> xyyaw;
   std::vector<double> spreads;
   std::vector<Iso3> poses;  // hand poses the top grasps reached
+  std::vector<ApproachSpec> approaches;
+  std::vector<int> on_object;  // the approaches that reach the object
 };
 int g_grasps = 256;
+std::string g_mesh;
+
+/// Seeded random approaches: direction -u, u uniform on the upper unit hemisphere; roll in
+/// [-pi, pi); target within 1 cm of the centre of the mesh's bounding box.
+std::vector<ApproachSpec> random_approaches(const TriMesh& mesh, int n) {
+  const Vec3 centre = 0.5 * (mesh.V.colwise().minCoeff() + mesh.V.colwise().maxCoeff()).transpose();
+  std::mt19937 rng(2);
+  std::normal_distribution<double> N;
+  std::uniform_real_distribution<double> U(-1.0, 1.0);
+  std::vector<ApproachSpec> out(n);
+  for (ApproachSpec& a : out) {
+    Vec3 u(N(rng), N(rng), N(rng));
+    u.z() = std::abs(u.z());
+    a.direction = -u.normalized();
+    a.roll = M_PI * U(rng);
+    a.target = centre + 0.01 * Vec3(U(rng), U(rng), U(rng));
+  }
+  return out;
+}
 
 Setup& setup() {
   static Setup s = [] {
     Setup s{HandModel::from_file(kSrc + "/python/bayesgrasp/data/hands/barrett_bh8.json"), {}, {}, {}, {}, {}};
-    const std::string obj = kSrc + "/bench/data/mug.obj";
+    const std::string obj = g_mesh.empty() ? kSrc + "/bench/data/mug.obj" : g_mesh;
+    if (!g_mesh.empty() && !std::ifstream(obj).good()) throw std::runtime_error("--mesh: cannot read " + obj);
     if (std::ifstream(obj).good()) {
       s.mug = read_obj(obj);
       s.mug_source = obj;
@@ -167,6 +199,9 @@ Setup& setup() {
     const GraspSimulator sim(s.hand, s.mug);
     for (int i = 0; i < g_grasps; ++i)
       s.poses.push_back(sim.top_grasp(s.xyyaw(i, 0), s.xyyaw(i, 1), s.xyyaw(i, 2), s.spreads[i]).hand_pose);
+    s.approaches = random_approaches(s.mug, g_grasps);
+    for (int i = 0; i < g_grasps; ++i)
+      if (!sim.approach(s.approaches[i], s.spreads[i]).stopped_by_table) s.on_object.push_back(i);
     return s;
   }();
   return s;
@@ -192,24 +227,27 @@ const char* variant_name(int v) {
   return names[v];
 }
 
-// Runs grasp(i) for every grasp of the set per iteration; counts grasps/s (CPU time), FCL
-// queries and advancement steps per grasp.
+// Runs grasp(i) for every i of `which` (default: every grasp of the set) per iteration;
+// counts grasps/s (CPU time), FCL queries, advancement steps and table stops per grasp.
 template <class Grasp>
-void run_grasps(benchmark::State& state, Grasp grasp) {
-  int64_t n = 0, queries = 0, iterations = 0;
+void run_grasps(benchmark::State& state, Grasp grasp, const std::vector<int>* which = nullptr) {
+  int64_t n = 0, queries = 0, iterations = 0, table_stops = 0;
+  const int count = which ? static_cast<int>(which->size()) : g_grasps;
   for (auto _ : state) {
-    for (int i = 0; i < g_grasps; ++i) {
-      const GraspResult r = grasp(i);
+    for (int k = 0; k < count; ++k) {
+      const GraspResult r = grasp(which ? (*which)[k] : k);
       queries += r.distance_queries;
       iterations += r.iterations;
+      table_stops += r.stopped_by_table;
       benchmark::DoNotOptimize(r.joints.data());
     }
-    n += g_grasps;
+    n += count;
   }
   state.SetItemsProcessed(n);
   state.counters["grasps_per_s"] = benchmark::Counter(static_cast<double>(n), benchmark::Counter::kIsRate);
   state.counters["queries_per_grasp"] = static_cast<double>(queries) / n;
   state.counters["steps_per_grasp"] = static_cast<double>(iterations) / n;
+  state.counters["table_stops"] = static_cast<double>(table_stops) / n;
 }
 
 void BM_TopGrasp(benchmark::State& state) {
@@ -220,6 +258,17 @@ void BM_TopGrasp(benchmark::State& state) {
   run_grasps(state, [&](int i) { return sim.top_grasp(s.xyyaw(i, 0), s.xyyaw(i, 1), s.xyyaw(i, 2), s.spreads[i]); });
 }
 BENCHMARK(BM_TopGrasp)->DenseRange(0, 5)->Unit(benchmark::kMillisecond);
+
+// Approach/0: every approach; Approach/1: those that reach the object.
+void BM_Approach(benchmark::State& state) {
+  Setup& s = setup();
+  const GraspSimulator sim(s.hand, s.mug);
+  const bool on_object = state.range(0) == 1;
+  state.SetLabel(on_object ? "reaching the object" : "all");
+  run_grasps(state, [&](int i) { return sim.approach(s.approaches[i], s.spreads[i]); },
+             on_object ? &s.on_object : nullptr);
+}
+BENCHMARK(BM_Approach)->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond);
 
 void BM_Close(benchmark::State& state) {
   Setup& s = setup();
@@ -297,6 +346,7 @@ int main(int argc, char** argv) {
   for (int i = 0; i < argc; ++i) {
     if (std::strncmp(argv[i], "--grasps=", 9) == 0) g_grasps = std::max(1, std::atoi(argv[i] + 9));
     else if (std::strncmp(argv[i], "--export=", 9) == 0) export_dir = argv[i] + 9;
+    else if (std::strncmp(argv[i], "--mesh=", 7) == 0) g_mesh = argv[i] + 7;
     else rest.push_back(argv[i]);
   }
   int n = static_cast<int>(rest.size());

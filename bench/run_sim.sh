@@ -7,7 +7,10 @@
 #   2. sim_pybullet.py (BENCH_PY): the same hand (URDF written to bench/results/) closed on the
 #      same mug by pybullet POSITION_CONTROL, same grasps.
 #   3. sim_report.py: medians, ratios -> bench/results/sim.json.
-# Env: BUILD_DIR (holds bench_sim), BENCH_PY (pybullet), BAYESGRASP_PY (unused here).
+#   4. bench_sim on the built-in mug (exported by world_export_mesh.py): approaches from random
+#      directions on the upper hemisphere (all, and those reaching the object) beside top grasps
+#      -> bench/results/bench_sim_approach.json.
+# Env: BUILD_DIR (holds bench_sim), BENCH_PY (pybullet), BAYESGRASP_PY (exports the built-in mug).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 BUILD_DIR=${BUILD_DIR:-build/py}
@@ -20,3 +23,7 @@ export OMP_NUM_THREADS=${OMP_NUM_THREADS:-1}
   --benchmark_out="$OUT/bench_sim.json" --benchmark_out_format=json
 "$BENCH_PY" bench/sim_pybullet.py --results "$OUT" --grasps "${SIM_PYBULLET_GRASPS:-64}"
 "$BENCH_PY" bench/sim_report.py --results "$OUT"
+"${BAYESGRASP_PY:-.venv/bin/python}" bench/world_export_mesh.py mug "$OUT/builtin_mug.obj"
+"$BUILD_DIR/bench_sim" --mesh="$OUT/builtin_mug.obj" --grasps=256 --benchmark_filter='Approach/|TopGrasp/0$' \
+  --benchmark_repetitions=5 --benchmark_report_aggregates_only=true \
+  --benchmark_out="$OUT/bench_sim_approach.json" --benchmark_out_format=json

@@ -9,15 +9,6 @@ namespace bayesgrasp::bind {
 
 namespace {
 
-py::array_t<double> poses_array(const std::vector<Iso3>& poses) {
-  py::array_t<double> out({static_cast<py::ssize_t>(poses.size()), py::ssize_t{4}, py::ssize_t{4}});
-  auto o = out.mutable_unchecked<3>();
-  for (size_t i = 0; i < poses.size(); ++i)
-    for (int r = 0; r < 4; ++r)
-      for (int c = 0; c < 4; ++c) o(static_cast<py::ssize_t>(i), r, c) = poses[i].matrix()(r, c);
-  return out;
-}
-
 Eigen::VectorXd joints_arg(const HandModel& h, const DArray& q) {
   const Eigen::VectorXd v = vector(q, "q");
   h.check_joints(v, 1e-9, "q");
@@ -74,7 +65,7 @@ void def_kinematics(py::class_<HandModel>& hand) {
       .def(
           "link_poses",
           [](const HandModel& h, const DArray& q, const py::object& hand_pose) {
-            return poses_array(h.link_poses(pose_or_identity(hand_pose, "hand_pose"), joints_arg(h, q)));
+            return to_numpy(h.link_poses(pose_or_identity(hand_pose, "hand_pose"), joints_arg(h, q)));
           },
           py::arg("q"), py::arg("hand_pose") = py::none(),
           "(L, 4, 4) poses of every link for joint vector q, in the frame of hand_pose (4x4, default identity).")

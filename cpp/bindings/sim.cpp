@@ -1,5 +1,5 @@
-// Bindings for cpp/bayesgrasp/sim: the grasp simulator (auto-grasp with breakaway, top grasps,
-// batches with the GIL released). Options and results are bound classes; the results' array
+// Bindings for cpp/bayesgrasp/sim: the grasp simulator (auto-grasp with breakaway, approaches
+// and top grasps, batches with the GIL released). Options and results are bound classes; the results' array
 // fields are read-only numpy views of the C++ results (no copies). Arguments are validated by
 // the core (std::invalid_argument becomes ValueError).
 #include <pybind11/stl.h>
@@ -124,8 +124,8 @@ The defaults are what every caller uses; the others exist for tests and benchmar
       .def_readwrite("max_iterations", &SimOptions::max_iterations,
                      "max_iterations : int\n    Advancement steps per finger and per approach (a safety net, >= 1).")
       .def_readwrite("table_clearance", &SimOptions::table_clearance,
-                     "table_clearance : float\n    Top grasps with a table keep the fingers' closing sweep at least "
-                     "this far above it (m); negative: stop at the first contact.")
+                     "table_clearance : float\n    Approaches along -z (top grasps) with a table keep the fingers' "
+                     "closing sweep at least this far above it (m); negative: stop at the first contact.")
       .def_readwrite("prune_queries", &SimOptions::prune_queries,
                      "prune_queries : bool\n    Skip FCL queries whose answer cannot change the result (same "
                      "grasps up to round-off).");
@@ -393,8 +393,8 @@ Args:
            py::arg("standoff") = 0.0, py::call_guard<py::gil_scoped_release>(),
            R"doc(Top grasp: the hand, palm down at (x, y, yaw), moves along -z until any link is within
 the contact tolerance of the object or the table, rises by `standoff` (m, >= 0, default 0: the
-first touching link stays in contact; and by the table clearance) and closes. Its hand_pose is
-where the hand stopped.)doc")
+first touching link stays in contact; and by the table clearance) and closes: the approach along
+-z with roll = yaw through (x, y, any z). Its hand_pose is where the hand stopped.)doc")
       .def(
           "link_object_distance",
           [](const GraspSimulator& s, const DArray& hand_pose, const DArray& q, int link) {

@@ -66,8 +66,9 @@ struct SimOptions {
   enum class LinkGeometry { Segments, Primitives, Meshes };
   LinkGeometry links = LinkGeometry::Segments;
   int max_iterations = 5000;  // per finger and per approach (a safety net), >= 1
-  /// Top grasps with a table: minimum height of the fingers' closing sweep above the table (m);
-  /// negative disables the rule (the hand then stops at the first contact).
+  /// Approaches along -z (top grasps) with a table: minimum height of the fingers' closing
+  /// sweep above the table (m); negative disables the rule (the hand then stops at the first
+  /// contact).
   double table_clearance = 0.005;
   /// Skip FCL queries whose answer cannot change the result (same joint angles and contacts up
   /// to round-off; see sim/query_pruning.hpp): lower bounds carried between advancement steps,
