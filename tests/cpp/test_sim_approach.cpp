@@ -53,7 +53,7 @@ TEST(SimApproach, SidewaysApproachStopsAtTheWall) {
   const Eigen::VectorXd open = hand.coupled_joints(hand.spread_default(), 0.0);
   for (const Vec3& u : {Vec3(1, 0, 0), Vec3(std::sqrt(0.5), std::sqrt(0.5), 0), Vec3(0.6, 0.0, -0.8)}) {
     const Iso3 start = facing(u, Vec3(-0.5, -0.5 * u.y() / u.x(), 0.4 - 0.5 * u.z() / u.x()));
-    const sim::Approach a = sim::approach_until_contact(s, start, u, Vec3::Constant(10.0), open);
+    const sim::Approach a = sim::approach_until_contact(s, start, u, start.translation() + 10.0 * u, open);
     // The hand only translated along u.
     EXPECT_TRUE(a.pose.linear().isApprox(start.linear(), 1e-15));
     const Vec3 moved = a.pose.translation() - start.translation();

@@ -11,6 +11,7 @@ namespace bayesgrasp::sim {
 namespace {
 
 constexpr double kStartGap = 0.01;  // the open hand starts this far before the object's box (m)
+constexpr double kTableReach = 1.0;  // a descending hand past the object looks this far for the table (m)
 
 /// The link distances of one approach step.
 struct StepDistances {
@@ -93,7 +94,8 @@ Approach approach_until_contact(const SimScene& s, const Iso3& start, const Vec3
   // Link poses of the open hand relative to the palm: the approach only translates them.
   const std::vector<Iso3> local = s.hand.link_poses(Iso3::Identity(), open_joints);
   std::vector<Iso3> poses(local.size());
-  const double limit = direction.dot(last);
+  // Past `last` the hand gives up; descending onto a table, only kTableReach further on.
+  const double limit = direction.dot(last) + (descent > 0.0 ? kTableReach : 0.0);
   Vec3 position = start.translation();
   for (int it = 0; it < s.options.max_iterations; ++it) {
     a.pose.translation() = position;
@@ -102,10 +104,13 @@ Approach approach_until_contact(const SimScene& s, const Iso3& start, const Vec3
       a.stopped_by_table = !d.object_touch;
       break;
     }
-    if (!(descent > 0.0) && direction.dot(position) > limit) break;
+    const double u = direction.dot(position);
+    if (u > limit) break;
     const double travel = safe_travel(s, d, poses, a);
     ++a.iterations;
-    const double dz = std::max(travel - 0.5 * tol, 0.0);
+    // (descending, a step ends at most just past the limit: the table may lie far beyond it)
+    double dz = std::max(travel - 0.5 * tol, 0.0);
+    if (descent > 0.0) dz = std::min(dz, limit - u + 1e-9);
     position += dz * direction;
     for (LinkDistance& c : a.distances) c.carried_lower = std::max(0.0, c.lower - dz);
     if (!position.allFinite()) position = last;  // nothing ahead (no table, no link with a distance)

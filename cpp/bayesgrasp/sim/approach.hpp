@@ -18,8 +18,9 @@
 // the target along d. It starts where the open hand's deepest point along d (depth_below_palm)
 // is 1 cm before the nearest corner of the object's bounding box along d (the hand is then
 // clear of the object), moved back further when the direction descends until the open hand is
-// at least 5 mm above the table. Unless the hand descends onto a table, it gives up once the
-// palm is half the open hand's depth past the box's farthest corner along d.
+// at least 5 mm above the table. It gives up once the palm is half the open hand's depth past
+// the box's farthest corner along d (`last`), or, descending onto a table, 1 m further on (the
+// table of a nearly horizontal approach can lie arbitrarily far ahead).
 //
 // Top grasps are the approach along d = -z with the palm-down hand (HandModel::top_grasp_pose).
 // Along d = -z with a table (only there), the palm then stays at least `table_clearance` above
@@ -45,8 +46,8 @@ struct Approach {
 };
 
 /// Moves the open hand (joints `open_joints`) from `start` along unit `direction` to the first
-/// contact. `last` is the farthest palm position on the line of motion: unless the direction
-/// descends onto a table, the hand gives up once it is beyond `last` (it has passed the object).
+/// contact. `last` is the farthest palm position on the line of motion: the hand gives up once
+/// it is beyond `last` (it has passed the object), or, descending onto a table, 1 m beyond it.
 /// The start pose must be collision-free.
 Approach approach_until_contact(const SimScene& s, const Iso3& start, const Vec3& direction, const Vec3& last,
                                 const Eigen::VectorXd& open_joints);

@@ -140,7 +140,8 @@ class GraspSimulator {
   /// table; it moves along the direction until a link is within the contact tolerance of the
   /// object or of the table (only when moving down onto it), backs off by `standoff` (>= 0, m)
   /// along the direction and closes. It gives up (and closes where it is) once the palm has
-  /// passed the object's box by half the open hand's depth with no table ahead. d = -z keeps
+  /// passed the object's box by half the open hand's depth (descending onto a table: by 1 m
+  /// more) without a contact. d = -z keeps
   /// the table-clearance rule of top grasps. A start in collision (the open hand in the table)
   /// is reported (collision_at_start), not an error. Throws std::invalid_argument naming
   /// `direction` (zero or not finite), `roll`, `target` (not finite, or below a table), `spread`
