@@ -4,6 +4,8 @@
 
 #include <Eigen/LU>
 
+#include <omp.h>
+
 #include <cmath>
 #include <limits>
 #include <random>
@@ -30,6 +32,13 @@ void make_data(int N, int D, int P, std::uint64_t seed, Eigen::MatrixXd& X, Eige
       for (int d = 0; d < D; ++d) s += std::sin((1.0 + p + d) * X(i, d));
       Y(i, p) = s + 0.3 * p + nd(rng);
     }
+}
+
+// The rows of A twice, one copy after the other (duplicated training inputs).
+Eigen::MatrixXd twice(const Eigen::MatrixXd& A) {
+  Eigen::MatrixXd out(2 * A.rows(), A.cols());
+  out << A, A;
+  return out;
 }
 
 GPOptions fixed_options(KernelType t = KernelType::SquaredExponential) {
@@ -300,7 +309,7 @@ TEST(GPSample, MarginalAndJointMomentsMatchPrediction) {
   Eigen::MatrixXd Xs(3, 1);
   Xs << -1.0, 0.3, 5.0;
   Eigen::MatrixXd m, v;
-  gp.predict(Xs, m, v, true);
+  gp.predict(Xs, m, v, Predictive::Observation);
   std::mt19937_64 rng(1);
   const int S = 20000;
   for (bool joint : {false, true}) {
@@ -354,9 +363,7 @@ TEST(GPMultiOutput, SharedHyperparametersEqualSeparateFitsAndIndependentModelsWo
 TEST(GPRobustness, DuplicatesZeroNoiseAndExtremeScales) {
   Eigen::MatrixXd X, Y;
   make_data(30, 2, 1, 12, X, Y);
-  Eigen::MatrixXd Xd(60, 2), Yd(60, 1);
-  Xd << X, X;
-  Yd << Y, Y;
+  const Eigen::MatrixXd Xd = twice(X), Yd = twice(Y);
   GPOptions o = fixed_options();
   o.noise = 0.0;
   ExactGP ex(o);
@@ -385,6 +392,40 @@ TEST(GPRobustness, DuplicatesZeroNoiseAndExtremeScales) {
   SparseGP flat(on);
   flat.fit(X, Eigen::MatrixXd::Constant(30, 1, 2.5));
   EXPECT_LT((flat.predict_mean(X).array() - 2.5).abs().maxCoeff(), 1e-6);
+}
+
+TEST(GPThreads, ZeroMeansAllCoresAndGivesTheOneThreadResult) {
+  // threads = 0: every hardware thread (omp_get_num_procs) for batches of >= 2048 inputs; the
+  // predictions are the one-thread predictions bit for bit (each input is computed alone).
+  Eigen::MatrixXd X, Y, Xs, Ys;
+  make_data(200, 3, 2, 61, X, Y);
+  make_data(5000, 3, 1, 62, Xs, Ys);
+  for (const bool sparse : {false, true}) {
+    GPOptions o = fixed_options();
+    o.n_inducing = 30;
+    o.threads = 0;
+    std::unique_ptr<GaussianProcess> all = sparse ? std::unique_ptr<GaussianProcess>(new SparseGP(o))
+                                                  : std::unique_ptr<GaussianProcess>(new ExactGP(o));
+    o.threads = 1;
+    std::unique_ptr<GaussianProcess> one = sparse ? std::unique_ptr<GaussianProcess>(new SparseGP(o))
+                                                  : std::unique_ptr<GaussianProcess>(new ExactGP(o));
+    all->fit(X, Y);
+    one->fit(X, Y);
+    EXPECT_EQ(all->threads(), omp_get_num_procs());
+    EXPECT_EQ(one->threads(), 1);
+    Eigen::MatrixXd ma, va, m1, v1;
+    all->predict(Xs, ma, va);
+    one->predict(Xs, m1, v1);
+    EXPECT_EQ(ma, m1);
+    EXPECT_EQ(va, v1);
+    EXPECT_EQ(all->predict_mean(Xs), one->predict_mean(Xs));
+    one->set_threads(0);
+    EXPECT_EQ(one->threads(), omp_get_num_procs());
+    EXPECT_THROW(one->set_threads(-1), std::invalid_argument);
+  }
+  GPOptions bad;
+  bad.threads = -2;
+  EXPECT_THROW(ExactGP{bad}, std::invalid_argument);
 }
 
 TEST(GPErrors, BadInputIsRejected) {
@@ -463,7 +504,7 @@ TEST(GPFitc, FusedPredictionEqualsDenseFormulaAndBlockwisePath) {
         EXPECT_LT((gp.predict_mean(Xs) - m).cwiseAbs().maxCoeff(), 1e-10);
         // with noise: var + noise
         Eigen::MatrixXd mn, vn;
-        gp.predict(Xs, mn, vn, true);
+        gp.predict(Xs, mn, vn, Predictive::Observation);
         EXPECT_LT(((vn - v).array() - 0.05).abs().maxCoeff(), 1e-12);
       }
     }
@@ -475,9 +516,7 @@ TEST(GPFitc, FusedVarianceNearZeroIsClampedNeverNaN) {
   // agree with the exact GP and with the blockwise path.
   Eigen::MatrixXd X, Y;
   make_data(40, 3, 1, 77, X, Y);
-  Eigen::MatrixXd Xd(80, 3), Yd(80, 1);
-  Xd << X, X;
-  Yd << Y, Y;
+  const Eigen::MatrixXd Xd = twice(X), Yd = twice(Y);
   GPOptions o = fixed_options();
   o.noise = 0.0;
   o.inducing = X;
