@@ -6,8 +6,15 @@
 
 namespace bayesgrasp::optim {
 
-/// Central differences in one batch of 2D rows; step h_k = h * max(1, |x_k|).
-/// Returns the gradient; adds 2D to *evaluations if given.
+/// The central-difference stencil around x: rows 2k and 2k + 1 of `points` are x + h_k e_k and
+/// x - h_k e_k, with the step h_k = h * max(1, |x_k|) in `steps`.
+struct CentralDifferences {
+  RowMatrixXd points;     ///< (2D, D)
+  Eigen::VectorXd steps;  ///< (D,)
+  CentralDifferences(const Eigen::VectorXd& x, double h);
+};
+
+/// The gradient by central differences, the stencil evaluated as one batch of 2D rows.
 Eigen::VectorXd numerical_gradient(Evaluator& eval, const Eigen::VectorXd& x, double h);
 
 struct DescentOptions {
