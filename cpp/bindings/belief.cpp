@@ -174,7 +174,9 @@ void def_belief_updates(py::class_<PyBelief>& c) {
           "Returns the recovery flag.")
       .def(
           "resample",
-          [](PyBelief& b, const std::string& scheme, int n) { b.belief.resample(b.rng, bl::resampling_from_string(scheme), n); },
+          [](PyBelief& b, const std::string& scheme, int n) {
+            b.belief.resample(b.rng, bl::resampling_from_string(scheme), n);
+          },
           "scheme"_a = "systematic", "n"_a = 0,
           "Resamples N (or n > 0) particles: 'systematic', 'stratified' or 'multinomial'; weights become uniform.")
       .def(
@@ -292,10 +294,11 @@ void bind_entropy(py::module_& m) {
 }
 
 /// Binds a planar pose map f(grasps (R, 3 + extra), poses (N, 3)) under `name`.
-void def_pose_map(py::module_& m, const char* name, bl::RowMatrixXd (*f)(const bl::RowMatrixXd&, const bl::RowMatrixXd&),
-                  const char* grasps, const char* doc) {
+using PoseMap = bl::RowMatrixXd (*)(const bl::RowMatrixXd&, const bl::RowMatrixXd&);
+void def_pose_map(py::module_& m, const char* name, PoseMap f, const char* grasps, const char* doc) {
   m.def(
-      name, [f, grasps](const DArray& g, const DArray& poses) { return to_np(f(matrix(g, grasps), matrix(poses, "poses"))); },
+      name,
+      [f, grasps](const DArray& g, const DArray& poses) { return to_np(f(matrix(g, grasps), matrix(poses, "poses"))); },
       py::arg(grasps), "poses"_a, doc);
 }
 

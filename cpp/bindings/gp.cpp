@@ -21,17 +21,10 @@ namespace {
 
 Eigen::MatrixXd cm(const RowMatrixXd& m) { return m; }
 
-/// y may be 1-D (N,) or 2-D (N, P).
-Eigen::MatrixXd outputs(const DArray& y, const char* name, py::ssize_t rows) {
-  if (y.ndim() == 1) {
-    Eigen::VectorXd v = vector(y, name, rows);
-    return v;
-  }
-  RowMatrixXd m = matrix(y, name);
-  if (m.rows() != rows)
-    throw py::value_error(std::string(name) + ": expected " + std::to_string(rows) + " rows, got " +
-                          std::to_string(m.rows()));
-  return m;
+/// y may be 1-D (N,) or 2-D (N, P) (the model checks N against its inputs).
+Eigen::MatrixXd outputs(const DArray& y, const char* name) {
+  if (y.ndim() == 1) return vector(y, name);
+  return cm(matrix(y, name));
 }
 
 /// Prediction inputs: any 2-D finite array (the model checks the column count once fitted).
@@ -68,7 +61,8 @@ void bind_options(py::module_& m) {
           [](GPOptions& o, const std::string& s) { o.mean = mean_type_from_string(s); },
           "mean : str\n    'zero' or 'constant' (one fitted constant per output).")
       .def_readwrite("mean_constant", &GPOptions::mean_constant,
-                     "mean_constant : numpy.ndarray\n    Initial mean constants (P,) for mean 'constant'; empty = automatic.")
+                     "mean_constant : numpy.ndarray\n"
+                     "    Initial mean constants (P,) for mean 'constant'; empty = automatic.")
       .def_readwrite("optimize", &GPOptions::optimize,
                      "optimize : bool\n    Maximise the log marginal likelihood in fit (L-BFGS-B).")
       .def_readwrite("max_iter", &GPOptions::max_iter, "max_iter : int\n    L-BFGS-B iterations, >= 0.")
@@ -81,14 +75,16 @@ void bind_options(py::module_& m) {
       .def_readwrite("threads", &GPOptions::threads,
                      "threads : int\n    OpenMP threads for prediction batches of >= 2048 inputs (0 = all cores).")
       .def_readwrite("n_inducing", &GPOptions::n_inducing,
-                     "n_inducing : int\n    SparseGP: inducing inputs M, >= 1 (capped at the distinct training inputs).")
+                     "n_inducing : int\n"
+                     "    SparseGP: inducing inputs M, >= 1 (capped at the distinct training inputs).")
       .def_readwrite("optimize_inducing", &GPOptions::optimize_inducing,
                      "optimize_inducing : bool\n    SparseGP: optimise the inducing inputs too.")
       .def_readwrite("profile_scale", &GPOptions::profile_scale,
                      "profile_scale : bool\n    SparseGP: optimise with the signal variance profiled out.")
       .def_readwrite("seed", &GPOptions::seed, "seed : int\n    SparseGP: k-means++ seed for the inducing inputs.")
       .def_readwrite("inducing", &GPOptions::inducing,
-                     "inducing : numpy.ndarray\n    SparseGP: initial inducing inputs (M, D) in input units; empty = k-means++.")
+                     "inducing : numpy.ndarray\n"
+                     "    SparseGP: initial inducing inputs (M, D) in input units; empty = k-means++.")
       .def_readwrite("kmeans_iter", &GPOptions::kmeans_iter,
                      "kmeans_iter : int\n    SparseGP: Lloyd iterations after the k-means++ seeding, >= 0.");
 
@@ -145,7 +141,7 @@ void bind_prediction(py::class_<GaussianProcess>& c) {
           "log_predictive_density",
           [](const GaussianProcess& gp, const DArray& X, const DArray& Y) {
             const Eigen::MatrixXd Xm = inputs(X);
-            const Eigen::MatrixXd Ym = outputs(Y, "Y", Xm.rows());
+            const Eigen::MatrixXd Ym = outputs(Y, "Y");
             py::gil_scoped_release nogil;
             return gp.log_predictive_density(Xm, Ym);
           },
@@ -180,7 +176,7 @@ void bind_gp(py::module_& m) {
         "fit",
         [](GaussianProcess& g, const DArray& X, const DArray& y) {
           const Eigen::MatrixXd Xm = cm(matrix(X, "X"));
-          const Eigen::MatrixXd Ym = outputs(y, "y", Xm.rows());
+          const Eigen::MatrixXd Ym = outputs(y, "y");
           py::gil_scoped_release nogil;
           g.fit(Xm, Ym);
         },

@@ -237,73 +237,63 @@ void bind_local_options(py::module_& m) {
                      "record_history : bool\n    Record the value after each iteration.");
 }
 
-void bind_optimisers(py::module_& m) {
+/// Binds a global optimiser f(objective, bounds, options) as name(objective, low, high, options).
+template <class Options>
+void def_global(py::module_& m, const char* name,
+                op::Result (*f)(const op::BatchObjective&, const op::Bounds&, const Options&), const char* doc) {
   m.def(
-      "pso",
-      [](const py::object& objective, const DArray& low, const DArray& high, const op::PSOOptions& o) {
+      name,
+      [f](const py::object& objective, const DArray& low, const DArray& high, const Options& o) {
         const op::Bounds b{vector(low, "low"), vector(high, "high")};
         const op::BatchObjective fun = objective_from(objective);
-        return run([&] { return op::pso(fun, b, o); });
+        return run([&] { return f(fun, b, o); });
       },
-      "objective"_a, "low"_a, "high"_a, "options"_a = op::PSOOptions{},
+      "objective"_a, "low"_a, "high"_a, "options"_a = Options{}, doc);
+}
+
+/// Binds a local optimiser f(fun, x0, bounds, options) as name(fun, x0, low=None, high=None,
+/// options); Fun is a batch objective or batch residuals, made from the Python callable by `make`.
+template <class Fun, class Options>
+void def_local(py::module_& m, const char* name, const char* fun_name, Fun (*make)(const py::object&),
+               op::Result (*f)(const Fun&, const Eigen::VectorXd&, const op::Bounds&, const Options&),
+               const char* doc) {
+  m.def(
+      name,
+      [make, f](const py::object& objective, const DArray& x0, const py::object& low, const py::object& high,
+                const Options& o) {
+        const Eigen::VectorXd x = vector(x0, "x0");
+        const op::Bounds b = bounds_from(low, high);
+        const Fun fun = make(objective);
+        return run([&] { return f(fun, x, b, o); });
+      },
+      py::arg(fun_name), "x0"_a, "low"_a = py::none(), "high"_a = py::none(), "options"_a = Options{}, doc);
+}
+
+void bind_optimisers(py::module_& m) {
+  def_global<op::PSOOptions>(
+      m, "pso", op::pso,
       "Particle swarm optimisation (global best, constriction parameters) of objective over the box\n"
       "[low, high]. objective: a vectorised callable (N, D) -> (N,) called once per iteration with the\n"
       "whole swarm, or a built-in name ('sphere', 'rastrigin', 'ackley', 'rosenbrock').");
-  m.def(
-      "simulated_annealing",
-      [](const py::object& objective, const DArray& low, const DArray& high, const op::AnnealingOptions& o) {
-        const op::Bounds b{vector(low, "low"), vector(high, "high")};
-        const op::BatchObjective fun = objective_from(objective);
-        return run([&] { return op::simulated_annealing(fun, b, o); });
-      },
-      "objective"_a, "low"_a, "high"_a, "options"_a = op::AnnealingOptions{},
+  def_global<op::AnnealingOptions>(
+      m, "simulated_annealing", op::simulated_annealing,
       "Simulated annealing with n_chains Metropolis chains evaluated as one batch per iteration, bounded\n"
       "(reflected) Gaussian proposals with per-chain adaptive step (fraction of the range), geometric\n"
       "cooling T_k = t0 cooling^k (t0 <= 0: std of f over the initial points).");
-  m.def(
-      "firefly",
-      [](const py::object& objective, const DArray& low, const DArray& high, const op::FireflyOptions& o) {
-        const op::Bounds b{vector(low, "low"), vector(high, "high")};
-        const op::BatchObjective fun = objective_from(objective);
-        return run([&] { return op::firefly(fun, b, o); });
-      },
-      "objective"_a, "low"_a, "high"_a, "options"_a = op::FireflyOptions{},
+  def_global<op::FireflyOptions>(
+      m, "firefly", op::firefly,
       "The firefly algorithm (Yang 2008): attractiveness beta0 exp(-gamma r^2), random step alpha (u - 1/2)\n"
       "decaying by alpha_decay per generation; distances and steps in unit-box coordinates.");
-  m.def(
-      "steepest_descent",
-      [](const py::object& objective, const DArray& x0, const py::object& low, const py::object& high,
-         const op::DescentOptions& o) {
-        const Eigen::VectorXd x = vector(x0, "x0");
-        const op::Bounds b = bounds_from(low, high);
-        const op::BatchObjective fun = objective_from(objective);
-        return run([&] { return op::steepest_descent(fun, x, b, o); });
-      },
-      "objective"_a, "x0"_a, "low"_a = py::none(), "high"_a = py::none(), "options"_a = op::DescentOptions{},
+  def_local<op::BatchObjective, op::DescentOptions>(
+      m, "steepest_descent", "objective", objective_from, op::steepest_descent,
       "Steepest descent from x0 with central-difference gradients (one batch of 2D rows) and an Armijo\n"
       "backtracking line search; projected onto [low, high] if given.");
-  m.def(
-      "levenberg_marquardt",
-      [](const py::object& residuals, const DArray& x0, const py::object& low, const py::object& high,
-         const op::LMOptions& o) {
-        const Eigen::VectorXd x = vector(x0, "x0");
-        const op::Bounds b = bounds_from(low, high);
-        const op::BatchResiduals fun = residuals_from(residuals);
-        return run([&] { return op::levenberg_marquardt(fun, x, b, o); });
-      },
-      "residuals"_a, "x0"_a, "low"_a = py::none(), "high"_a = py::none(), "options"_a = op::LMOptions{},
+  def_local<op::BatchResiduals, op::LMOptions>(
+      m, "levenberg_marquardt", "residuals", residuals_from, op::levenberg_marquardt,
       "Levenberg-Marquardt on f(x) = 1/2 |r(x)|^2; residuals: vectorised callable (N, D) -> (N, R); the\n"
       "Jacobian by central differences in one batch (fun = 1/2 |r|^2).");
-  m.def(
-      "trust_region",
-      [](const py::object& objective, const DArray& x0, const py::object& low, const py::object& high,
-         const op::TrustRegionOptions& o) {
-        const Eigen::VectorXd x = vector(x0, "x0");
-        const op::Bounds b = bounds_from(low, high);
-        const op::BatchObjective fun = objective_from(objective);
-        return run([&] { return op::trust_region(fun, x, b, o); });
-      },
-      "objective"_a, "x0"_a, "low"_a = py::none(), "high"_a = py::none(), "options"_a = op::TrustRegionOptions{},
+  def_local<op::BatchObjective, op::TrustRegionOptions>(
+      m, "trust_region", "objective", objective_from, op::trust_region,
       "Dogleg trust region with central-difference gradients and BFGS Hessian updates on a scalar\n"
       "objective (e.g. the negative log posterior of a pose, Eq. 4.4).");
 }

@@ -102,7 +102,7 @@ Args:
     torque_scale: > 0, largest distance from the centre of mass to the surface (m).
     mu: friction coefficient >= 0.
     n_edges: friction-cone edges, >= 3.
-    volume: also compute the 6-D volume (about 15% of the cost); else 0.
+    volume: also compute the 6-D volume (a share of the cost); else 0.
 
 Returns:
     (epsilon, volume) floats.)doc");

@@ -8,8 +8,10 @@
 
 #include <cmath>
 #include <limits>
+#include <memory>
 #include <random>
 #include <string>
+#include <tuple>
 
 #include "bayesgrasp/gp/gp.hpp"
 
@@ -159,35 +161,35 @@ TEST(GPExact, MatchesDirectLinearAlgebra) {
   EXPECT_LT((gp.predict_cov(Xs).diagonal() - var).cwiseAbs().maxCoeff(), 1e-9);
 }
 
-TEST(GPGradient, ExactMatchesFiniteDifferences) {
-  Eigen::MatrixXd X, Y;
-  make_data(35, 2, 2, 5, X, Y);
-  for (KernelType t : {KernelType::SquaredExponential, KernelType::Matern52}) {
-    GPOptions o = fixed_options(t);
-    o.mean = MeanType::Constant;
-    o.lengthscale = Eigen::Vector2d(0.7, 1.4);
-    ExactGP gp(o);
-    gp.fit(X, Y);
-    check_gradient(gp, gp.parameters(), 1e-5);
-  }
-}
+// Analytic gradients against central differences for every model and kernel, constant mean: the
+// exact GP, and FITC with its inducing inputs among the parameters.
+class GPGradientFD : public ::testing::TestWithParam<std::tuple<bool, KernelType>> {};
 
-TEST(GPGradient, FitcMatchesFiniteDifferencesIncludingInducingInputs) {
+TEST_P(GPGradientFD, MatchesFiniteDifferences) {
+  const auto [sparse, kernel] = GetParam();
+  const int D = sparse ? 3 : 2;
   Eigen::MatrixXd X, Y;
-  make_data(80, 3, 2, 6, X, Y);
-  for (KernelType t : {KernelType::SquaredExponential, KernelType::Matern52}) {
-    GPOptions o = fixed_options(t);
-    o.mean = MeanType::Constant;
-    o.lengthscale = Eigen::Vector3d(0.7, 1.4, 1.0);
+  make_data(sparse ? 80 : 35, D, 2, sparse ? 6 : 5, X, Y);
+  GPOptions o = fixed_options(kernel);
+  o.mean = MeanType::Constant;
+  o.lengthscale = Eigen::Vector3d(0.7, 1.4, 1.0).head(D);
+  std::unique_ptr<GaussianProcess> gp;
+  if (sparse) {
     o.n_inducing = 12;
     o.optimize_inducing = true;
     o.normalize_x = true;
-    SparseGP gp(o);
-    gp.fit(X, Y);
-    ASSERT_EQ(gp.parameters().size(), 3 + 2 + 2 + 12 * 3);
-    check_gradient(gp, gp.parameters(), 1e-5);
+    gp = std::make_unique<SparseGP>(o);
+  } else {
+    gp = std::make_unique<ExactGP>(o);
   }
+  gp->fit(X, Y);
+  if (sparse) ASSERT_EQ(gp->parameters().size(), 3 + 2 + 2 + 12 * 3);
+  check_gradient(*gp, gp->parameters(), 1e-5);
 }
+
+INSTANTIATE_TEST_SUITE_P(ModelsAndKernels, GPGradientFD,
+                         ::testing::Combine(::testing::Bool(),
+                                            ::testing::Values(KernelType::SquaredExponential, KernelType::Matern52)));
 
 TEST(GPGradient, FitcMatchesFiniteDifferencesFixedInducingFarFromTheOrigin) {
   // Fixed inducing inputs take the lengthscale-only gradient contraction (expanded around the

@@ -62,7 +62,9 @@ void triangular_left(TriangularLeft routine, const char* what, Triangle triangle
   const int m = as_int(B.rows(), "rows"), n = as_int(B.cols(), "cols");
   const int lda = ld(T), ldb = ld(B);
   const double one = 1.0;
-  routine("L", triangle == Triangle::Lower ? "L" : "U", op == Op::Transpose ? "T" : "N", "N", &m, &n, &one, T.data(), &lda, B.data(), &ldb);
+  const char* uplo = triangle == Triangle::Lower ? "L" : "U";
+  const char* trans = op == Op::Transpose ? "T" : "N";
+  routine("L", uplo, trans, "N", &m, &n, &one, T.data(), &lda, B.data(), &ldb);
 }
 }  // namespace
 

@@ -20,8 +20,9 @@ int threads_for(Eigen::Index n, int threads) { return n >= kParallelPredictionMi
 // same way whatever the allocation's address (an unaligned start is peeled in scalar code).
 class GroupBuffer {
  public:
-  explicit GroupBuffer(Eigen::Index M)
-      : data_(static_cast<double*>(std::aligned_alloc(64, (static_cast<std::size_t>(M) * kGroup * sizeof(double) + 63) / 64 * 64))) {
+  explicit GroupBuffer(Eigen::Index M) {
+    const std::size_t bytes = static_cast<std::size_t>(M) * kGroup * sizeof(double);
+    data_ = static_cast<double*>(std::aligned_alloc(64, (bytes + 63) / 64 * 64));
     if (!data_) throw std::bad_alloc();
   }
   ~GroupBuffer() { std::free(data_); }
@@ -30,7 +31,7 @@ class GroupBuffer {
   double* data() { return data_; }
 
  private:
-  double* data_;
+  double* data_ = nullptr;
 };
 
 // F (M x n): kernel shape between the cache basis and n raw inputs (rows i0.. of X).

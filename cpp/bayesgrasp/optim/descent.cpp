@@ -9,13 +9,20 @@ Eigen::VectorXd project(const Eigen::VectorXd& x, const Bounds& b) {
   return x.cwiseMax(b.low).cwiseMin(b.high);
 }
 
-void validate_start(const Eigen::VectorXd& x0, const Bounds& b) {
+void validate_start(const Eigen::VectorXd& x0, const Bounds& b, double h) {
   if (x0.size() == 0) throw std::invalid_argument("x0: must have at least one entry");
   if (!x0.allFinite()) throw std::invalid_argument("x0: contains NaN or infinity");
   if (b.low.size() || b.high.size()) {
     validate_bounds(b);
     if (b.dim() != x0.size()) throw std::invalid_argument("bounds: dimension differs from x0");
   }
+  if (!(h > 0.0)) throw std::invalid_argument("h: must be positive");
+}
+
+double start_value(Evaluator& eval, const Eigen::VectorXd& x) {
+  const double f = eval.at(x);
+  if (!std::isfinite(f)) throw std::invalid_argument("x0: objective is not finite at the start point");
+  return f;
 }
 
 CentralDifferences::CentralDifferences(const Eigen::VectorXd& x, double h)
@@ -40,15 +47,13 @@ Eigen::VectorXd numerical_gradient(Evaluator& eval, const Eigen::VectorXd& x, do
 
 Result steepest_descent(const BatchObjective& fun, const Eigen::VectorXd& x0_, const Bounds& b,
                         const DescentOptions& o) {
-  validate_start(x0_, b);
-  if (!(o.h > 0.0)) throw std::invalid_argument("h: must be positive");
+  validate_start(x0_, b, o.h);
   if (!(o.t0 > 0.0)) throw std::invalid_argument("t0: must be positive");
   if (!(o.backtrack > 0.0 && o.backtrack < 1.0)) throw std::invalid_argument("backtrack: must be in (0, 1)");
   if (!(o.armijo > 0.0 && o.armijo < 1.0)) throw std::invalid_argument("armijo: must be in (0, 1)");
   Evaluator eval(fun);
   Eigen::VectorXd x = project(x0_, b);
-  double f = eval.at(x);
-  if (!std::isfinite(f)) throw std::invalid_argument("x0: objective is not finite at the start point");
+  double f = start_value(eval, x);
   Result r;
   if (o.record_history) r.history.push_back(f);
   double t = o.t0;

@@ -36,7 +36,10 @@ Result steepest_descent(const BatchObjective& fun, const Eigen::VectorXd& x0, co
 
 /// Clips x into the box (no-op for empty bounds).
 Eigen::VectorXd project(const Eigen::VectorXd& x, const Bounds& b);
-/// Checks x0 is finite and matches the bounds' dimension (if any); validates non-empty bounds.
-void validate_start(const Eigen::VectorXd& x0, const Bounds& b);
+/// Checks x0 is finite and matches the bounds' dimension (if any), non-empty bounds, and the
+/// relative finite-difference step h > 0: what every local optimiser needs.
+void validate_start(const Eigen::VectorXd& x0, const Bounds& b, double h);
+/// The objective at the start point x; throws std::invalid_argument (naming x0) if not finite.
+double start_value(Evaluator& eval, const Eigen::VectorXd& x);
 
 }  // namespace bayesgrasp::optim

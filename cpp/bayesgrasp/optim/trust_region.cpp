@@ -72,8 +72,7 @@ void bfgs_update(Eigen::MatrixXd& B, const Eigen::VectorXd& s, const Eigen::Vect
 
 Result levenberg_marquardt(const BatchResiduals& fun, const Eigen::VectorXd& x0, const Bounds& b,
                            const LMOptions& o) {
-  validate_start(x0, b);
-  if (!(o.h > 0.0)) throw std::invalid_argument("h: must be positive");
+  validate_start(x0, b, o.h);
   if (!(o.lambda0 > 0.0)) throw std::invalid_argument("lambda0: must be positive");
   const int d = static_cast<int>(x0.size());
   ResidualEvaluator ev{fun};
@@ -133,15 +132,13 @@ Result levenberg_marquardt(const BatchResiduals& fun, const Eigen::VectorXd& x0,
 
 Result trust_region(const BatchObjective& fun, const Eigen::VectorXd& x0, const Bounds& b,
                     const TrustRegionOptions& o) {
-  validate_start(x0, b);
-  if (!(o.h > 0.0)) throw std::invalid_argument("h: must be positive");
+  validate_start(x0, b, o.h);
   if (!(o.radius0 > 0.0)) throw std::invalid_argument("radius0: must be positive");
   if (!(o.eta >= 0.0 && o.eta < 0.25)) throw std::invalid_argument("eta: must be in [0, 0.25)");
   const int d = static_cast<int>(x0.size());
   Evaluator eval(fun);
   Eigen::VectorXd x = project(x0, b);
-  double f = eval.at(x);
-  if (!std::isfinite(f)) throw std::invalid_argument("x0: objective is not finite at the start point");
+  double f = start_value(eval, x);
   Eigen::VectorXd g = numerical_gradient(eval, x, o.h);
   Eigen::MatrixXd B = Eigen::MatrixXd::Identity(d, d);
   bool scaled = false;
