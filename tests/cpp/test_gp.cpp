@@ -55,6 +55,23 @@ GPOptions fixed_options(KernelType t = KernelType::SquaredExponential) {
   return o;
 }
 
+// N inputs (and outputs) and every one of them twice (Xd, Yd), with fixed_options() at zero
+// noise: the exact covariance is singular without jitter.
+struct DuplicatedNoiseFree {
+  Eigen::MatrixXd X, Y, Xd, Yd;
+  GPOptions options;
+};
+
+DuplicatedNoiseFree duplicated_noise_free(int N, int D, std::uint64_t seed) {
+  DuplicatedNoiseFree d;
+  make_data(N, D, 1, seed, d.X, d.Y);
+  d.Xd = twice(d.X);
+  d.Yd = twice(d.Y);
+  d.options = fixed_options();
+  d.options.noise = 0.0;
+  return d;
+}
+
 }  // namespace
 
 TEST(GPKernel, SquaredExponentialAndMaternClosedForms) {
@@ -363,11 +380,7 @@ TEST(GPMultiOutput, SharedHyperparametersEqualSeparateFitsAndIndependentModelsWo
 }
 
 TEST(GPRobustness, DuplicatesZeroNoiseAndExtremeScales) {
-  Eigen::MatrixXd X, Y;
-  make_data(30, 2, 1, 12, X, Y);
-  const Eigen::MatrixXd Xd = twice(X), Yd = twice(Y);
-  GPOptions o = fixed_options();
-  o.noise = 0.0;
+  const auto [X, Y, Xd, Yd, o] = duplicated_noise_free(30, 2, 12);
   ExactGP ex(o);
   ex.fit(Xd, Yd);  // singular without jitter
   EXPECT_GT(ex.fit_info().jitter_used, 0.0);
@@ -516,11 +529,7 @@ TEST(GPFitc, FusedVarianceNearZeroIsClampedNeverNaN) {
   // Inducing = training inputs (duplicated), zero noise: the predictive variance at the training
   // inputs is ~0 (rounding may push 1 - |G f|^2 below zero); it must come back >= 0 and finite,
   // agree with the exact GP and with the blockwise path.
-  Eigen::MatrixXd X, Y;
-  make_data(40, 3, 1, 77, X, Y);
-  const Eigen::MatrixXd Xd = twice(X), Yd = twice(Y);
-  GPOptions o = fixed_options();
-  o.noise = 0.0;
+  auto [X, Y, Xd, Yd, o] = duplicated_noise_free(40, 3, 77);
   o.inducing = X;
   SparseGP gp(o);
   gp.fit(Xd, Yd);
