@@ -27,7 +27,8 @@ _c = _core.belief
 
 __all__ = ["ParticleBelief", "planar_pose_bounds", "weight_entropy", "kde_entropy", "expected_posterior_entropy",
            "expected_posterior_entropy_gp", "relative_planar_pose", "absolute_planar_pose",
-           "absolute_planar_pose_paired", "resample_indices", "gp_log_likelihood", "AllZeroLikelihoodWarning"]
+           "absolute_planar_pose_paired", "resample_indices", "gp_log_likelihood", "shape_weights",
+           "AllZeroLikelihoodWarning"]
 
 
 class AllZeroLikelihoodWarning(UserWarning):

@@ -18,6 +18,7 @@ from typing import List, Optional, Sequence, Union
 
 import numpy as np
 
+from .belief import absolute_planar_pose
 from . import physics, quality
 from .hand import Hand
 from .objects import ObjectModel, Scene
@@ -143,13 +144,7 @@ class World:
             raise ValueError(f"grasps: expected shape (N, 3) of (x, y, yaw), got {np.shape(xyyaw)}")
         if not np.all(np.isfinite(g)):
             raise ValueError("grasps: contain NaN or infinity")
-        ox, oy, oyaw = self.scene.planar_pose(self.object_index)
-        c, s = np.cos(oyaw), np.sin(oyaw)
-        out = np.empty_like(g)
-        out[:, 0] = ox + c * g[:, 0] - s * g[:, 1]
-        out[:, 1] = oy + s * g[:, 0] + c * g[:, 1]
-        out[:, 2] = g[:, 2] + oyaw
-        return out
+        return absolute_planar_pose(g, np.asarray(self.scene.planar_pose(self.object_index), dtype=float))
 
     # ---- grasps -------------------------------------------------------------------------
     def grasp(self, x: float, y: float, yaw: float, spread: Optional[float] = None,
