@@ -10,6 +10,7 @@
 
 #include "bayesgrasp/belief/entropy.hpp"
 #include "bayesgrasp/belief/measurement_model.hpp"
+#include "bayesgrasp/belief/model_mixture.hpp"
 #include "bayesgrasp/belief/particles.hpp"
 #include "bayesgrasp/belief/pose_grid.hpp"
 #include "bayesgrasp/belief/relative_pose.hpp"
@@ -378,6 +379,60 @@ void bind_pose_grid(py::module_& m) {
           "channels [mean_c0, mean_c0+k) and its variance in [var_c0, var_c0+k). Returns (h (A,), se (A,)).");
 }
 
+void bind_model_mixture(py::module_& m) {
+  py::class_<bl::ModelPoseOptions>(m, "ModelPoseOptions", "Options of Eq. 4.4's per-model MAP pose update.")
+      .def(py::init<>())
+      .def_readwrite("prior_std", &bl::ModelPoseOptions::prior_std,
+                     "prior_std : ndarray (3,)\n    sd of the Gaussian prior around the previous pose (m, m, rad)")
+      .def_readwrite("measurement_noise", &bl::ModelPoseOptions::measurement_noise,
+                     "measurement_noise : float\n    joint-angle noise sd (rad) added to the predictive variance")
+      .def_readwrite("trust_region", &bl::ModelPoseOptions::trust_region,
+                     "trust_region : TrustRegionOptions\n    the dogleg trust region's options (scaled coordinates)");
+  py::class_<bl::ModelPoseUpdate>(m, "ModelPoseUpdate", "One model's MAP pose after a grasp (Eq. 4.4).")
+      .def_readonly("pose", &bl::ModelPoseUpdate::pose, "pose : ndarray (3,)\n    p_i(t) = (x, y, yaw), yaw in [-pi, pi)")
+      .def_readonly("log_likelihood", &bl::ModelPoseUpdate::log_likelihood,
+                    "log_likelihood : float\n    log L_i of the measurement at p_i(t)")
+      .def_readonly("log_prior", &bl::ModelPoseUpdate::log_prior,
+                    "log_prior : float\n    log N(p_i(t); p_i(t-1), S) up to its constant")
+      .def_readonly("evaluations", &bl::ModelPoseUpdate::evaluations, "evaluations : int\n    objective evaluations")
+      .def_readonly("converged", &bl::ModelPoseUpdate::converged, "converged : bool\n    a tolerance was met");
+  py::class_<bl::ModelWeightUpdate>(m, "ModelWeightUpdate", "Eq. 4.5's weights.")
+      .def_readonly("weights", &bl::ModelWeightUpdate::weights, "weights : ndarray (M,)\n    normalised weights")
+      .def_readonly("underflow", &bl::ModelWeightUpdate::underflow,
+                    "underflow : bool\n    every likelihood was zero: the previous weights were kept");
+  m.def(
+      "map_model_poses",
+      [](const std::vector<const bl::RelativePoseGrid*>& grids, int mean_c0, int var_c0, int k, const DArray& grasp,
+         const DArray& measurement, const DArray& prior_poses, const bl::ModelPoseOptions& o, int threads) {
+        const Eigen::Vector3d g = vector(grasp, "grasp", 3);
+        const Eigen::VectorXd mv = vector(measurement, "measurement");
+        const RowMatrixXd P = matrix(prior_poses, "prior_poses", 3, true);
+        py::gil_scoped_release release;
+        return bl::map_model_poses(grids, bl::MeasurementChannels{mean_c0, var_c0, k}, g, mv, P, o, threads);
+      },
+      "grids"_a, "mean_c0"_a, "var_c0"_a, "k"_a, "grasp"_a, "measurement"_a, "prior_poses"_a,
+      "options"_a = bl::ModelPoseOptions(), "threads"_a = 1,
+      "Eq. 4.4 for every model: its MAP pose after the top grasp `grasp` (x, y, yaw) read `measurement`.");
+  m.def(
+      "measurement_log_likelihood",
+      [](const bl::RelativePoseGrid& g, int mean_c0, int var_c0, int k, const DArray& grasp, const DArray& measurement,
+         const DArray& poses, double noise) {
+        return bl::measurement_log_likelihood(g, bl::MeasurementChannels{mean_c0, var_c0, k}, vector(grasp, "grasp", 3),
+                                              vector(measurement, "measurement"), matrix(poses, "poses", 3, true), noise);
+      },
+      "grid"_a, "mean_c0"_a, "var_c0"_a, "k"_a, "grasp"_a, "measurement"_a, "poses"_a, "measurement_noise"_a = 0.0,
+      "log N(m; mu(G - p), var(G - p) + s_n^2) for poses p (N, 3).");
+  m.def(
+      "update_model_weights",
+      [](const DArray& ll, const DArray& previous, bool recursive) {
+        Eigen::Map<const Eigen::VectorXd> l(ll.data(), ll.ndim() == 1 ? ll.shape(0) : 0);
+        if (ll.ndim() != 1) throw py::value_error("log_likelihoods: expected shape (M,), got " + shape_str(ll));
+        return bl::update_model_weights(l, vector(previous, "previous"), recursive);
+      },
+      "log_likelihoods"_a, "previous"_a, "recursive"_a = false,
+      "Eq. 4.5: w_i = L_i / sum_j L_j (recursive: w_i ~ w_i(t-1) L_i); all zero keeps the previous weights.");
+}
+
 }  // namespace
 
 void bind_belief(py::module_& m) {
@@ -385,6 +440,7 @@ void bind_belief(py::module_& m) {
   bind_entropy(m);
   bind_planar_pose(m);
   bind_pose_grid(m);
+  bind_model_mixture(m);
 }
 
 }  // namespace bayesgrasp::bind
