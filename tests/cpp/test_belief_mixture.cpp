@@ -84,8 +84,13 @@ TEST(ModelMixture, WeightsByEq45PlainRecursiveAndUnderflow) {
   const ModelWeightUpdate none = update_model_weights(Eigen::Vector3d(ninf, ninf, ninf), prev, false);
   EXPECT_TRUE(none.underflow);
   EXPECT_NEAR(none.weights[0], 0.5, 1e-15);
-  // very small likelihoods are fine (the maximum is shifted out)
-  const ModelWeightUpdate tiny = update_model_weights(Eigen::Vector3d(-2000.0, -2000.0 + std::log(3.0), -5000.0), prev, false);
+  // small likelihoods are fine (the maximum is shifted out) ...
+  const ModelWeightUpdate tiny = update_model_weights(Eigen::Vector3d(-700.0, -700.0 + std::log(3.0), -5000.0), prev, false);
+  EXPECT_FALSE(tiny.underflow);
   EXPECT_NEAR(tiny.weights[1], 0.75, 1e-12);
+  // ... but when every one underflows a double the measurement explains nothing: weights kept
+  const ModelWeightUpdate under = update_model_weights(Eigen::Vector3d(-2000.0, -1000.0, -5000.0), prev, false);
+  EXPECT_TRUE(under.underflow);
+  EXPECT_NEAR(under.weights[1], 0.25, 1e-15);
   EXPECT_THROW(update_model_weights(Eigen::Vector3d(NAN, 0, 0), prev, false), std::invalid_argument);
 }

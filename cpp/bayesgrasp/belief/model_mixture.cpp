@@ -13,6 +13,8 @@ namespace bayesgrasp::belief {
 namespace {
 
 constexpr double kLog2Pi = 1.8378770664093453;
+// log of the smallest normal double: a likelihood below it underflows to zero (or subnormal)
+constexpr double kLogMinLikelihood = -708.3964185322641;
 
 void check_channels(const RelativePoseGrid& grid, const MeasurementChannels& ch) {
   if (ch.k < 1 || ch.mean_c0 < 0 || ch.var_c0 < 0 || ch.mean_c0 + ch.k > grid.channels() ||
@@ -120,10 +122,15 @@ ModelWeightUpdate update_model_weights(const Eigen::VectorXd& log_likelihoods, c
   for (Eigen::Index i = 0; i < n; ++i)
     if (std::isnan(log_likelihoods[i]) || log_likelihoods[i] == std::numeric_limits<double>::infinity())
       throw std::invalid_argument("log_likelihoods: NaN or +infinity at index " + std::to_string(i));
+  ModelWeightUpdate out;
+  if (!(log_likelihoods.maxCoeff() > kLogMinLikelihood)) {  // every likelihood underflows: keep w(t-1)
+    out.weights = previous / previous.sum();
+    out.underflow = true;
+    return out;
+  }
   Eigen::VectorXd lw = log_likelihoods;
   if (recursive)
     for (Eigen::Index i = 0; i < n; ++i) lw[i] += previous[i] > 0 ? std::log(previous[i]) : -std::numeric_limits<double>::infinity();
-  ModelWeightUpdate out;
   const double top = lw.maxCoeff();
   if (!std::isfinite(top)) {
     out.weights = previous / previous.sum();

@@ -63,7 +63,8 @@ struct ModelWeightUpdate {
 };
 
 /// Eq. 4.5 from log-likelihoods (stable: shifted by their maximum). recursive: w ~ w(t-1) L.
-/// Every likelihood zero (all -inf): the previous weights are kept and underflow is set.
+/// Every likelihood underflowing (all below the smallest normal double, e.g. an absurd
+/// measurement): the previous weights are kept and underflow is set.
 ModelWeightUpdate update_model_weights(const Eigen::VectorXd& log_likelihoods, const Eigen::VectorXd& previous,
                                        bool recursive);
 
