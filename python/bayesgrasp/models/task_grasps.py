@@ -92,12 +92,20 @@ def sample_targets(obj: ObjectModel, parts: Sequence[str], n: int, rng: np.rando
     return P[:, 0] + u[:, None] * (P[:, 1] - P[:, 0]) + v[:, None] * (P[:, 2] - P[:, 0])
 
 
+def object_contact_parts(batch, i: int) -> List[str]:
+    """The part names of grasp i's object contacts in a World grasp batch (table contacts left out)."""
+    off = np.asarray(batch.contacts.offsets)
+    on_table = np.asarray(batch.contacts.on_table, bool)[off[i]:off[i + 1]]
+    parts = batch.contact_part[off[i]:off[i + 1]]
+    return [str(p) for p, t in zip(parts, on_table) if not t]
+
+
 def _rule_ok(batch, rule: TaskRule) -> np.ndarray:
     """Per grasp of a world batch: started free, touched the object (not stopped by the table),
     object contacts as the rule allows."""
     ok = ~np.asarray(batch.collision_at_start, bool) & ~np.asarray(batch.stopped_by_table, bool)
     for i in np.flatnonzero(ok):
-        ok[i] = rule.contacts_ok(batch.object_contact_parts(i))
+        ok[i] = rule.contacts_ok(object_contact_parts(batch, i))
     return ok
 
 
@@ -114,9 +122,9 @@ def generate_task_grasps(obj: Union[str, ObjectModel], rule: TaskRule, hand: str
         d = sample_directions(rule, s.candidates, rng)
         t = sample_targets(o, rule.targets, s.candidates, rng)
         roll = rng.uniform(0, 2 * np.pi, s.candidates)
-        b = world.grasp_approaches(d, t, roll, spread=spread, standoff=s.standoff)
+        b = world.approach_batch(d, t, roll, spread=spread, standoff=s.standoff)
         ok = _rule_ok(b, rule) & (np.asarray(b.epsilon) > 0)
-        found += [(float(b.epsilon[i]), float(spread), np.asarray(b.hand_pose[i])) for i in np.flatnonzero(ok)]
+        found += [(float(b.epsilon[i]), float(spread), np.asarray(b.hand_pose_object[i])) for i in np.flatnonzero(ok)]
     found.sort(key=lambda x: -x[0])
     tested = found[:s.lift_tests]
     say(f"task grasps {o.name}/{rule.name}: {len(found)} candidates obey the rule; lift-testing {len(tested)}")
