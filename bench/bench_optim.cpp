@@ -20,61 +20,52 @@ void report(benchmark::State& st, long long evals) {
       static_cast<double>(evals) * st.iterations(), benchmark::Counter::kIsRate | benchmark::Counter::kInvert,
       benchmark::Counter::OneK::kIs1000);
 }
-}  // namespace
 
-static void BM_PSO_Overhead(benchmark::State& st) {
-  const int d = static_cast<int>(st.range(0));
-  PSOOptions o;
-  o.n_particles = 40;
-  o.max_iter = 1000;
+// Times one run of `optimise` (a callable returning a Result) per benchmark iteration.
+template <class Optimise>
+void time_runs(benchmark::State& st, Optimise optimise) {
   long long evals = 0;
   for (auto _ : st) {
-    const Result r = pso(trivial, box(d), o);
+    const Result r = optimise();
     benchmark::DoNotOptimize(r.f);
     evals = r.evaluations;
   }
   report(st, evals);
+}
+
+// 40 particles x 1000 swarm updates.
+PSOOptions swarm() {
+  PSOOptions o;
+  o.n_particles = 40;
+  o.max_iter = 1000;
+  return o;
+}
+}  // namespace
+
+static void BM_PSO_Overhead(benchmark::State& st) {
+  const Bounds b = box(static_cast<int>(st.range(0)));
+  time_runs(st, [&] { return pso(trivial, b, swarm()); });
 }
 BENCHMARK(BM_PSO_Overhead)->Arg(2)->Arg(4)->Arg(10)->Unit(benchmark::kMillisecond);
 
 static void BM_PSO_Rastrigin(benchmark::State& st) {
-  const int d = static_cast<int>(st.range(0));
-  PSOOptions o;
-  o.n_particles = 40;
-  o.max_iter = 1000;
-  long long evals = 0;
-  for (auto _ : st) {
-    const Result r = pso(rastrigin, box(d), o);
-    benchmark::DoNotOptimize(r.f);
-    evals = r.evaluations;
-  }
-  report(st, evals);
+  const Bounds b = box(static_cast<int>(st.range(0)));
+  time_runs(st, [&] { return pso(rastrigin, b, swarm()); });
 }
 BENCHMARK(BM_PSO_Rastrigin)->Arg(4)->Unit(benchmark::kMillisecond);
 
 static void BM_Annealing_Overhead(benchmark::State& st) {
-  AnnealingOptions o;
-  long long evals = 0;
-  for (auto _ : st) {
-    const Result r = simulated_annealing(trivial, box(static_cast<int>(st.range(0))), o);
-    benchmark::DoNotOptimize(r.f);
-    evals = r.evaluations;
-  }
-  report(st, evals);
+  const Bounds b = box(static_cast<int>(st.range(0)));
+  time_runs(st, [&] { return simulated_annealing(trivial, b, AnnealingOptions{}); });
 }
 BENCHMARK(BM_Annealing_Overhead)->Arg(4)->Unit(benchmark::kMillisecond);
 
 static void BM_Firefly_Overhead(benchmark::State& st) {
+  const Bounds b = box(static_cast<int>(st.range(0)));
   FireflyOptions o;
   o.n_fireflies = 25;
   o.max_iter = 400;
-  long long evals = 0;
-  for (auto _ : st) {
-    const Result r = firefly(trivial, box(static_cast<int>(st.range(0))), o);
-    benchmark::DoNotOptimize(r.f);
-    evals = r.evaluations;
-  }
-  report(st, evals);
+  time_runs(st, [&] { return firefly(trivial, b, o); });
 }
 BENCHMARK(BM_Firefly_Overhead)->Arg(4)->Unit(benchmark::kMillisecond);
 

@@ -3,7 +3,7 @@
   python bench/gp_peers.py data  OUT_DIR        # writes the shared data (npz + raw .bin for C++)
   python bench/gp_peers.py peers OUT_DIR JSON   # times GPy FITC and scikit-learn on that data
 
-Workload (issue 3, section 6): N = 5000 training points in 3-D, M = 200 fixed inducing inputs,
+Workload: N = 5000 training points in 3-D, M = 200 fixed inducing inputs,
 prediction at 100,000 inputs; exact GP vs scikit-learn at N = 2000, 10,000 prediction inputs.
 """
 import json
@@ -12,6 +12,8 @@ import sys
 import time
 
 import numpy as np
+
+from gp_timing import CPU, median_time  # bench/gp_timing.py, beside this script
 
 N, D, M, NS = 5000, 3, 200, 100_000
 N_EXACT, NS_EXACT = 2000, 10_000
@@ -27,21 +29,6 @@ def make_data(out):
     np.savez(os.path.join(out, "gp_data.npz"), X=X, y=y, Z=Z, Xs=Xs)
     for name, a in (("X", X), ("y", y), ("Z", Z), ("Xs", Xs)):
         np.ascontiguousarray(a, dtype=np.float64).tofile(os.path.join(out, name + ".bin"))
-
-
-CPU = {}  # name -> median process CPU time, recorded beside the wall time (shared machines)
-
-
-def median_time(fn, repeat=5, name=None):
-    ts, cs = [], []
-    for _ in range(repeat):
-        t, c = time.perf_counter(), time.process_time()
-        fn()
-        ts.append(time.perf_counter() - t)
-        cs.append(time.process_time() - c)
-    if name:
-        CPU[name] = float(np.median(cs))
-    return float(np.median(ts))
 
 
 def dgemm_gflops():

@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Grasp-quality benchmarks (issue 2, section 5): epsilon + GWS volume per grasp, one core.
+# Grasp-quality benchmarks: epsilon + GWS volume per grasp, one core.
 #  1. C++ (Google Benchmark, bench_quality): grasp_quality() for 2..7 contacts, 8 cone edges
 #     (and 5 contacts with 4 edges), on seeded ellipsoid grasps.
 #  2. The same computation through Python on the same seeded wrench sets: ours
@@ -8,17 +8,9 @@
 #     BENCH_PY) - what a user would write otherwise. Wrenches are generated once by ours and
 #     saved to bench/results/quality_wrenches.npz, so both sides hull identical points.
 # Env (set by bench/bench_all.sh): BUILD_DIR, BAYESGRASP_PY, BENCH_PY.
-set -euo pipefail
-cd "$(dirname "$0")/.."
-BUILD_DIR=${BUILD_DIR:-build/py}
-BAYESGRASP_PY=${BAYESGRASP_PY:-.venv/bin/python}
-BENCH_PY=${BENCH_PY:-.venv-bench/bin/python}
-export OMP_NUM_THREADS=1 OPENBLAS_NUM_THREADS=1 MKL_NUM_THREADS=1
-R=bench/results
-mkdir -p "$R"
+source "$(dirname "$0")/env.sh"
 echo ">> C++: grasp_quality per grasp (CPU time, median of 3)"
-"$BUILD_DIR/bench_quality" --benchmark_repetitions=3 --benchmark_report_aggregates_only=true \
-  --benchmark_out="$R/quality_cpp.json" --benchmark_out_format=json
+run_cpp_bench quality 3
 
 echo ">> ours through Python vs scipy.spatial.ConvexHull on the same wrenches (5 contacts, 8 edges)"
 "$BAYESGRASP_PY" - "$R" <<'PY'

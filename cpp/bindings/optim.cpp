@@ -1,12 +1,10 @@
 // Bindings for the optim concept: PSO, simulated annealing, firefly, steepest descent,
-// Levenberg-Marquardt and a dogleg trust region. Thin: validate, convert, release the GIL and
-// re-acquire it only around calls of a Python objective. The common result object lives in
-// python/bayesgrasp/optim.py.
+// Levenberg-Marquardt and a dogleg trust region, each taking its options class and returning an
+// OptimizeResult. Thin: convert, release the GIL and re-acquire it only around calls of a Python
+// objective; the core validates (its std::invalid_argument becomes ValueError).
 #include <pybind11/eigen.h>
 #include <pybind11/pybind11.h>
 #include <pybind11/stl.h>
-
-#include <limits>
 
 #include "bayesgrasp/optim/annealing.hpp"
 #include "bayesgrasp/optim/firefly.hpp"
@@ -22,26 +20,44 @@ namespace op = bayesgrasp::optim;
 
 namespace {
 
-constexpr double kNegInf = -std::numeric_limits<double>::infinity();
+/// What every optimiser returns to Python: op::Result with numpy arrays (owned, writable).
+struct OptimizeResult {
+  py::array_t<double> x, history;
+  double fun = 0.0;
+  int nit = 0;
+  long long nfev = 0;
+  bool converged = false;
+  std::string message;
+};
+
+OptimizeResult to_python(const op::Result& r) {
+  OptimizeResult out;
+  out.x = py::array_t<double>(r.x.size(), r.x.data());
+  out.history = py::array_t<double>(static_cast<py::ssize_t>(r.history.size()), r.history.data());
+  out.fun = r.f;
+  out.nit = r.iterations;
+  out.nfev = r.evaluations;
+  out.converged = r.converged;
+  out.message = r.message;
+  return out;
+}
+
+/// Copies a batch of candidates into a new numpy array (the argument of a Python callback).
+py::array_t<double> candidates(const op::RowMatrixXd& X) {
+  py::array_t<double> arr({X.rows(), X.cols()});
+  std::copy(X.data(), X.data() + X.size(), arr.mutable_data());
+  return arr;
+}
 
 /// A C++ built-in (by name) or a vectorised Python callable (N, D) -> (N,), called with the GIL.
 op::BatchObjective objective_from(const py::object& obj) {
-  if (py::isinstance<py::str>(obj)) {
-    try {
-      return op::builtin_objective(obj.cast<std::string>());
-    } catch (const std::invalid_argument& e) {
-      throw py::value_error(e.what());
-    }
-  }
+  if (py::isinstance<py::str>(obj)) return op::builtin_objective(obj.cast<std::string>());
   if (!PyCallable_Check(obj.ptr()))
     throw py::value_error("objective: expected a callable (N, D) -> (N,) or a built-in name");
   py::function fn = py::reinterpret_borrow<py::function>(obj);
   return [fn](const op::RowMatrixXd& X, Eigen::VectorXd& f) {
     py::gil_scoped_acquire gil;
-    py::array_t<double> arr({X.rows(), X.cols()});
-    std::copy(X.data(), X.data() + X.size(), arr.mutable_data());
-    py::object out = fn(arr);
-    DArray a = py::cast<DArray>(out);
+    DArray a = py::cast<DArray>(fn(candidates(X)));
     if (!(a.ndim() == 1 || (a.ndim() == 2 && a.shape(1) == 1)) || a.shape(0) != X.rows())
       throw py::value_error("objective: must return an array of shape (" + std::to_string(X.rows()) +
                             ",), got " + shape_str(a));
@@ -55,9 +71,7 @@ op::BatchResiduals residuals_from(const py::object& obj) {
   py::function fn = py::reinterpret_borrow<py::function>(obj);
   return [fn](const op::RowMatrixXd& X, op::RowMatrixXd& R) {
     py::gil_scoped_acquire gil;
-    py::array_t<double> arr({X.rows(), X.cols()});
-    std::copy(X.data(), X.data() + X.size(), arr.mutable_data());
-    DArray a = py::cast<DArray>(fn(arr));
+    DArray a = py::cast<DArray>(fn(candidates(X)));
     if (a.ndim() == 1 && X.rows() == 1) {
       R = Eigen::Map<const op::RowMatrixXd>(a.data(), 1, a.shape(0));
       return;
@@ -69,221 +83,232 @@ op::BatchResiduals residuals_from(const py::object& obj) {
   };
 }
 
-op::Bounds bounds_from(const DArray& low, const DArray& high) {
-  op::Bounds b{vector(low, "low"), vector(high, "high")};
-  if (b.low.size() == 0) throw py::value_error("low: must have at least one entry");
-  if (b.high.size() != b.low.size()) throw py::value_error("high: expected the same length as low");
-  for (int i = 0; i < b.dim(); ++i)
-    if (b.low[i] > b.high[i])
-      throw py::value_error("bounds: low > high in dimension " + std::to_string(i) + " (" + std::to_string(b.low[i]) +
-                            " > " + std::to_string(b.high[i]) + ")");
-  return b;
-}
-
-op::Bounds optional_bounds(const py::object& low, const py::object& high, Eigen::Index dim) {
+/// The box [low, high] (validated by the optimiser); both None = unconstrained.
+op::Bounds bounds_from(const py::object& low, const py::object& high) {
   if (low.is_none() && high.is_none()) return {};
   if (low.is_none() || high.is_none()) throw py::value_error("bounds: give both low and high, or neither");
-  op::Bounds b = bounds_from(py::cast<DArray>(low), py::cast<DArray>(high));
-  if (b.dim() != dim) throw py::value_error("low: expected the same length as x0");
-  return b;
+  return op::Bounds{vector(py::cast<DArray>(low), "low"), vector(py::cast<DArray>(high), "high")};
 }
 
-op::RowMatrixXd optional_init(const py::object& init, int n, int d) {
-  if (init.is_none()) return {};
-  op::RowMatrixXd m = matrix(py::cast<DArray>(init), "init", d);
-  if (m.rows() != n) throw py::value_error("init: expected " + std::to_string(n) + " rows");
-  return m;
-}
-
-py::dict to_dict(const op::Result& r) {
-  return py::dict("x"_a = r.x, "fun"_a = r.f, "nit"_a = r.iterations, "nfev"_a = r.evaluations,
-                  "history"_a = r.history, "converged"_a = r.converged, "message"_a = r.message);
-}
-
-/// Runs f without the GIL, mapping std::invalid_argument to ValueError.
+/// Runs an optimiser without the GIL.
 template <class F>
-op::Result run(F&& f) {
-  try {
+OptimizeResult run(F&& f) {
+  op::Result r;
+  {
     py::gil_scoped_release release;
-    return f();
-  } catch (const std::invalid_argument& e) {
-    throw py::value_error(e.what());
+    r = f();
   }
+  return to_python(r);
+}
+
+void bind_result(py::module_& m) {
+  py::class_<OptimizeResult>(m, "OptimizeResult", "What every optimiser reports.")
+      .def_readonly("x", &OptimizeResult::x, "x : numpy.ndarray\n    Best point found (D,).")
+      .def_readonly("fun", &OptimizeResult::fun,
+                    "fun : float\n    Objective at x (for levenberg_marquardt: 1/2 |r|^2).")
+      .def_readonly("nit", &OptimizeResult::nit, "nit : int\n    Iterations done.")
+      .def_readonly("nfev", &OptimizeResult::nfev,
+                    "nfev : int\n    Rows passed to the objective (candidate evaluations).")
+      .def_readonly("history", &OptimizeResult::history,
+                    "history : numpy.ndarray\n    Best value after each iteration (empty unless record_history).")
+      .def_readonly("converged", &OptimizeResult::converged,
+                    "converged : bool\n    A tolerance or the target was met (else the budget ran out).")
+      .def_readonly("message", &OptimizeResult::message, "message : str\n    Why it stopped.")
+      .def("__repr__", [](const OptimizeResult& r) {
+        return "OptimizeResult(x=" + py::repr(r.x).cast<std::string>() +
+               ", fun=" + py::repr(py::float_(r.fun)).cast<std::string>() + ", nit=" + std::to_string(r.nit) +
+               ", nfev=" + std::to_string(r.nfev) + ", converged=" + (r.converged ? "True" : "False") +
+               ", message='" + r.message + "')";
+      });
+}
+
+/// The fields every population optimiser's options share (op::PopulationOptions).
+template <class Options>
+void def_population_fields(py::class_<Options>& c, const char* size_name) {
+  c.def_readwrite("seed", &Options::seed, "seed : int\n    Seed of the optimiser's generator.")
+      .def_readwrite("target", &Options::target, "target : float\n    Stop once the best value is <= target.")
+      .def_readwrite("record_history", &Options::record_history,
+                     "record_history : bool\n    Record the best value after each iteration.")
+      .def_readwrite("init", &Options::init,
+                     (std::string("init : numpy.ndarray\n    Optional (") + size_name +
+                      ", D) starting points, clipped into the box; empty = uniform in the box.")
+                         .c_str());
+}
+
+void bind_global_options(py::module_& m) {
+  py::class_<op::PSOOptions> pso(m, "PSOOptions", "Options of pso (defaults: Clerc & Kennedy's constriction).");
+  pso.def(py::init<>())
+      .def_readwrite("n_particles", &op::PSOOptions::n_particles, "n_particles : int\n    Swarm size, >= 1.")
+      .def_readwrite("max_iter", &op::PSOOptions::max_iter,
+                     "max_iter : int\n    Swarm updates after the initial evaluation, >= 0.")
+      .def_readwrite("inertia", &op::PSOOptions::inertia, "inertia : float\n    Velocity inertia weight.")
+      .def_readwrite("c1", &op::PSOOptions::c1, "c1 : float\n    Cognitive (own best) weight.")
+      .def_readwrite("c2", &op::PSOOptions::c2, "c2 : float\n    Social (swarm best) weight.")
+      .def_readwrite("vmax_fraction", &op::PSOOptions::vmax_fraction,
+                     "vmax_fraction : float\n    Velocity bound as a fraction of the range, > 0.")
+      .def_readwrite("stall_iter", &op::PSOOptions::stall_iter,
+                     "stall_iter : int\n    Stop after this many iterations improving by at most ftol (0: off).")
+      .def_readwrite("ftol", &op::PSOOptions::ftol, "ftol : float\n    Improvement that resets the stall count.");
+  def_population_fields(pso, "n_particles");
+
+  py::class_<op::AnnealingOptions> sa(m, "AnnealingOptions", "Options of simulated_annealing.");
+  sa.def(py::init<>())
+      .def_readwrite("n_chains", &op::AnnealingOptions::n_chains, "n_chains : int\n    Metropolis chains, >= 1.")
+      .def_readwrite("max_iter", &op::AnnealingOptions::max_iter,
+                     "max_iter : int\n    Proposals per chain after the initial evaluation, >= 0.")
+      .def_readwrite("t0", &op::AnnealingOptions::t0,
+                     "t0 : float\n    Initial temperature; <= 0: the std of f over the initial points.")
+      .def_readwrite("cooling", &op::AnnealingOptions::cooling,
+                     "cooling : float\n    Geometric cooling factor T_k = t0 cooling^k, in (0, 1].")
+      .def_readwrite("step", &op::AnnealingOptions::step,
+                     "step : float\n    Initial proposal std as a fraction of the range, > 0.")
+      .def_readwrite("step_min", &op::AnnealingOptions::step_min,
+                     "step_min : float\n    Lower bound of the adapted step (fraction of the range), > 0.")
+      .def_readwrite("step_max", &op::AnnealingOptions::step_max,
+                     "step_max : float\n    Upper bound of the adapted step, >= step_min.")
+      .def_readwrite("adapt_interval", &op::AnnealingOptions::adapt_interval,
+                     "adapt_interval : int\n    Iterations between step adaptations (0 = fixed step).")
+      .def_readwrite("target_acceptance", &op::AnnealingOptions::target_acceptance,
+                     "target_acceptance : float\n    Acceptance rate the step adapts towards, in (0, 1).")
+      .def_readwrite("adapt_factor", &op::AnnealingOptions::adapt_factor,
+                     "adapt_factor : float\n    Step growth / shrink factor, > 1.");
+  def_population_fields(sa, "n_chains");
+
+  py::class_<op::FireflyOptions> ff(m, "FireflyOptions", "Options of firefly (Yang 2008).");
+  ff.def(py::init<>())
+      .def_readwrite("n_fireflies", &op::FireflyOptions::n_fireflies, "n_fireflies : int\n    Population, >= 1.")
+      .def_readwrite("max_iter", &op::FireflyOptions::max_iter,
+                     "max_iter : int\n    Generations after the initial evaluation, >= 0.")
+      .def_readwrite("beta0", &op::FireflyOptions::beta0, "beta0 : float\n    Attractiveness at distance 0, >= 0.")
+      .def_readwrite("gamma", &op::FireflyOptions::gamma,
+                     "gamma : float\n    Light absorption (unit-box coordinates), >= 0.")
+      .def_readwrite("alpha", &op::FireflyOptions::alpha,
+                     "alpha : float\n    Initial random step (fraction of the range), >= 0.")
+      .def_readwrite("alpha_decay", &op::FireflyOptions::alpha_decay,
+                     "alpha_decay : float\n    alpha_k = alpha alpha_decay^k, in (0, 1].");
+  def_population_fields(ff, "n_fireflies");
+}
+
+void bind_local_options(py::module_& m) {
+  py::class_<op::DescentOptions>(m, "DescentOptions", "Options of steepest_descent.")
+      .def(py::init<>())
+      .def_readwrite("max_iter", &op::DescentOptions::max_iter, "max_iter : int\n    Iterations, >= 0.")
+      .def_readwrite("h", &op::DescentOptions::h, "h : float\n    Relative finite-difference step, > 0.")
+      .def_readwrite("t0", &op::DescentOptions::t0, "t0 : float\n    First trial step length, > 0.")
+      .def_readwrite("armijo", &op::DescentOptions::armijo,
+                     "armijo : float\n    Sufficient-decrease constant, in (0, 1).")
+      .def_readwrite("backtrack", &op::DescentOptions::backtrack,
+                     "backtrack : float\n    Step shrink factor, in (0, 1).")
+      .def_readwrite("max_backtrack", &op::DescentOptions::max_backtrack,
+                     "max_backtrack : int\n    Line-search trials per iteration.")
+      .def_readwrite("gtol", &op::DescentOptions::gtol,
+                     "gtol : float\n    Stop when the projected gradient's max-norm is below gtol.")
+      .def_readwrite("ftol", &op::DescentOptions::ftol,
+                     "ftol : float\n    Stop when the relative decrease is below ftol.")
+      .def_readwrite("record_history", &op::DescentOptions::record_history,
+                     "record_history : bool\n    Record the value after each iteration.");
+
+  py::class_<op::LMOptions>(m, "LMOptions", "Options of levenberg_marquardt.")
+      .def(py::init<>())
+      .def_readwrite("max_iter", &op::LMOptions::max_iter, "max_iter : int\n    Iterations, >= 0.")
+      .def_readwrite("h", &op::LMOptions::h, "h : float\n    Relative finite-difference step, > 0.")
+      .def_readwrite("lambda0", &op::LMOptions::lambda0,
+                     "lambda0 : float\n    Initial damping relative to max diag(J^T J), > 0.")
+      .def_readwrite("gtol", &op::LMOptions::gtol, "gtol : float\n    Stop when max |J^T r| < gtol.")
+      .def_readwrite("xtol", &op::LMOptions::xtol, "xtol : float\n    Stop when |dx| < xtol (|x| + xtol).")
+      .def_readwrite("ftol", &op::LMOptions::ftol, "ftol : float\n    Stop when 1/2 |r|^2 < ftol.")
+      .def_readwrite("record_history", &op::LMOptions::record_history,
+                     "record_history : bool\n    Record the value after each iteration.");
+
+  py::class_<op::TrustRegionOptions>(m, "TrustRegionOptions", "Options of trust_region.")
+      .def(py::init<>())
+      .def_readwrite("max_iter", &op::TrustRegionOptions::max_iter, "max_iter : int\n    Iterations, >= 0.")
+      .def_readwrite("h", &op::TrustRegionOptions::h, "h : float\n    Relative finite-difference step, > 0.")
+      .def_readwrite("radius0", &op::TrustRegionOptions::radius0, "radius0 : float\n    Initial trust radius, > 0.")
+      .def_readwrite("max_radius", &op::TrustRegionOptions::max_radius,
+                     "max_radius : float\n    Largest trust radius.")
+      .def_readwrite("eta", &op::TrustRegionOptions::eta,
+                     "eta : float\n    Accept a step when actual / predicted reduction > eta, in [0, 0.25).")
+      .def_readwrite("gtol", &op::TrustRegionOptions::gtol,
+                     "gtol : float\n    Stop when the gradient's max-norm < gtol.")
+      .def_readwrite("xtol", &op::TrustRegionOptions::xtol,
+                     "xtol : float\n    Stop when the trust radius < xtol (|x| + xtol).")
+      .def_readwrite("record_history", &op::TrustRegionOptions::record_history,
+                     "record_history : bool\n    Record the value after each iteration.");
+}
+
+/// Binds a global optimiser f(objective, bounds, options) as name(objective, low, high, options).
+template <class Options>
+void def_global(py::module_& m, const char* name,
+                op::Result (*f)(const op::BatchObjective&, const op::Bounds&, const Options&), const char* doc) {
+  m.def(
+      name,
+      [f](const py::object& objective, const DArray& low, const DArray& high, const Options& o) {
+        const op::Bounds b{vector(low, "low"), vector(high, "high")};
+        const op::BatchObjective fun = objective_from(objective);
+        return run([&] { return f(fun, b, o); });
+      },
+      "objective"_a, "low"_a, "high"_a, "options"_a = Options{}, doc);
+}
+
+/// Binds a local optimiser f(fun, x0, bounds, options) as name(fun, x0, low=None, high=None,
+/// options); Fun is a batch objective or batch residuals, made from the Python callable by `make`.
+template <class Fun, class Options>
+void def_local(py::module_& m, const char* name, const char* fun_name, Fun (*make)(const py::object&),
+               op::Result (*f)(const Fun&, const Eigen::VectorXd&, const op::Bounds&, const Options&),
+               const char* doc) {
+  m.def(
+      name,
+      [make, f](const py::object& objective, const DArray& x0, const py::object& low, const py::object& high,
+                const Options& o) {
+        const Eigen::VectorXd x = vector(x0, "x0");
+        const op::Bounds b = bounds_from(low, high);
+        const Fun fun = make(objective);
+        return run([&] { return f(fun, x, b, o); });
+      },
+      py::arg(fun_name), "x0"_a, "low"_a = py::none(), "high"_a = py::none(), "options"_a = Options{}, doc);
+}
+
+void bind_optimisers(py::module_& m) {
+  def_global<op::PSOOptions>(
+      m, "pso", op::pso,
+      "Particle swarm optimisation (global best, constriction parameters) of objective over the box\n"
+      "[low, high]. objective: a vectorised callable (N, D) -> (N,) called once per iteration with the\n"
+      "whole swarm, or a built-in name ('sphere', 'rastrigin', 'ackley', 'rosenbrock').");
+  def_global<op::AnnealingOptions>(
+      m, "simulated_annealing", op::simulated_annealing,
+      "Simulated annealing with n_chains Metropolis chains evaluated as one batch per iteration, bounded\n"
+      "(reflected) Gaussian proposals with per-chain adaptive step (fraction of the range), geometric\n"
+      "cooling T_k = t0 cooling^k (t0 <= 0: std of f over the initial points).");
+  def_global<op::FireflyOptions>(
+      m, "firefly", op::firefly,
+      "The firefly algorithm (Yang 2008): attractiveness beta0 exp(-gamma r^2), random step alpha (u - 1/2)\n"
+      "decaying by alpha_decay per generation; distances and steps in unit-box coordinates.");
+  def_local<op::BatchObjective, op::DescentOptions>(
+      m, "steepest_descent", "objective", objective_from, op::steepest_descent,
+      "Steepest descent from x0 with central-difference gradients (one batch of 2D rows) and an Armijo\n"
+      "backtracking line search; projected onto [low, high] if given.");
+  def_local<op::BatchResiduals, op::LMOptions>(
+      m, "levenberg_marquardt", "residuals", residuals_from, op::levenberg_marquardt,
+      "Levenberg-Marquardt on f(x) = 1/2 |r(x)|^2; residuals: vectorised callable (N, D) -> (N, R); the\n"
+      "Jacobian by central differences in one batch (fun = 1/2 |r|^2).");
+  def_local<op::BatchObjective, op::TrustRegionOptions>(
+      m, "trust_region", "objective", objective_from, op::trust_region,
+      "Dogleg trust region with central-difference gradients and BFGS Hessian updates on a scalar\n"
+      "objective (e.g. the negative log posterior of a pose, Eq. 4.4).");
 }
 
 }  // namespace
 
 void bind_optim(py::module_& m) {
-  m.def(
-      "pso",
-      [](const py::object& objective, const DArray& low, const DArray& high, int n_particles, int max_iter,
-         double inertia, double c1, double c2, double vmax_fraction, std::uint64_t seed, double target,
-         int stall_iter, double ftol, const py::object& init, bool record_history) {
-        const op::Bounds b = bounds_from(low, high);
-        op::PSOOptions o;
-        o.n_particles = n_particles;
-        o.max_iter = max_iter;
-        o.inertia = finite(inertia, "inertia");
-        o.c1 = finite(c1, "c1");
-        o.c2 = finite(c2, "c2");
-        o.vmax_fraction = positive(vmax_fraction, "vmax_fraction");
-        o.seed = seed;
-        o.target = target;
-        o.stall_iter = stall_iter;
-        o.ftol = ftol;
-        o.init = optional_init(init, n_particles, b.dim());
-        o.record_history = record_history;
-        const op::BatchObjective fun = objective_from(objective);
-        return to_dict(run([&] { return op::pso(fun, b, o); }));
-      },
-      "objective"_a, "low"_a, "high"_a, "n_particles"_a = 40, "max_iter"_a = 200, "inertia"_a = 0.7298,
-      "c1"_a = 1.49618, "c2"_a = 1.49618, "vmax_fraction"_a = 0.5, "seed"_a = 0, "target"_a = kNegInf,
-      "stall_iter"_a = 0, "ftol"_a = 0.0, "init"_a = py::none(), "record_history"_a = false,
-      "Particle swarm optimisation (global best, constriction parameters) of objective over the box\n"
-      "[low, high]. objective: a vectorised callable (N, D) -> (N,) called once per iteration with the\n"
-      "whole swarm, or a built-in name ('sphere', 'rastrigin', 'ackley', 'rosenbrock'). Returns a dict\n"
-      "(x, fun, nit, nfev, history, converged, message).");
-
-  m.def(
-      "simulated_annealing",
-      [](const py::object& objective, const DArray& low, const DArray& high, int n_chains, int max_iter, double t0,
-         double cooling, double step, double step_min, double step_max, int adapt_interval,
-         double target_acceptance, double adapt_factor, std::uint64_t seed, double target, const py::object& init,
-         bool record_history) {
-        const op::Bounds b = bounds_from(low, high);
-        op::AnnealingOptions o;
-        o.n_chains = n_chains;
-        o.max_iter = max_iter;
-        o.t0 = t0;
-        o.cooling = cooling;
-        o.step = step;
-        o.step_min = step_min;
-        o.step_max = step_max;
-        o.adapt_interval = adapt_interval;
-        o.target_acceptance = target_acceptance;
-        o.adapt_factor = adapt_factor;
-        o.seed = seed;
-        o.target = target;
-        o.init = optional_init(init, n_chains, b.dim());
-        o.record_history = record_history;
-        const op::BatchObjective fun = objective_from(objective);
-        return to_dict(run([&] { return op::simulated_annealing(fun, b, o); }));
-      },
-      "objective"_a, "low"_a, "high"_a, "n_chains"_a = 16, "max_iter"_a = 1000, "t0"_a = -1.0, "cooling"_a = 0.98,
-      "step"_a = 0.1, "step_min"_a = 1e-9, "step_max"_a = 0.5, "adapt_interval"_a = 10,
-      "target_acceptance"_a = 0.2, "adapt_factor"_a = 1.5, "seed"_a = 0, "target"_a = kNegInf,
-      "init"_a = py::none(), "record_history"_a = false,
-      "Simulated annealing with n_chains Metropolis chains evaluated as one batch per iteration, bounded\n"
-      "(reflected) Gaussian proposals with per-chain adaptive step (fraction of the range), geometric\n"
-      "cooling T_k = t0 cooling^k (t0 <= 0: std of f over the initial points). Returns a dict.");
-
-  m.def(
-      "firefly",
-      [](const py::object& objective, const DArray& low, const DArray& high, int n_fireflies, int max_iter,
-         double beta0, double gamma, double alpha, double alpha_decay, std::uint64_t seed, double target,
-         const py::object& init, bool record_history) {
-        const op::Bounds b = bounds_from(low, high);
-        op::FireflyOptions o;
-        o.n_fireflies = n_fireflies;
-        o.max_iter = max_iter;
-        o.beta0 = beta0;
-        o.gamma = gamma;
-        o.alpha = alpha;
-        o.alpha_decay = alpha_decay;
-        o.seed = seed;
-        o.target = target;
-        o.init = optional_init(init, n_fireflies, b.dim());
-        o.record_history = record_history;
-        const op::BatchObjective fun = objective_from(objective);
-        return to_dict(run([&] { return op::firefly(fun, b, o); }));
-      },
-      "objective"_a, "low"_a, "high"_a, "n_fireflies"_a = 25, "max_iter"_a = 100, "beta0"_a = 1.0, "gamma"_a = 1.0,
-      "alpha"_a = 0.2, "alpha_decay"_a = 0.97, "seed"_a = 0, "target"_a = kNegInf, "init"_a = py::none(),
-      "record_history"_a = false,
-      "The firefly algorithm (Yang 2008): attractiveness beta0 exp(-gamma r^2), random step alpha (u - 1/2)\n"
-      "decaying by alpha_decay per generation; distances and steps in unit-box coordinates. Returns a dict.");
-
-  m.def(
-      "steepest_descent",
-      [](const py::object& objective, const DArray& x0, const py::object& low, const py::object& high, int max_iter,
-         double h, double t0, double armijo, double backtrack, int max_backtrack, double gtol, double ftol,
-         bool record_history) {
-        const Eigen::VectorXd x = vector(x0, "x0");
-        const op::Bounds b = optional_bounds(low, high, x.size());
-        op::DescentOptions o;
-        o.max_iter = max_iter;
-        o.h = h;
-        o.t0 = t0;
-        o.armijo = armijo;
-        o.backtrack = backtrack;
-        o.max_backtrack = max_backtrack;
-        o.gtol = gtol;
-        o.ftol = ftol;
-        o.record_history = record_history;
-        const op::BatchObjective fun = objective_from(objective);
-        return to_dict(run([&] { return op::steepest_descent(fun, x, b, o); }));
-      },
-      "objective"_a, "x0"_a, "low"_a = py::none(), "high"_a = py::none(), "max_iter"_a = 500, "h"_a = 1e-6,
-      "t0"_a = 1.0, "armijo"_a = 1e-4, "backtrack"_a = 0.5, "max_backtrack"_a = 40, "gtol"_a = 1e-8,
-      "ftol"_a = 1e-14, "record_history"_a = false,
-      "Steepest descent from x0 with central-difference gradients (one batch of 2D rows) and an Armijo\n"
-      "backtracking line search; projected onto [low, high] if given. Returns a dict.");
-
-  m.def(
-      "levenberg_marquardt",
-      [](const py::object& residuals, const DArray& x0, const py::object& low, const py::object& high, int max_iter,
-         double h, double lambda0, double gtol, double xtol, double ftol, bool record_history) {
-        const Eigen::VectorXd x = vector(x0, "x0");
-        const op::Bounds b = optional_bounds(low, high, x.size());
-        op::LMOptions o;
-        o.max_iter = max_iter;
-        o.h = h;
-        o.lambda0 = lambda0;
-        o.gtol = gtol;
-        o.xtol = xtol;
-        o.ftol = ftol;
-        o.record_history = record_history;
-        const op::BatchResiduals fun = residuals_from(residuals);
-        return to_dict(run([&] { return op::levenberg_marquardt(fun, x, b, o); }));
-      },
-      "residuals"_a, "x0"_a, "low"_a = py::none(), "high"_a = py::none(), "max_iter"_a = 200, "h"_a = 1e-6,
-      "lambda0"_a = 1e-3, "gtol"_a = 1e-10, "xtol"_a = 1e-12, "ftol"_a = 1e-15, "record_history"_a = false,
-      "Levenberg-Marquardt on f(x) = 1/2 |r(x)|^2; residuals: vectorised callable (N, D) -> (N, R); the\n"
-      "Jacobian by central differences in one batch. Returns a dict (fun = 1/2 |r|^2).");
-
-  m.def(
-      "trust_region",
-      [](const py::object& objective, const DArray& x0, const py::object& low, const py::object& high, int max_iter,
-         double h, double radius0, double max_radius, double eta, double gtol, double xtol, bool record_history) {
-        const Eigen::VectorXd x = vector(x0, "x0");
-        const op::Bounds b = optional_bounds(low, high, x.size());
-        op::TrustRegionOptions o;
-        o.max_iter = max_iter;
-        o.h = h;
-        o.radius0 = radius0;
-        o.max_radius = max_radius;
-        o.eta = eta;
-        o.gtol = gtol;
-        o.xtol = xtol;
-        o.record_history = record_history;
-        const op::BatchObjective fun = objective_from(objective);
-        return to_dict(run([&] { return op::trust_region(fun, x, b, o); }));
-      },
-      "objective"_a, "x0"_a, "low"_a = py::none(), "high"_a = py::none(), "max_iter"_a = 200, "h"_a = 1e-6,
-      "radius0"_a = 1.0, "max_radius"_a = 1e6, "eta"_a = 1e-4, "gtol"_a = 1e-8, "xtol"_a = 1e-12,
-      "record_history"_a = false,
-      "Dogleg trust region with central-difference gradients and BFGS Hessian updates on a scalar\n"
-      "objective (e.g. the negative log posterior of a pose, Eq. 4.4). Returns a dict.");
-
+  bind_result(m);
+  bind_global_options(m);
+  bind_local_options(m);
+  bind_optimisers(m);
   m.def(
       "evaluate_builtin",
       [](const std::string& name, const DArray& X) {
-        op::BatchObjective f;
-        try {
-          f = op::builtin_objective(name);
-        } catch (const std::invalid_argument& e) {
-          throw py::value_error(e.what());
-        }
+        const op::BatchObjective f = op::builtin_objective(name);
         const op::RowMatrixXd x = matrix(X, "X");
         Eigen::VectorXd v(x.rows());
         f(x, v);

@@ -1,4 +1,6 @@
-// Bindings for cpp/bayesgrasp/quality: grasp wrench space, Ferrari-Canny epsilon, volume.
+// Bindings for cpp/bayesgrasp/quality: grasp wrench space, Ferrari-Canny epsilon, volume. Thin:
+// convert arrays to contacts, release the GIL for the hulls; the core validates the parameters
+// and contacts (its std::invalid_argument becomes ValueError).
 #include <string>
 
 #include "bayesgrasp/quality/wrench_space.hpp"
@@ -9,8 +11,6 @@ namespace bayesgrasp::bind {
 namespace {
 
 QualityParams params(double mu, int n_edges, bool volume) {
-  if (!std::isfinite(mu) || mu < 0.0) throw py::value_error("mu: must be finite and >= 0, got " + std::to_string(mu));
-  if (n_edges < 3) throw py::value_error("n_edges: must be >= 3, got " + std::to_string(n_edges));
   QualityParams p;
   p.mu = mu;
   p.n_edges = n_edges;
@@ -39,23 +39,15 @@ std::pair<RowMatrixXd, RowMatrixXd> points_normals(const DArray& points, const D
   if (P.rows() != N.rows())
     throw py::value_error("points and normals: different numbers of rows (" + std::to_string(P.rows()) + " vs " +
                           std::to_string(N.rows()) + ")");
-  for (Eigen::Index i = 0; i < N.rows(); ++i)
-    if (N.row(i).norm() < 1e-12) throw py::value_error("normals: row " + std::to_string(i) + " is zero");
   return {std::move(P), std::move(N)};
 }
 
-}  // namespace
-
-void bind_quality(py::module_& m) {
-  m.attr("DEFAULT_FRICTION") = kDefaultFriction;
-  m.attr("DEFAULT_CONE_EDGES") = kDefaultConeEdges;
-
+void bind_contact_wrenches(py::module_& m) {
   m.def(
       "contact_wrenches",
       [](const DArray& points, const DArray& normals, const DArray& com, double torque_scale, double mu, int n_edges) {
         auto [P, N] = points_normals(points, normals);
         const Vec3 c = com_arg(com);
-        positive(torque_scale, "torque_scale");
         const Wrenches W = contact_wrenches(contacts_from(P, N, 0, P.rows()), c, torque_scale, params(mu, n_edges, false));
         return to_numpy(W);
       },
@@ -74,14 +66,15 @@ Args:
 Returns:
     (K * n_edges, 6) array (K rows if mu == 0): rows (f, (p - com) x f / torque_scale),
     f = -n + mu (cos a t1 + sin a t2), a = 2 pi j / n_edges (unit normal component).)doc");
+}
 
+void bind_epsilon_volume(py::module_& m) {
   m.def(
       "epsilon_volume",
       [](const DArray& points, const DArray& normals, const DArray& com, double torque_scale, double mu, int n_edges,
          bool volume) {
         auto [P, N] = points_normals(points, normals);
         const Vec3 c = com_arg(com);
-        positive(torque_scale, "torque_scale");
         const QualityParams p = params(mu, n_edges, volume);
         const Contacts cs = contacts_from(P, N, 0, P.rows());
         GraspQuality q;
@@ -109,33 +102,41 @@ Args:
     torque_scale: > 0, largest distance from the centre of mass to the surface (m).
     mu: friction coefficient >= 0.
     n_edges: friction-cone edges, >= 3.
-    volume: also compute the 6-D volume (about 15% of the cost); else 0.
+    volume: also compute the 6-D volume (a share of the cost); else 0.
 
 Returns:
     (epsilon, volume) floats.)doc");
+}
 
+// Contacts of N grasps from (M, 3) points and normals and (N,) counts (sum M).
+std::vector<Contacts> grasps_from(const RowMatrixXd& P, const RowMatrixXd& N, const IArray& counts) {
+  if (counts.ndim() != 1) throw py::value_error("counts: expected shape (N,), got " + shape_str(counts));
+  const py::ssize_t n = counts.shape(0);
+  std::vector<Contacts> grasps(static_cast<size_t>(n));
+  Eigen::Index row = 0;
+  for (py::ssize_t i = 0; i < n; ++i) {
+    const int k = counts.data()[i];
+    if (k < 0) throw py::value_error("counts: entry " + std::to_string(i) + " is negative");
+    if (row + k > P.rows())
+      throw py::value_error("counts: sum exceeds the number of points (" + std::to_string(P.rows()) + ")");
+    grasps[static_cast<size_t>(i)] = contacts_from(P, N, row, row + k);
+    row += k;
+  }
+  if (row != P.rows())
+    throw py::value_error("counts: sum " + std::to_string(row) + " != number of points " + std::to_string(P.rows()));
+  return grasps;
+}
+
+void bind_epsilon_volume_batch(py::module_& m) {
   m.def(
       "epsilon_volume_batch",
       [](const DArray& points, const DArray& normals, const IArray& counts, const DArray& com, double torque_scale,
          double mu, int n_edges, bool volume, int threads) {
         auto [P, N] = points_normals(points, normals);
-        if (counts.ndim() != 1) throw py::value_error("counts: expected shape (N,), got " + shape_str(counts));
+        const std::vector<Contacts> grasps = grasps_from(P, N, counts);
         const Vec3 c = com_arg(com);
-        positive(torque_scale, "torque_scale");
         const QualityParams p = params(mu, n_edges, volume);
-        const py::ssize_t n = counts.shape(0);
-        std::vector<Contacts> grasps(static_cast<size_t>(n));
-        Eigen::Index row = 0;
-        for (py::ssize_t i = 0; i < n; ++i) {
-          const int k = counts.data()[i];
-          if (k < 0) throw py::value_error("counts: entry " + std::to_string(i) + " is negative");
-          if (row + k > P.rows())
-            throw py::value_error("counts: sum exceeds the number of points (" + std::to_string(P.rows()) + ")");
-          grasps[static_cast<size_t>(i)] = contacts_from(P, N, row, row + k);
-          row += k;
-        }
-        if (row != P.rows())
-          throw py::value_error("counts: sum " + std::to_string(row) + " != number of points " + std::to_string(P.rows()));
+        const py::ssize_t n = static_cast<py::ssize_t>(grasps.size());
         std::vector<GraspQuality> q;
         {
           py::gil_scoped_release release;
@@ -158,10 +159,20 @@ Args:
     normals: (M, 3) outward normals.
     counts: (N,) int, number of contacts of each grasp (sum = M; zeros allowed).
     com, torque_scale, mu, n_edges, volume: as in ``epsilon_volume``.
-    threads: OpenMP threads (<= 0: OpenMP's default).
+    threads: OpenMP threads (0 = all cores).
 
 Returns:
     (epsilon (N,), volume (N,)) arrays, equal to the one-by-one results.)doc");
+}
+
+}  // namespace
+
+void bind_quality(py::module_& m) {
+  m.attr("DEFAULT_FRICTION") = kDefaultFriction;
+  m.attr("DEFAULT_CONE_EDGES") = kDefaultConeEdges;
+  bind_contact_wrenches(m);
+  bind_epsilon_volume(m);
+  bind_epsilon_volume_batch(m);
 }
 
 }  // namespace bayesgrasp::bind

@@ -26,7 +26,8 @@ from bayesgrasp import _core
 _c = _core.belief
 
 __all__ = ["ParticleBelief", "planar_pose_bounds", "weight_entropy", "kde_entropy", "expected_posterior_entropy",
-           "expected_posterior_entropy_gp", "relative_planar_pose", "resample_indices", "gp_log_likelihood",
+           "expected_posterior_entropy_gp", "relative_planar_pose", "absolute_planar_pose",
+           "absolute_planar_pose_paired", "resample_indices", "gp_log_likelihood", "shape_weights",
            "AllZeroLikelihoodWarning"]
 
 
@@ -47,6 +48,16 @@ def planar_pose_bounds(x_range: Tuple[float, float], y_range: Tuple[float, float
             [False, False, True])
 
 
+def _flags(wraps):
+    """The wrapping flags as a list (None: no dimension wraps)."""
+    return None if wraps is None else list(wraps)
+
+
+def _core_property(name: str, doc: str) -> property:
+    """A read-only property forwarding to the C++ belief's attribute ``name``."""
+    return property(lambda self: getattr(self._b, name), doc=doc)
+
+
 class ParticleBelief:
     """Weighted particles over [low, high] (wrapping dims for angles), with a seeded generator.
 
@@ -55,7 +66,7 @@ class ParticleBelief:
 
     def __init__(self, particles, low, high, wraps: Optional[Sequence[bool]] = None, log_weights=None, seed: int = 0):
         self._b = _c.ParticleBelief(np.asarray(particles, dtype=float), np.asarray(low, dtype=float),
-                                    np.asarray(high, dtype=float), None if wraps is None else list(wraps),
+                                    np.asarray(high, dtype=float), _flags(wraps),
                                     None if log_weights is None else np.asarray(log_weights, dtype=float),
                                     int(seed))
 
@@ -69,49 +80,26 @@ class ParticleBelief:
     def uniform(cls, low, high, n: int, wraps=None, seed: int = 0) -> "ParticleBelief":
         """n particles uniform in the box."""
         return cls._wrap(_c.ParticleBelief.uniform(np.asarray(low, float), np.asarray(high, float), int(n),
-                                                   None if wraps is None else list(wraps), int(seed)))
+                                                   _flags(wraps), int(seed)))
 
     @classmethod
     def gaussian(cls, low, high, mean, std, n: int, wraps=None, seed: int = 0) -> "ParticleBelief":
         """n particles from N(mean, diag(std^2)) truncated to the box (wrapping dims wrapped)."""
         return cls._wrap(_c.ParticleBelief.gaussian(np.asarray(low, float), np.asarray(high, float),
                                                     np.asarray(mean, float), np.asarray(std, float), int(n),
-                                                    None if wraps is None else list(wraps), int(seed)))
+                                                    _flags(wraps), int(seed)))
 
-    # ---- state -----------------------------------------------------------------------------------
-    @property
-    def particles(self) -> np.ndarray:
-        """(N, D) particle states (a copy)."""
-        return self._b.particles
-
-    @property
-    def log_weights(self) -> np.ndarray:
-        """(N,) normalised log-weights."""
-        return self._b.log_weights
-
-    @property
-    def weights(self) -> np.ndarray:
-        """(N,) weights summing to 1."""
-        return self._b.weights
-
-    @property
-    def low(self) -> np.ndarray:
-        return self._b.low
-
-    @property
-    def high(self) -> np.ndarray:
-        return self._b.high
-
-    @property
-    def wraps(self):
-        return self._b.wraps
+    # ---- state (read from the C++ belief) ---------------------------------------------------------
+    particles = _core_property("particles", "(N, D) particle states (a copy).")
+    log_weights = _core_property("log_weights", "(N,) normalised log-weights.")
+    weights = _core_property("weights", "(N,) weights summing to 1.")
+    low = _core_property("low", "(D,) lower bounds.")
+    high = _core_property("high", "(D,) upper bounds.")
+    wraps = _core_property("wraps", "Per dimension: whether it wraps (an angle in [low, high)).")
+    dim = _core_property("dim", "State dimension D.")
 
     def __len__(self) -> int:
         return self._b.size
-
-    @property
-    def dim(self) -> int:
-        return self._b.dim
 
     def ess(self) -> float:
         """Effective sample size 1 / sum w^2."""
@@ -154,10 +142,10 @@ class ParticleBelief:
         """Resamples when ess < threshold * N; returns whether it did."""
         return self._b.resample_if_needed(float(threshold), scheme)
 
-    def metropolis(self, log_target: Callable[[np.ndarray], np.ndarray], step, n_steps: int = 1) -> dict:
+    def metropolis(self, log_target: Callable[[np.ndarray], np.ndarray], step, n_steps: int = 1):
         """n_steps Metropolis random-walk sweeps under log_target (vectorised, called once per sweep
-        plus once at the start); proposal std ``step`` per dimension. Returns acceptance_rate and
-        evaluations."""
+        plus once at the start); proposal std ``step`` per dimension. Returns a
+        :class:`bayesgrasp._core.belief.MetropolisStats` (``acceptance_rate``, ``evaluations``)."""
         return self._b.metropolis(log_target, np.broadcast_to(np.asarray(step, float), (self.dim,)).copy(),
                                   int(n_steps))
 
@@ -188,7 +176,7 @@ def kde_entropy(particles, log_weights, low, high, wraps=None, bandwidth: str = 
     covariance and f by Scott's or Silverman's rule (n_eff = 1/sum w^2) — scipy.stats.gaussian_kde's
     conventions. Differences in wrapping dims are wrapped."""
     return _c.kde_entropy(np.asarray(particles, float), np.asarray(log_weights, float), np.asarray(low, float),
-                          np.asarray(high, float), None if wraps is None else list(wraps), bandwidth)
+                          np.asarray(high, float), _flags(wraps), bandwidth)
 
 
 def expected_posterior_entropy(log_weights, mean, var, n_samples: int = 100, seed: int = 0, n_threads: int = 1):
@@ -235,6 +223,21 @@ def relative_planar_pose(actions, poses) -> np.ndarray:
     (x, y, yaw, ...), poses (N, 3) -> (A*N, 3 + extra); row a*N + j is
     (R(-yaw_j)(a_xy - o_xy), wrap(a_yaw - yaw_j) in [-pi, pi), extra_a)."""
     return _c.relative_planar_pose(np.atleast_2d(np.asarray(actions, float)), np.atleast_2d(np.asarray(poses, float)))
+
+
+def absolute_planar_pose(relative, poses) -> np.ndarray:
+    """The inverse of :func:`relative_planar_pose`: grasps given in object frames placed in the
+    world, for all pairs: relative (R, 3 + extra) rows (x, y, yaw, ...), poses (N, 3) ->
+    (R*N, 3 + extra); row r*N + j is (o_xy_j + R(yaw_j) r_xy, wrap(r_yaw + yaw_j) in [-pi, pi),
+    extra_r). With one pose, row r is relative grasp r in the world."""
+    return _c.compose_planar_pose(np.atleast_2d(np.asarray(relative, float)), np.atleast_2d(np.asarray(poses, float)))
+
+
+def absolute_planar_pose_paired(relative, poses) -> np.ndarray:
+    """:func:`absolute_planar_pose` one to one: relative (N, 3 + extra) and poses (N, 3) ->
+    (N, 3 + extra); row i is (o_xy_i + R(yaw_i) r_xy_i, wrap(r_yaw_i + yaw_i) in [-pi, pi), extra_i)."""
+    return _c.compose_planar_pose_paired(np.atleast_2d(np.asarray(relative, float)),
+                                         np.atleast_2d(np.asarray(poses, float)))
 
 
 def resample_indices(weights, n: int, scheme: str = "systematic", seed: int = 0) -> np.ndarray:

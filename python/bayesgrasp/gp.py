@@ -25,10 +25,6 @@ from bayesgrasp import _core
 
 __all__ = ["ExactGP", "SparseGP", "load"]
 
-_KERNELS = ("se", "matern52")
-_MEANS = ("zero", "constant")
-
-
 def _as_2d(a, name, cols=None):
     try:
         a = np.asarray(a, dtype=float)
@@ -49,6 +45,23 @@ def _as_2d(a, name, cols=None):
 
 class _GPBase:
     _core_cls = None
+
+    def __init__(self, kernel="se", lengthscale=None, variance=1.0, noise=1e-2, mean="zero", optimize=True,
+                 max_iter=200, normalize_x=True, normalize_y=True, jitter=1e-8, threads=1,
+                 shared_hyperparameters=True, seed=0):
+        self.kernel = kernel
+        self.lengthscale = lengthscale
+        self.variance = variance
+        self.noise = noise
+        self.mean = mean
+        self.optimize = optimize
+        self.max_iter = max_iter
+        self.normalize_x = normalize_x
+        self.normalize_y = normalize_y
+        self.jitter = jitter
+        self.threads = threads
+        self.shared_hyperparameters = shared_hyperparameters
+        self.seed = seed
 
     # ---- scikit-learn parameter protocol -------------------------------------------------------
     @classmethod
@@ -71,29 +84,14 @@ class _GPBase:
         args = ", ".join(f"{k}={v!r}" for k, v in self.get_params().items())
         return f"{type(self).__name__}({args})"
 
-    # ---- validation ----------------------------------------------------------------------------
+    # ---- core options (the C++ model validates them when it is built) --------------------------
     def _check_params(self):
-        if self.kernel not in _KERNELS:
-            raise ValueError(f"kernel: expected one of {_KERNELS}, got {self.kernel!r}")
-        if self.mean not in _MEANS:
-            raise ValueError(f"mean: expected one of {_MEANS}, got {self.mean!r}")
-        if self.lengthscale is not None:
-            ls = np.atleast_1d(np.asarray(self.lengthscale, dtype=float))
-            if ls.ndim != 1 or ls.size == 0 or not np.all(np.isfinite(ls)) or np.any(ls <= 0):
-                raise ValueError(f"lengthscale: must be positive and finite, got {self.lengthscale!r}")
-        if not (np.isfinite(self.variance) and self.variance > 0):
-            raise ValueError(f"variance: must be positive and finite, got {self.variance!r}")
-        if not (np.isfinite(self.noise) and self.noise >= 0):
-            raise ValueError(f"noise: must be >= 0 and finite, got {self.noise!r}")
-        if int(self.max_iter) < 0:
-            raise ValueError(f"max_iter: must be >= 0, got {self.max_iter!r}")
+        """Checks what the C++ options cannot hold; everything else is checked by the C++ model."""
+        if self.lengthscale is not None and (np.ndim(self.lengthscale) > 1 or np.size(self.lengthscale) == 0):
+            raise ValueError(f"lengthscale: expected a scalar or a non-empty 1-D array, got {self.lengthscale!r}")
 
     def _core_kwargs(self, D):
-        ls = None
-        if self.lengthscale is not None:
-            ls = np.atleast_1d(np.asarray(self.lengthscale, dtype=float))
-            if ls.size not in (1, D):
-                raise ValueError(f"lengthscale: expected 1 or {D} values, got {ls.size}")
+        ls = None if self.lengthscale is None else np.atleast_1d(np.asarray(self.lengthscale, dtype=float))
         return dict(kernel=self.kernel, lengthscale=ls, variance=float(self.variance), noise=float(self.noise),
                     mean=self.mean, optimize=bool(self.optimize), max_iter=int(self.max_iter),
                     normalize_x=bool(self.normalize_x), normalize_y=bool(self.normalize_y),
@@ -134,7 +132,11 @@ class _GPBase:
         return self
 
     def _make_core(self, kw):
-        return self._core_cls(**kw)
+        options = _core.gp.GPOptions()
+        for name, value in kw.items():
+            if value is not None:
+                setattr(options, name, value)
+        return self._core_cls(options)
 
     def _per_model(self, fn):
         parts = [fn(m) for m in self.models_]
@@ -221,6 +223,7 @@ class _GPBase:
 
     @property
     def fit_info_(self):
+        """:class:`bayesgrasp._core.gp.FitInfo` of the fit (a list of them, one per model, if not shared)."""
         self._check_fitted()
         return [m.fit_info for m in self.models_] if len(self.models_) > 1 else self.models_[0].fit_info
 
@@ -272,28 +275,11 @@ class ExactGP(_GPBase):
     Parameters: kernel 'se' | 'matern52'; lengthscale (scalar or (D,), None = 1); variance; noise
     (noise variance, >= 0); mean 'zero' | 'constant'; optimize (maximise the log marginal
     likelihood with L-BFGS-B and analytic gradients); max_iter; normalize_x; normalize_y; jitter
-    (initial relative jitter for failed Cholesky factorisations); threads (prediction);
-    shared_hyperparameters (one model for all outputs); seed (for sampling defaults).
+    (initial relative jitter for failed Cholesky factorisations); threads (prediction batches;
+    0 = all cores); shared_hyperparameters (one model for all outputs); seed (for sampling defaults).
     """
 
     _core_cls = _core.gp.ExactGP
-
-    def __init__(self, kernel="se", lengthscale=None, variance=1.0, noise=1e-2, mean="zero", optimize=True,
-                 max_iter=200, normalize_x=True, normalize_y=True, jitter=1e-8, threads=1,
-                 shared_hyperparameters=True, seed=0):
-        self.kernel = kernel
-        self.lengthscale = lengthscale
-        self.variance = variance
-        self.noise = noise
-        self.mean = mean
-        self.optimize = optimize
-        self.max_iter = max_iter
-        self.normalize_x = normalize_x
-        self.normalize_y = normalize_y
-        self.jitter = jitter
-        self.threads = threads
-        self.shared_hyperparameters = shared_hyperparameters
-        self.seed = seed
 
 
 class SparseGP(_GPBase):
@@ -310,19 +296,9 @@ class SparseGP(_GPBase):
                  max_iter=200, normalize_x=True, normalize_y=True, jitter=1e-8, threads=1,
                  shared_hyperparameters=True, seed=0, n_inducing=200, optimize_inducing=False, inducing=None,
                  kmeans_iter=10):
-        self.kernel = kernel
-        self.lengthscale = lengthscale
-        self.variance = variance
-        self.noise = noise
-        self.mean = mean
-        self.optimize = optimize
-        self.max_iter = max_iter
-        self.normalize_x = normalize_x
-        self.normalize_y = normalize_y
-        self.jitter = jitter
-        self.threads = threads
-        self.shared_hyperparameters = shared_hyperparameters
-        self.seed = seed
+        super().__init__(kernel=kernel, lengthscale=lengthscale, variance=variance, noise=noise, mean=mean,
+                         optimize=optimize, max_iter=max_iter, normalize_x=normalize_x, normalize_y=normalize_y,
+                         jitter=jitter, threads=threads, shared_hyperparameters=shared_hyperparameters, seed=seed)
         self.n_inducing = n_inducing
         self.optimize_inducing = optimize_inducing
         self.inducing = inducing
@@ -330,9 +306,7 @@ class SparseGP(_GPBase):
 
     def _check_params(self):
         super()._check_params()
-        if int(self.n_inducing) < 1:
-            raise ValueError(f"n_inducing: must be >= 1, got {self.n_inducing!r}")
-        if int(self.seed) < 0:
+        if int(self.seed) < 0:  # the C++ seed is unsigned
             raise ValueError(f"seed: must be >= 0, got {self.seed!r}")
 
     def _core_kwargs(self, D):

@@ -18,7 +18,6 @@ Example::
 """
 from __future__ import annotations
 
-from dataclasses import dataclass, field
 from typing import Callable, Optional, Sequence, Tuple, Union
 
 import numpy as np
@@ -33,29 +32,29 @@ Bounds = Union[Tuple[Sequence[float], Sequence[float]], np.ndarray]
 __all__ = ["OptimizeResult", "pso", "simulated_annealing", "firefly", "steepest_descent",
            "levenberg_marquardt", "trust_region", "rastrigin", "ackley", "sphere", "rosenbrock"]
 
+#: What every optimiser returns (bound C++ class): x (D,) best point; fun (for
+#: ``levenberg_marquardt``: 1/2 |r|^2); nit iterations; nfev rows passed to the objective; history
+#: best value after each iteration (if ``record_history``); converged (a tolerance or the target was
+#: met); message (why it stopped).
+OptimizeResult = _c.OptimizeResult
 
-@dataclass
-class OptimizeResult:
-    """What every optimiser reports.
 
-    x: best point found (D,); fun: objective there (for ``levenberg_marquardt``: 1/2 |r|^2);
-    nit: iterations; nfev: rows passed to the objective (candidate evaluations); history: best
-    value after each iteration (if ``record_history``); converged: a tolerance or target was met;
-    message: why it stopped.
-    """
-    x: np.ndarray
-    fun: float
-    nit: int
-    nfev: int
-    history: np.ndarray = field(default_factory=lambda: np.empty(0))
-    converged: bool = False
-    message: str = ""
-
-    @classmethod
-    def _from(cls, d: dict) -> "OptimizeResult":
-        return cls(x=np.asarray(d["x"], dtype=float), fun=float(d["fun"]), nit=int(d["nit"]),
-                   nfev=int(d["nfev"]), history=np.asarray(d["history"], dtype=float),
-                   converged=bool(d["converged"]), message=str(d["message"]))
+def _options(cls, settings: dict):
+    """An options object of the bound class ``cls`` with the given fields (None keeps the default),
+    each value converted to the type of the field's default."""
+    o = cls()
+    for name, value in settings.items():
+        if value is None:
+            continue
+        default = getattr(o, name)
+        if isinstance(default, bool):
+            value = bool(value)
+        elif isinstance(default, int):
+            value = int(value)
+        elif isinstance(default, float):
+            value = float(value)
+        setattr(o, name, value)
+    return o
 
 
 def _bounds(bounds, name="bounds"):
@@ -96,9 +95,10 @@ def pso(fun: Objective, bounds: Bounds, *, n_particles: int = 40, max_iter: int 
     nfev = n_particles * (nit + 1).
     """
     low, high = _bounds(bounds)
-    return OptimizeResult._from(_c.pso(_objective(fun), low, high, int(n_particles), int(max_iter), inertia, c1,
-                                       c2, vmax_fraction, int(seed), float(target), int(stall_iter), float(ftol),
-                                       init, bool(record_history)))
+    o = _options(_c.PSOOptions, dict(n_particles=n_particles, max_iter=max_iter, inertia=inertia, c1=c1, c2=c2,
+                                     vmax_fraction=vmax_fraction, seed=seed, target=target, stall_iter=stall_iter,
+                                     ftol=ftol, init=init, record_history=record_history))
+    return _c.pso(_objective(fun), low, high, o)
 
 
 def simulated_annealing(fun: Objective, bounds: Bounds, *, n_chains: int = 16, max_iter: int = 1000,
@@ -114,10 +114,11 @@ def simulated_annealing(fun: Objective, bounds: Bounds, *, n_chains: int = 16, m
     nfev = n_chains * (nit + 1).
     """
     low, high = _bounds(bounds)
-    return OptimizeResult._from(_c.simulated_annealing(
-        _objective(fun), low, high, int(n_chains), int(max_iter), float(t0), float(cooling), float(step),
-        float(step_min), float(step_max), int(adapt_interval), float(target_acceptance), float(adapt_factor),
-        int(seed), float(target), init, bool(record_history)))
+    o = _options(_c.AnnealingOptions, dict(n_chains=n_chains, max_iter=max_iter, t0=t0, cooling=cooling, step=step,
+                                           step_min=step_min, step_max=step_max, adapt_interval=adapt_interval,
+                                           target_acceptance=target_acceptance, adapt_factor=adapt_factor,
+                                           seed=seed, target=target, init=init, record_history=record_history))
+    return _c.simulated_annealing(_objective(fun), low, high, o)
 
 
 def firefly(fun: Objective, bounds: Bounds, *, n_fireflies: int = 25, max_iter: int = 100, beta0: float = 1.0,
@@ -131,9 +132,10 @@ def firefly(fun: Objective, bounds: Bounds, *, n_fireflies: int = 25, max_iter: 
     unit-box coordinates (each dimension divided by its range). nfev = n_fireflies * (nit + 1).
     """
     low, high = _bounds(bounds)
-    return OptimizeResult._from(_c.firefly(_objective(fun), low, high, int(n_fireflies), int(max_iter),
-                                           float(beta0), float(gamma), float(alpha), float(alpha_decay), int(seed),
-                                           float(target), init, bool(record_history)))
+    o = _options(_c.FireflyOptions, dict(n_fireflies=n_fireflies, max_iter=max_iter, beta0=beta0, gamma=gamma,
+                                         alpha=alpha, alpha_decay=alpha_decay, seed=seed, target=target, init=init,
+                                         record_history=record_history))
+    return _c.firefly(_objective(fun), low, high, o)
 
 
 def steepest_descent(fun: Objective, x0, bounds: Optional[Bounds] = None, *, max_iter: int = 500,
@@ -143,9 +145,10 @@ def steepest_descent(fun: Objective, x0, bounds: Optional[Bounds] = None, *, max
     """Steepest descent from ``x0``: central-difference gradients (one batch of 2D rows, step
     h * max(1, |x_k|)) and Armijo backtracking; projected onto ``bounds`` if given."""
     low, high = _bounds(bounds)
-    return OptimizeResult._from(_c.steepest_descent(
-        _objective(fun), np.asarray(x0, dtype=float), low, high, int(max_iter), float(h), float(t0), float(armijo),
-        float(backtrack), int(max_backtrack), float(gtol), float(ftol), bool(record_history)))
+    o = _options(_c.DescentOptions, dict(max_iter=max_iter, h=h, t0=t0, armijo=armijo, backtrack=backtrack,
+                                         max_backtrack=max_backtrack, gtol=gtol, ftol=ftol,
+                                         record_history=record_history))
+    return _c.steepest_descent(_objective(fun), np.asarray(x0, dtype=float), low, high, o)
 
 
 def levenberg_marquardt(residuals: Callable[[np.ndarray], np.ndarray], x0, bounds: Optional[Bounds] = None, *,
@@ -156,9 +159,9 @@ def levenberg_marquardt(residuals: Callable[[np.ndarray], np.ndarray], x0, bound
     if not callable(residuals):
         raise ValueError("residuals: expected a vectorised callable (N, D) -> (N, R)")
     low, high = _bounds(bounds)
-    return OptimizeResult._from(_c.levenberg_marquardt(
-        residuals, np.asarray(x0, dtype=float), low, high, int(max_iter), float(h), float(lambda0), float(gtol),
-        float(xtol), float(ftol), bool(record_history)))
+    o = _options(_c.LMOptions, dict(max_iter=max_iter, h=h, lambda0=lambda0, gtol=gtol, xtol=xtol, ftol=ftol,
+                                    record_history=record_history))
+    return _c.levenberg_marquardt(residuals, np.asarray(x0, dtype=float), low, high, o)
 
 
 def trust_region(fun: Objective, x0, bounds: Optional[Bounds] = None, *, max_iter: int = 200, h: float = 1e-6,
@@ -167,9 +170,9 @@ def trust_region(fun: Objective, x0, bounds: Optional[Bounds] = None, *, max_ite
     """Dogleg trust region with central-difference gradients and BFGS Hessian updates, for scalar
     objectives such as a negative log posterior of a pose (Eq. 4.4)."""
     low, high = _bounds(bounds)
-    return OptimizeResult._from(_c.trust_region(
-        _objective(fun), np.asarray(x0, dtype=float), low, high, int(max_iter), float(h), float(radius0),
-        float(max_radius), float(eta), float(gtol), float(xtol), bool(record_history)))
+    o = _options(_c.TrustRegionOptions, dict(max_iter=max_iter, h=h, radius0=radius0, max_radius=max_radius,
+                                             eta=eta, gtol=gtol, xtol=xtol, record_history=record_history))
+    return _c.trust_region(_objective(fun), np.asarray(x0, dtype=float), low, high, o)
 
 
 def _builtin(name):

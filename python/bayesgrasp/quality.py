@@ -66,7 +66,8 @@ def epsilon_volume_batch(points, normals, com, torque_scale, mu=DEFAULT_FRICTION
     """Epsilon and volume of N grasps of one object, in C++ threads.
 
     Either ``points`` and ``normals`` are lists of N (K_i, 3) arrays, or they are (M, 3)
-    arrays of all contacts, grasp after grasp, and ``counts`` (N,) gives K_i.
+    arrays of all contacts, grasp after grasp, and ``counts`` (N,) gives K_i. ``threads``: C++
+    threads over the grasps (0 = all cores; the result does not depend on it).
 
     Returns:
         ``(epsilon, volume)``, two (N,) arrays.

@@ -37,6 +37,7 @@ from typing import List, Optional, Sequence, Tuple, Union
 
 import numpy as np
 
+from .belief import absolute_planar_pose
 from . import physics, quality
 from .hand import Hand
 from .objects import ObjectModel, Scene
@@ -191,11 +192,7 @@ class World:
             raise ValueError(f"grasps: expected shape (N, 3) of (x, y, yaw), got {np.shape(xyyaw)}")
         if not np.all(np.isfinite(g)):
             raise ValueError("grasps: contain NaN or infinity")
-        ox, oy, oyaw = self.scene.planar_pose(self.object_index)
-        out = np.empty_like(g)
-        out[:, :2] = _turn_xy(g[:, :2], oyaw, ox, oy)
-        out[:, 2] = g[:, 2] + oyaw
-        return out
+        return absolute_planar_pose(g, np.asarray(self.scene.planar_pose(self.object_index), dtype=float))
 
     def _approaches_to_world(self, directions, targets, rolls, frame: str, names: Tuple[str, str]):
         """(N, 3) directions and targets and (N,) rolls (a number or (N,)) in `frame` -> world;
@@ -203,10 +200,17 @@ class World:
         D, P = (_rows3(a, n) for a, n in zip((directions, targets), names))
         if len(P) != len(D):
             raise ValueError(f"{names[1]}: need one per direction ({len(D)}), got {len(P)}")
-        ox, oy, oyaw = self._planar(frame)
-        Dw, Pw = np.empty_like(D), np.empty_like(P)
-        Dw[:, :2], Dw[:, 2] = _turn_xy(D[:, :2], oyaw), D[:, 2]
-        Pw[:, :2], Pw[:, 2] = _turn_xy(P[:, :2], oyaw, ox, oy), P[:, 2]
+        r = np.broadcast_to(np.asarray(rolls, dtype=float), (len(D),)) if np.ndim(rolls) == 0 else \
+            np.asarray(rolls, dtype=float)
+        if r.shape != (len(D),):
+            raise ValueError(f"rolls: need a number or one per approach ({len(D)}), got shape {r.shape}")
+        pose = np.asarray(self._planar(frame), dtype=float)
+        Dw, Pw, rw = D, P, r
+        if frame == "object":  # rows (x, y, yaw, z) placed by the object's planar pose, as top grasps
+            Dw = _placed(np.c_[D[:, :2], np.zeros(len(D)), D[:, 2]], pose * [0, 0, 1])[:, [0, 1, 3]]
+            finite_r = np.isfinite(r)
+            placed = _placed(np.c_[P[:, :2], np.where(finite_r, r, 0.0), P[:, 2]], pose)
+            Pw, rw = placed[:, [0, 1, 3]], np.where(finite_r, placed[:, 2], r)
         hx, hy = self.scene.table_size[0] / 2 + TABLE_MARGIN, self.scene.table_size[1] / 2 + TABLE_MARGIN
         off = np.flatnonzero((np.abs(Pw[:, 0]) > hx) | (np.abs(Pw[:, 1]) > hy))
         if len(off):
@@ -214,8 +218,7 @@ class World:
             where = names[1] if names[1] == "target" else f"{names[1]}[{i}]"
             raise ValueError(f"{where}: off the table: world (x, y) = ({Pw[i, 0]:.3f}, {Pw[i, 1]:.3f}) m is outside "
                              f"[-{hx:g}, {hx:g}] x [-{hy:g}, {hy:g}] (the table grown by {TABLE_MARGIN} m)")
-        r = np.asarray(rolls, dtype=float)
-        return Dw, Pw, (float(r) + oyaw if r.ndim == 0 else r + oyaw)
+        return Dw, Pw, (float(rw[0]) if np.ndim(rolls) == 0 and len(rw) else rw)
 
     # ---- grasps -------------------------------------------------------------------------
     def grasp(self, x: float, y: float, yaw: float, spread: Optional[float] = None,
@@ -350,11 +353,14 @@ class _BatchOfOne:
         self.distance_queries = np.array([g.distance_queries], dtype=np.int32)
 
 
-def _turn_xy(xy: np.ndarray, yaw: float, x0: float = 0.0, y0: float = 0.0) -> np.ndarray:
-    """(N, 2) points turned by yaw about the origin, then moved by (x0, y0)."""
-    c, s = np.cos(yaw), np.sin(yaw)
-    with np.errstate(invalid="ignore"):  # an infinite entry gives NaN, which the simulator rejects
-        return np.column_stack([x0 + c * xy[:, 0] - s * xy[:, 1], y0 + s * xy[:, 0] + c * xy[:, 1]])
+def _placed(rows: np.ndarray, pose: np.ndarray) -> np.ndarray:
+    """Rows (x, y, yaw, extra...) placed by the planar pose (absolute_planar_pose); rows with a
+    non-finite entry stay as they are (the simulator names the argument)."""
+    out = rows.copy()
+    ok = np.isfinite(rows).all(axis=1)
+    if ok.any():
+        out[ok] = absolute_planar_pose(rows[ok], pose)
+    return out
 
 
 def _floats(a, name: str) -> np.ndarray:

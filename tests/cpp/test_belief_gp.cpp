@@ -43,7 +43,7 @@ TEST(BeliefGP, LikelihoodIsLogPredictiveDensityAtRelativePoses) {
   ll_fn(b.particles(), ll);
   // Independently: Gaussian log density with the GP's predictive mean and variance (+ noise).
   Eigen::MatrixXd mean, var;
-  model.predict(belief::relative_planar_pose(action, b.particles()), mean, var, true);
+  model.predict(belief::relative_planar_pose(action, b.particles()), mean, var, gp::Predictive::Observation);
   for (int i = 0; i < b.size(); ++i) {
     double e = 0.0;
     for (int k = 0; k < 3; ++k)
@@ -86,7 +86,7 @@ TEST(BeliefGP, ExpectedEntropyMatchesManualPipeline) {
   ASSERT_EQ(e.size(), 3u);
   for (int a = 0; a < 3; ++a) {
     Eigen::MatrixXd mean, var;
-    model.predict(belief::relative_planar_pose(actions.row(a), b.particles()), mean, var, true);
+    model.predict(belief::relative_planar_pose(actions.row(a), b.particles()), mean, var, gp::Predictive::Observation);
     const auto one = belief::expected_posterior_entropy(b.log_weights(), mean, var, 40, 7);
     EXPECT_NEAR(e[a].mean, one.mean, 1e-9);
     // The identity sensor with std 0.01 is very informative: a large drop from log 200.

@@ -4,10 +4,14 @@
 
 #include <Eigen/LU>
 
+#include <omp.h>
+
 #include <cmath>
 #include <limits>
+#include <memory>
 #include <random>
 #include <string>
+#include <tuple>
 
 #include "bayesgrasp/gp/gp.hpp"
 
@@ -32,6 +36,13 @@ void make_data(int N, int D, int P, std::uint64_t seed, Eigen::MatrixXd& X, Eige
     }
 }
 
+// The rows of A twice, one copy after the other (duplicated training inputs).
+Eigen::MatrixXd twice(const Eigen::MatrixXd& A) {
+  Eigen::MatrixXd out(2 * A.rows(), A.cols());
+  out << A, A;
+  return out;
+}
+
 GPOptions fixed_options(KernelType t = KernelType::SquaredExponential) {
   GPOptions o;
   o.kernel = t;
@@ -42,6 +53,23 @@ GPOptions fixed_options(KernelType t = KernelType::SquaredExponential) {
   o.variance = 1.3;
   o.noise = 0.05;
   return o;
+}
+
+// N inputs (and outputs) and every one of them twice (Xd, Yd), with fixed_options() at zero
+// noise: the exact covariance is singular without jitter.
+struct DuplicatedNoiseFree {
+  Eigen::MatrixXd X, Y, Xd, Yd;
+  GPOptions options;
+};
+
+DuplicatedNoiseFree duplicated_noise_free(int N, int D, std::uint64_t seed) {
+  DuplicatedNoiseFree d;
+  make_data(N, D, 1, seed, d.X, d.Y);
+  d.Xd = twice(d.X);
+  d.Yd = twice(d.Y);
+  d.options = fixed_options();
+  d.options.noise = 0.0;
+  return d;
 }
 
 }  // namespace
@@ -150,35 +178,35 @@ TEST(GPExact, MatchesDirectLinearAlgebra) {
   EXPECT_LT((gp.predict_cov(Xs).diagonal() - var).cwiseAbs().maxCoeff(), 1e-9);
 }
 
-TEST(GPGradient, ExactMatchesFiniteDifferences) {
-  Eigen::MatrixXd X, Y;
-  make_data(35, 2, 2, 5, X, Y);
-  for (KernelType t : {KernelType::SquaredExponential, KernelType::Matern52}) {
-    GPOptions o = fixed_options(t);
-    o.mean = MeanType::Constant;
-    o.lengthscale = Eigen::Vector2d(0.7, 1.4);
-    ExactGP gp(o);
-    gp.fit(X, Y);
-    check_gradient(gp, gp.parameters(), 1e-5);
-  }
-}
+// Analytic gradients against central differences for every model and kernel, constant mean: the
+// exact GP, and FITC with its inducing inputs among the parameters.
+class GPGradientFD : public ::testing::TestWithParam<std::tuple<bool, KernelType>> {};
 
-TEST(GPGradient, FitcMatchesFiniteDifferencesIncludingInducingInputs) {
+TEST_P(GPGradientFD, MatchesFiniteDifferences) {
+  const auto [sparse, kernel] = GetParam();
+  const int D = sparse ? 3 : 2;
   Eigen::MatrixXd X, Y;
-  make_data(80, 3, 2, 6, X, Y);
-  for (KernelType t : {KernelType::SquaredExponential, KernelType::Matern52}) {
-    GPOptions o = fixed_options(t);
-    o.mean = MeanType::Constant;
-    o.lengthscale = Eigen::Vector3d(0.7, 1.4, 1.0);
+  make_data(sparse ? 80 : 35, D, 2, sparse ? 6 : 5, X, Y);
+  GPOptions o = fixed_options(kernel);
+  o.mean = MeanType::Constant;
+  o.lengthscale = Eigen::Vector3d(0.7, 1.4, 1.0).head(D);
+  std::unique_ptr<GaussianProcess> gp;
+  if (sparse) {
     o.n_inducing = 12;
     o.optimize_inducing = true;
     o.normalize_x = true;
-    SparseGP gp(o);
-    gp.fit(X, Y);
-    ASSERT_EQ(gp.parameters().size(), 3 + 2 + 2 + 12 * 3);
-    check_gradient(gp, gp.parameters(), 1e-5);
+    gp = std::make_unique<SparseGP>(o);
+  } else {
+    gp = std::make_unique<ExactGP>(o);
   }
+  gp->fit(X, Y);
+  if (sparse) ASSERT_EQ(gp->parameters().size(), 3 + 2 + 2 + 12 * 3);
+  check_gradient(*gp, gp->parameters(), 1e-5);
 }
+
+INSTANTIATE_TEST_SUITE_P(ModelsAndKernels, GPGradientFD,
+                         ::testing::Combine(::testing::Bool(),
+                                            ::testing::Values(KernelType::SquaredExponential, KernelType::Matern52)));
 
 TEST(GPGradient, FitcMatchesFiniteDifferencesFixedInducingFarFromTheOrigin) {
   // Fixed inducing inputs take the lengthscale-only gradient contraction (expanded around the
@@ -300,7 +328,7 @@ TEST(GPSample, MarginalAndJointMomentsMatchPrediction) {
   Eigen::MatrixXd Xs(3, 1);
   Xs << -1.0, 0.3, 5.0;
   Eigen::MatrixXd m, v;
-  gp.predict(Xs, m, v, true);
+  gp.predict(Xs, m, v, Predictive::Observation);
   std::mt19937_64 rng(1);
   const int S = 20000;
   for (bool joint : {false, true}) {
@@ -352,13 +380,7 @@ TEST(GPMultiOutput, SharedHyperparametersEqualSeparateFitsAndIndependentModelsWo
 }
 
 TEST(GPRobustness, DuplicatesZeroNoiseAndExtremeScales) {
-  Eigen::MatrixXd X, Y;
-  make_data(30, 2, 1, 12, X, Y);
-  Eigen::MatrixXd Xd(60, 2), Yd(60, 1);
-  Xd << X, X;
-  Yd << Y, Y;
-  GPOptions o = fixed_options();
-  o.noise = 0.0;
+  const auto [X, Y, Xd, Yd, o] = duplicated_noise_free(30, 2, 12);
   ExactGP ex(o);
   ex.fit(Xd, Yd);  // singular without jitter
   EXPECT_GT(ex.fit_info().jitter_used, 0.0);
@@ -385,6 +407,40 @@ TEST(GPRobustness, DuplicatesZeroNoiseAndExtremeScales) {
   SparseGP flat(on);
   flat.fit(X, Eigen::MatrixXd::Constant(30, 1, 2.5));
   EXPECT_LT((flat.predict_mean(X).array() - 2.5).abs().maxCoeff(), 1e-6);
+}
+
+TEST(GPThreads, ZeroMeansAllCoresAndGivesTheOneThreadResult) {
+  // threads = 0: every hardware thread (omp_get_num_procs) for batches of >= 2048 inputs; the
+  // predictions are the one-thread predictions bit for bit (each input is computed alone).
+  Eigen::MatrixXd X, Y, Xs, Ys;
+  make_data(200, 3, 2, 61, X, Y);
+  make_data(5000, 3, 1, 62, Xs, Ys);
+  for (const bool sparse : {false, true}) {
+    GPOptions o = fixed_options();
+    o.n_inducing = 30;
+    o.threads = 0;
+    std::unique_ptr<GaussianProcess> all = sparse ? std::unique_ptr<GaussianProcess>(new SparseGP(o))
+                                                  : std::unique_ptr<GaussianProcess>(new ExactGP(o));
+    o.threads = 1;
+    std::unique_ptr<GaussianProcess> one = sparse ? std::unique_ptr<GaussianProcess>(new SparseGP(o))
+                                                  : std::unique_ptr<GaussianProcess>(new ExactGP(o));
+    all->fit(X, Y);
+    one->fit(X, Y);
+    EXPECT_EQ(all->threads(), omp_get_num_procs());
+    EXPECT_EQ(one->threads(), 1);
+    Eigen::MatrixXd ma, va, m1, v1;
+    all->predict(Xs, ma, va);
+    one->predict(Xs, m1, v1);
+    EXPECT_EQ(ma, m1);
+    EXPECT_EQ(va, v1);
+    EXPECT_EQ(all->predict_mean(Xs), one->predict_mean(Xs));
+    one->set_threads(0);
+    EXPECT_EQ(one->threads(), omp_get_num_procs());
+    EXPECT_THROW(one->set_threads(-1), std::invalid_argument);
+  }
+  GPOptions bad;
+  bad.threads = -2;
+  EXPECT_THROW(ExactGP{bad}, std::invalid_argument);
 }
 
 TEST(GPErrors, BadInputIsRejected) {
@@ -463,7 +519,7 @@ TEST(GPFitc, FusedPredictionEqualsDenseFormulaAndBlockwisePath) {
         EXPECT_LT((gp.predict_mean(Xs) - m).cwiseAbs().maxCoeff(), 1e-10);
         // with noise: var + noise
         Eigen::MatrixXd mn, vn;
-        gp.predict(Xs, mn, vn, true);
+        gp.predict(Xs, mn, vn, Predictive::Observation);
         EXPECT_LT(((vn - v).array() - 0.05).abs().maxCoeff(), 1e-12);
       }
     }
@@ -473,13 +529,7 @@ TEST(GPFitc, FusedVarianceNearZeroIsClampedNeverNaN) {
   // Inducing = training inputs (duplicated), zero noise: the predictive variance at the training
   // inputs is ~0 (rounding may push 1 - |G f|^2 below zero); it must come back >= 0 and finite,
   // agree with the exact GP and with the blockwise path.
-  Eigen::MatrixXd X, Y;
-  make_data(40, 3, 1, 77, X, Y);
-  Eigen::MatrixXd Xd(80, 3), Yd(80, 1);
-  Xd << X, X;
-  Yd << Y, Y;
-  GPOptions o = fixed_options();
-  o.noise = 0.0;
+  auto [X, Y, Xd, Yd, o] = duplicated_noise_free(40, 3, 77);
   o.inducing = X;
   SparseGP gp(o);
   gp.fit(Xd, Yd);

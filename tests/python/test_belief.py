@@ -57,7 +57,7 @@ def test_metropolis_calls_once_per_sweep_and_is_seeded():
             return -0.5 * ((P[:, 0] - 0.02) / 0.01) ** 2
 
         st = b.metropolis(target, [0.01, 0.01, 0.1], n_steps=5)
-        assert calls == [300] * 6 and st["evaluations"] == 1800
+        assert calls == [300] * 6 and st.evaluations == 1800
         b.resample("stratified")
         b.roughen(0.2)
         return b.particles
@@ -142,3 +142,45 @@ def test_gp_update_paths_agree_and_entropy_gp_matches_manual():
 def test_bad_input(call, match):
     with pytest.raises(ValueError, match=match):
         call()
+
+
+def test_metropolis_returns_a_bound_stats_class():
+    b = ParticleBelief(np.zeros((50, 3)), LOW, HIGH, WRAPS, seed=2)  # 0.1 from every bound
+    st = b.metropolis(lambda P: np.zeros(len(P)), [0.001, 0.001, 0.01], n_steps=3)
+    assert isinstance(st, belief._c.MetropolisStats)
+    assert st.evaluations == 50 * 4 and isinstance(st.evaluations, int)
+    assert st.acceptance_rate == 1.0  # a flat target accepts every move that stays in the box
+    for name in ("acceptance_rate", "evaluations"):
+        assert getattr(belief._c.MetropolisStats, name).__doc__.startswith(f"{name} : ")
+
+
+def test_absolute_planar_pose_by_hand_with_yaw_wrapping():
+    # (0.1, 0, 3.0, extra 5) in an object at (1, 2, pi/2): R(pi/2)(0.1, 0) = (0, 0.1); 3 + pi/2 wraps.
+    W = belief.absolute_planar_pose([[0.1, 0.0, 3.0, 5.0]], [[1.0, 2.0, np.pi / 2], [-1.0, 0.0, -np.pi]])
+    np.testing.assert_allclose(W, [[1.0, 2.1, 3.0 + np.pi / 2 - 2 * np.pi, 5.0], [-1.1, 0.0, 3.0 - np.pi, 5.0]],
+                               atol=1e-12)
+    P = belief.absolute_planar_pose_paired([[0.1, 0.0, 3.0], [0.0, 0.2, -3.0]], [[1.0, 2.0, np.pi / 2],
+                                                                                [-1.0, 0.0, -np.pi]])
+    np.testing.assert_allclose(P, [[1.0, 2.1, 3.0 + np.pi / 2 - 2 * np.pi], [-1.0, -0.2, -3.0 + np.pi]], atol=1e-12)
+    with pytest.raises(ValueError, match="poses"):
+        belief.absolute_planar_pose_paired(np.zeros((2, 3)), np.zeros((3, 3)))
+    with pytest.raises(ValueError, match="relative"):
+        belief.absolute_planar_pose(np.zeros((2, 2)), np.zeros((1, 3)))
+
+
+def test_absolute_planar_pose_inverts_relative_planar_pose_both_ways():
+    rng = np.random.default_rng(3)
+    A = np.column_stack([rng.uniform(-0.5, 0.5, (9, 2)), rng.uniform(-10, 10, 9), rng.normal(size=9)])
+    P = np.column_stack([rng.uniform(-0.5, 0.5, (4, 2)), rng.uniform(-10, 10, 4)])
+    rel = belief.relative_planar_pose(A, P).reshape(9, 4, 4)
+    for j in range(4):
+        back = belief.absolute_planar_pose(rel[:, j], P[j])
+        np.testing.assert_allclose(back[:, [0, 1, 3]], A[:, [0, 1, 3]], atol=1e-12)
+        np.testing.assert_allclose(np.angle(np.exp(1j * (back[:, 2] - A[:, 2]))), 0.0, atol=1e-12)
+        assert np.all(back[:, 2] >= -np.pi) and np.all(back[:, 2] < np.pi)
+        np.testing.assert_array_equal(belief.absolute_planar_pose_paired(rel[:, j], np.tile(P[j], (9, 1))), back)
+    world = belief.absolute_planar_pose(A, P).reshape(9, 4, 4)
+    for j in range(4):
+        again = belief.relative_planar_pose(world[:, j], P[j])
+        np.testing.assert_allclose(again[:, :2], A[:, :2], atol=1e-12)
+        np.testing.assert_allclose(np.angle(np.exp(1j * (again[:, 2] - A[:, 2]))), 0.0, atol=1e-12)

@@ -64,7 +64,7 @@ def test_sparse_variance_equals_dense_fitc_formula(ns):
     Z, _ = data(29, 3, seed=5)
     ls, var, noise = np.array([0.9, 1.2, 1.6]), 1.4, 0.02
     sp = SparseGP(inducing=Z, lengthscale=ls, variance=var, noise=noise, **FIXED).fit(X, y)
-    jit = sp.fit_info_["jitter_used"]
+    jit = sp.fit_info_.jitter_used
     Kmm = _se(Z, Z, ls, var) + jit * var * np.eye(29)
     Kmn = _se(Z, X, ls, var)
     Ki = np.linalg.inv(Kmm)
@@ -216,3 +216,41 @@ def test_get_set_params():
     assert gp.get_params()["n_inducing"] == 7
     assert gp.set_params(n_inducing=9, kernel="matern52") is gp
     assert gp.n_inducing == 9 and gp.kernel == "matern52"
+
+
+def test_fit_info_is_a_bound_class():
+    X, y = data(60, 2)
+    gp = SparseGP(n_inducing=15, max_iter=30).fit(X, y)
+    info = gp.fit_info_
+    assert isinstance(info.iterations, int) and 0 < info.iterations <= 30
+    assert isinstance(info.evaluations, int) and info.evaluations >= info.iterations
+    assert info.log_marginal_likelihood == pytest.approx(gp.log_marginal_likelihood(), rel=1e-12)
+    assert info.jitter_used >= 0.0
+    assert info.message == "converged" or info.message.startswith("stopped: ")
+    with pytest.raises(AttributeError):
+        info.iterations = 0
+    fixed = ExactGP(optimize=False).fit(X, y).fit_info_
+    assert fixed.iterations == 0 and fixed.evaluations == 0 and fixed.message == ""
+    per_model = ExactGP(max_iter=5, shared_hyperparameters=False).fit(X, np.c_[y, -y]).fit_info_
+    assert len(per_model) == 2 and all(f.iterations <= 5 for f in per_model)
+    from bayesgrasp import _core
+    for name in ["iterations", "evaluations", "log_marginal_likelihood", "jitter_used", "message"]:
+        assert getattr(_core.gp.FitInfo, name).__doc__.startswith(f"{name} : ")
+
+
+def test_threads_zero_means_all_cores_with_the_same_predictions():
+    import os
+    X, y = data(150, 3)
+    Xs, _ = data(4096, 3, seed=9)  # large enough for the threaded path (>= 2048 inputs)
+    for cls in (ExactGP, SparseGP):
+        all_cores = cls(threads=0, max_iter=10).fit(X, y)
+        one = cls(threads=1, max_iter=10).fit(X, y)
+        assert all_cores.models_[0].threads == len(os.sched_getaffinity(0))
+        assert one.models_[0].threads == 1
+        m0, s0 = all_cores.predict(Xs, return_std=True)
+        m1, s1 = one.predict(Xs, return_std=True)
+        np.testing.assert_array_equal(m0, m1)
+        np.testing.assert_array_equal(s0, s1)
+        assert all_cores.models_[0].options.threads == 0
+    with pytest.raises(ValueError, match="threads"):
+        ExactGP(threads=-1).fit(X, y)

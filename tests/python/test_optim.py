@@ -106,3 +106,43 @@ def test_steepest_descent_quadratic_with_bounds():
 def test_bad_input(call, match):
     with pytest.raises(ValueError, match=match):
         call()
+
+
+def _documented(cls, fields):
+    """Every field is a property with a numpydoc 'name : type' docstring."""
+    for name in fields:
+        doc = getattr(cls, name).__doc__ or ""
+        assert doc.startswith(f"{name} : "), (cls.__name__, name, doc)
+
+
+def test_result_is_a_bound_class_with_numpy_fields():
+    r = optim.pso("sphere", ([-1, -1], [1, 1]), n_particles=8, max_iter=5, record_history=True, seed=1)
+    assert isinstance(r, optim.OptimizeResult)
+    assert isinstance(r.x, np.ndarray) and r.x.shape == (2,) and r.x.dtype == np.float64
+    assert isinstance(r.history, np.ndarray) and r.history.shape == (6,)
+    assert isinstance(r.fun, float) and isinstance(r.nit, int) and isinstance(r.nfev, int)
+    assert isinstance(r.converged, bool) and isinstance(r.message, str)
+    assert r.nit == 5 and r.nfev == 8 * 6 and r.history[-1] == r.fun
+    assert r.x is r.x  # one array per result
+    r.x[0] = 5.0  # writable, as the result's own copy
+    assert r.x[0] == 5.0
+    with pytest.raises(AttributeError):
+        r.fun = 0.0
+    no_history = optim.trust_region("sphere", [0.5, 0.5])
+    assert no_history.history.shape == (0,) and no_history.fun < 1e-12
+    assert "OptimizeResult(" in repr(r)
+    _documented(optim.OptimizeResult, ["x", "fun", "nit", "nfev", "history", "converged", "message"])
+
+
+def test_options_classes_are_bound_and_documented():
+    c = optim._c
+    _documented(c.PSOOptions, ["n_particles", "max_iter", "inertia", "c1", "c2", "vmax_fraction", "stall_iter",
+                               "ftol", "seed", "target", "record_history", "init"])
+    _documented(c.AnnealingOptions, ["n_chains", "t0", "cooling", "step", "adapt_interval", "init"])
+    _documented(c.FireflyOptions, ["n_fireflies", "beta0", "gamma", "alpha", "alpha_decay", "init"])
+    _documented(c.TrustRegionOptions, ["radius0", "max_radius", "eta", "gtol", "xtol"])
+    o = c.PSOOptions()
+    assert o.n_particles == 40 and o.inertia == pytest.approx(0.7298) and o.target == -np.inf
+    o.n_particles = 12
+    r = c.pso("sphere", np.array([-1.0, -1.0]), np.array([1.0, 1.0]), o)
+    assert r.nfev == 12 * (o.max_iter + 1)

@@ -104,3 +104,16 @@ def test_batch_bad_counts():
         quality.epsilon_volume_batch(P, P, np.zeros(3), 0.05, counts=[1, 1])
     with pytest.raises(ValueError, match="counts"):
         quality.epsilon_volume_batch(P, P, np.zeros(3), 0.05, counts=[4, -1])
+
+
+def test_batch_threads_zero_is_all_cores_and_negative_is_rejected():
+    rng = np.random.default_rng(5)
+    Ps = [rng.normal(size=(5, 3)) for _ in range(6)]
+    Ns = [p / np.linalg.norm(p, axis=1, keepdims=True) for p in Ps]
+    Ps = [0.04 * n for n in Ns]
+    all_cores = quality.epsilon_volume_batch(Ps, Ns, np.zeros(3), 0.04, threads=0)
+    one = quality.epsilon_volume_batch(Ps, Ns, np.zeros(3), 0.04, threads=1)
+    np.testing.assert_array_equal(all_cores[0], one[0])
+    np.testing.assert_array_equal(all_cores[1], one[1])
+    with pytest.raises(ValueError, match="threads"):
+        quality.epsilon_volume_batch(Ps, Ns, np.zeros(3), 0.04, threads=-1)

@@ -5,9 +5,7 @@
 #include <cmath>
 #include <limits>
 
-#ifdef _OPENMP
-#include <omp.h>
-#endif
+#include "bayesgrasp/common/parallel.hpp"
 
 namespace bayesgrasp::belief {
 
@@ -38,20 +36,21 @@ Bandwidth bandwidth_from_string(const std::string& s) {
   throw std::invalid_argument("bandwidth: expected 'scott' or 'silverman', got '" + s + "'");
 }
 
-double kde_entropy(const RowMatrixXd& X, const Eigen::VectorXd& lw, const StateSpace& space, Bandwidth bw) {
-  space.validate();
-  const int n = static_cast<int>(X.rows()), d = static_cast<int>(X.cols());
-  if (n == 0) throw std::invalid_argument("particles: zero particles");
-  if (d != space.dim()) throw std::invalid_argument("particles: column count differs from the bounds' dimension");
-  if (!X.allFinite()) throw std::invalid_argument("particles: contains NaN or infinity");
-  if (lw.size() != n) throw std::invalid_argument("log_weights: expected one per particle");
-  const Eigen::VectorXd w = normalised_weights(lw);
+namespace {
+
+// The KDE's Gaussian kernel: covariance H = f^2 C (C the weighted covariance of the deviations
+// from the weighted mean, f by Scott's or Silverman's rule), as its whitening W = chol(H)^-1 and
+// the log normalising constant of N(0, H).
+struct KdeKernel {
+  Eigen::MatrixXd W;
+  double log_norm = 0.0;
+};
+
+KdeKernel kde_kernel(const RowMatrixXd& Xc, const Eigen::VectorXd& w, const Eigen::VectorXd& mu,
+                     const StateSpace& space, Bandwidth bw) {
+  const int n = static_cast<int>(Xc.rows()), d = static_cast<int>(Xc.cols());
   const double sw2 = w.squaredNorm();
   const double neff = 1.0 / sw2;
-  // Weighted mean (circular for wrapping dims) and deviations.
-  ParticleBelief tmp(space, X, lw);
-  const Eigen::VectorXd mu = tmp.mean();
-  const RowMatrixXd& Xc = tmp.particles();  // wrapped copy
   RowMatrixXd dev(n, d);
   for (int i = 0; i < n; ++i)
     for (int k = 0; k < d; ++k) dev(i, k) = space.difference(k, Xc(i, k), mu[k]);
@@ -72,9 +71,39 @@ double kde_entropy(const RowMatrixXd& X, const Eigen::VectorXd& lw, const StateS
     llt.compute(H);
   }
   const Eigen::MatrixXd Lf = llt.matrixL();
-  const double log_norm = -0.5 * d * std::log(2.0 * M_PI) - Lf.diagonal().array().log().sum();
+  KdeKernel kernel;
+  kernel.log_norm = -0.5 * d * std::log(2.0 * M_PI) - Lf.diagonal().array().log().sum();
   // Whitening W = L^-1 (lower triangular): Mahalanobis distance = |W diff|^2.
-  const Eigen::MatrixXd W = Lf.triangularView<Eigen::Lower>().solve(Eigen::MatrixXd::Identity(d, d));
+  kernel.W = Lf.triangularView<Eigen::Lower>().solve(Eigen::MatrixXd::Identity(d, d));
+  return kernel;
+}
+
+// Squared Mahalanobis distance |W (x_i - x_j)|^2 with wrapped differences in wrapping dims
+// (both in [low, high): |e| < period), W lower triangular.
+double wrapped_mahalanobis(const RowMatrixXd& Xc, int i, int j, const Eigen::MatrixXd& W, const StateSpace& space,
+                           const Eigen::VectorXd& period, std::vector<double>& diff) {
+  const int d = static_cast<int>(Xc.cols());
+  for (int k = 0; k < d; ++k) {
+    double e = Xc(i, k) - Xc(j, k);
+    if (space.wrap(k)) {
+      if (e >= 0.5 * period[k]) e -= period[k];
+      else if (e < -0.5 * period[k]) e += period[k];
+    }
+    diff[k] = e;
+  }
+  double q = 0.0;
+  for (int r = 0; r < d; ++r) {
+    double t = 0.0;
+    for (int c = 0; c <= r; ++c) t += W(r, c) * diff[c];
+    q += t * t;
+  }
+  return q;
+}
+
+// -sum_i w_i log p(x_i), p(x) = sum_j w_j N(x - x_j; 0, H), each inner sum by log-sum-exp.
+double resubstitution_entropy(const RowMatrixXd& Xc, const Eigen::VectorXd& lw, const Eigen::VectorXd& w,
+                              const KdeKernel& kernel, const StateSpace& space) {
+  const int n = static_cast<int>(Xc.rows()), d = static_cast<int>(Xc.cols());
   const Eigen::VectorXd logw = lw.array() - log_sum_exp(lw);
   bool any_wrap = false;
   Eigen::VectorXd period(d);
@@ -84,9 +113,9 @@ double kde_entropy(const RowMatrixXd& X, const Eigen::VectorXd& lw, const StateS
   }
   // Without wrapping dims, whiten the particles once; otherwise wrap each difference first.
   RowMatrixXd Z;
-  if (!any_wrap) Z = Xc * W.transpose();
+  if (!any_wrap) Z = Xc * kernel.W.transpose();
   double H_est = 0.0;
-  std::vector<double> terms(n), diff(d), z(d);
+  std::vector<double> terms(n), diff(d);
   for (int i = 0; i < n; ++i) {
     if (w[i] == 0.0) continue;
     double mx = -kInf;
@@ -95,28 +124,33 @@ double kde_entropy(const RowMatrixXd& X, const Eigen::VectorXd& lw, const StateS
       if (!any_wrap) {
         for (int k = 0; k < d; ++k) { const double e = Z(i, k) - Z(j, k); q += e * e; }
       } else {
-        for (int k = 0; k < d; ++k) {
-          double e = Xc(i, k) - Xc(j, k);
-          if (space.wrap(k)) {  // both in [low, high): |e| < period
-            if (e >= 0.5 * period[k]) e -= period[k];
-            else if (e < -0.5 * period[k]) e += period[k];
-          }
-          diff[k] = e;
-        }
-        for (int r = 0; r < d; ++r) {
-          double t = 0.0;
-          for (int c = 0; c <= r; ++c) t += W(r, c) * diff[c];
-          q += t * t;
-        }
+        q = wrapped_mahalanobis(Xc, i, j, kernel.W, space, period, diff);
       }
       terms[j] = logw[j] - 0.5 * q;
       mx = std::max(mx, terms[j]);
     }
     double sum = 0.0;
     for (int j = 0; j < n; ++j) sum += std::exp(terms[j] - mx);
-    H_est -= w[i] * (log_norm + mx + std::log(sum));
+    H_est -= w[i] * (kernel.log_norm + mx + std::log(sum));
   }
   return H_est;
+}
+
+}  // namespace
+
+double kde_entropy(const RowMatrixXd& X, const Eigen::VectorXd& lw, const StateSpace& space, Bandwidth bw) {
+  space.validate();
+  const int n = static_cast<int>(X.rows()), d = static_cast<int>(X.cols());
+  if (n == 0) throw std::invalid_argument("particles: zero particles");
+  if (d != space.dim()) throw std::invalid_argument("particles: column count differs from the bounds' dimension");
+  if (!X.allFinite()) throw std::invalid_argument("particles: contains NaN or infinity");
+  if (lw.size() != n) throw std::invalid_argument("log_weights: expected one per particle");
+  const Eigen::VectorXd w = normalised_weights(lw);
+  // Weighted mean (circular for wrapping dims) of the wrapped particles.
+  const ParticleBelief tmp(space, X, lw);
+  const RowMatrixXd& Xc = tmp.particles();
+  const KdeKernel kernel = kde_kernel(Xc, w, tmp.mean(), space, bw);
+  return resubstitution_entropy(Xc, lw, w, kernel, space);
 }
 
 namespace {
@@ -209,15 +243,11 @@ std::vector<EntropyEstimate> expected_posterior_entropy_batch(const Eigen::Vecto
   cdf[n - 1] = 1.0;
   const Draws dr = make_draws(n_samples, K, seed);
   std::vector<EntropyEstimate> out(n_actions);
-#ifdef _OPENMP
-  const int threads = n_threads <= 0 ? omp_get_max_threads() : n_threads;
+  const int threads = thread_count(n_threads, "n_threads");
 #pragma omp parallel num_threads(threads) if (threads > 1 && n_actions > 1)
-#endif
   {
     std::vector<double> buf;
-#ifdef _OPENMP
 #pragma omp for schedule(static)
-#endif
     for (int a = 0; a < n_actions; ++a)
       out[a] = epe_one(lw, cdf, mean.data() + static_cast<size_t>(a) * n * K,
                        var.data() + static_cast<size_t>(a) * n * K, n, K, dr, buf);

@@ -39,7 +39,7 @@ EntropyEstimate expected_posterior_entropy(const Eigen::VectorXd& log_weights, c
                                            const RowMatrixXd& var, int n_samples, std::uint64_t seed);
 
 /// The same for A candidate actions at once: mean and var are (A*N, K), rows a*N .. a*N+N-1 for
-/// action a. Actions are independent (parallel with OpenMP when n_threads != 1; 0 = all).
+/// action a. Actions are independent (n_threads OpenMP threads; 0 = all cores, negative throws).
 std::vector<EntropyEstimate> expected_posterior_entropy_batch(const Eigen::VectorXd& log_weights,
                                                               const RowMatrixXd& mean, const RowMatrixXd& var,
                                                               int n_actions, int n_samples, std::uint64_t seed,

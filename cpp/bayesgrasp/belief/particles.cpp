@@ -40,7 +40,9 @@ void StateSpace::validate() const {
     throw std::invalid_argument("wraps: expected one flag per dimension");
   if (!low.allFinite() || !high.allFinite()) throw std::invalid_argument("bounds: contains NaN or infinity");
   for (int k = 0; k < dim(); ++k) {
-    if (low[k] > high[k]) throw std::invalid_argument("bounds: low > high in dimension " + std::to_string(k));
+    if (low[k] > high[k])
+      throw std::invalid_argument("bounds: low > high in dimension " + std::to_string(k) + " (" +
+                                  std::to_string(low[k]) + " > " + std::to_string(high[k]) + ")");
     if (wrap(k) && !(high[k] > low[k]))
       throw std::invalid_argument("bounds: a wrapping dimension needs high > low (dimension " + std::to_string(k) + ")");
   }

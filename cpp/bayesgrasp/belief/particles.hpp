@@ -16,13 +16,13 @@
 #include <string>
 #include <vector>
 
+#include "bayesgrasp/common/random.hpp"
+
 namespace bayesgrasp::belief {
 
 using RowMatrixXd = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
-using Rng = std::mt19937_64;
-
-/// Uniform in [0, 1) from the top 53 bits of the engine.
-inline double uniform01(Rng& rng) { return static_cast<double>(rng() >> 11) * 0x1.0p-53; }
+using bayesgrasp::Rng;        // common/random.hpp: the seeded engine and its uniform [0, 1)
+using bayesgrasp::uniform01;
 
 /// Batch log-likelihood (or log-target): X is (N, D); writes ll (already sized N).
 /// -inf is allowed (zero likelihood); NaN and +inf are errors.

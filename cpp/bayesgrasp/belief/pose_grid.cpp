@@ -2,9 +2,11 @@
 
 #include <algorithm>
 #include <cmath>
-#include <omp.h>
 #include <stdexcept>
 #include <string>
+
+#include "bayesgrasp/belief/relative_pose.hpp"
+#include "bayesgrasp/common/parallel.hpp"
 
 namespace bayesgrasp::belief {
 
@@ -71,15 +73,8 @@ void RelativePoseGrid::at(double x, double y, double yaw, int c0, int nc, double
   }
 }
 
-namespace {
-void check_poses(const RowMatrixXd& m, const char* name) {
-  if (m.cols() != 3) throw std::invalid_argument(std::string(name) + ": expected 3 columns (x, y, yaw)");
-  if (!m.allFinite()) throw std::invalid_argument(std::string(name) + ": contains NaN or infinity");
-}
-}  // namespace
-
 RowMatrixXd RelativePoseGrid::interpolate(const RowMatrixXd& rel) const {
-  check_poses(rel, "rel");
+  check_planar_poses(rel, "rel");
   RowMatrixXd out(rel.rows(), channels());
   for (Eigen::Index p = 0; p < rel.rows(); ++p) at(rel(p, 0), rel(p, 1), rel(p, 2), 0, channels(), &out(p, 0));
   return out;
@@ -87,43 +82,42 @@ RowMatrixXd RelativePoseGrid::interpolate(const RowMatrixXd& rel) const {
 
 RowMatrixXd RelativePoseGrid::interpolate_pairs(const RowMatrixXd& A, const RowMatrixXd& P, int c0, int nc,
                                                 int n_threads) const {
-  check_poses(A, "actions");
-  check_poses(P, "poses");
+  check_planar_poses(A, "actions");
+  check_planar_poses(P, "poses");
   if (c0 < 0 || nc < 1 || c0 + nc > channels()) throw std::invalid_argument("channels: out of range");
   const Eigen::Index na = A.rows(), n = P.rows();
   RowMatrixXd out(na * n, nc);
-  std::vector<double> cs(n), sn(n);
-  for (Eigen::Index j = 0; j < n; ++j) { cs[j] = std::cos(P(j, 2)); sn[j] = std::sin(P(j, 2)); }
-  const int threads = n_threads <= 0 ? omp_get_max_threads() : n_threads;
+  const std::vector<PlanarFrame> frames = planar_frames(P);
+  const int threads = thread_count(n_threads, "n_threads");
 #pragma omp parallel for schedule(static) num_threads(threads) if (threads > 1 && na > 1)
   for (Eigen::Index a = 0; a < na; ++a)
     for (Eigen::Index j = 0; j < n; ++j) {
-      const double dx = A(a, 0) - P(j, 0), dy = A(a, 1) - P(j, 1);
-      at(cs[j] * dx + sn[j] * dy, -sn[j] * dx + cs[j] * dy, A(a, 2) - P(j, 2), c0, nc, &out(a * n + j, 0));
+      double x, y;  // the action in object j's frame (the yaw difference is wrapped by at())
+      frames[j].to_local(A(a, 0), A(a, 1), x, y);
+      at(x, y, A(a, 2) - P(j, 2), c0, nc, &out(a * n + j, 0));
     }
   return out;
 }
 
 Eigen::VectorXd RelativePoseGrid::expected(const RowMatrixXd& A, const RowMatrixXd& P, const Eigen::VectorXd& w,
                                            int channel, int n_threads) const {
-  check_poses(A, "actions");
-  check_poses(P, "poses");
+  check_planar_poses(A, "actions");
+  check_planar_poses(P, "poses");
   if (channel < 0 || channel >= channels()) throw std::invalid_argument("channel: out of range");
   if (w.size() != P.rows()) throw std::invalid_argument("weights: expected one per pose");
   if (!w.allFinite() || (w.array() < 0).any()) throw std::invalid_argument("weights: must be finite and >= 0");
   const Eigen::Index na = A.rows(), n = P.rows();
-  std::vector<double> cs(n), sn(n);
-  for (Eigen::Index j = 0; j < n; ++j) { cs[j] = std::cos(P(j, 2)); sn[j] = std::sin(P(j, 2)); }
+  const std::vector<PlanarFrame> frames = planar_frames(P);
   Eigen::VectorXd out(na);
-  const int threads = n_threads <= 0 ? omp_get_max_threads() : n_threads;
+  const int threads = thread_count(n_threads, "n_threads");
 #pragma omp parallel for schedule(static) num_threads(threads) if (threads > 1 && na > 1)
   for (Eigen::Index a = 0; a < na; ++a) {
     double s = 0.0;
     for (Eigen::Index j = 0; j < n; ++j) {
       if (w[j] == 0.0) continue;
-      const double dx = A(a, 0) - P(j, 0), dy = A(a, 1) - P(j, 1);
-      double v;
-      at(cs[j] * dx + sn[j] * dy, -sn[j] * dx + cs[j] * dy, A(a, 2) - P(j, 2), channel, 1, &v);
+      double x, y, v;
+      frames[j].to_local(A(a, 0), A(a, 1), x, y);
+      at(x, y, A(a, 2) - P(j, 2), channel, 1, &v);
       s += w[j] * v;
     }
     out[a] = s;
@@ -135,6 +129,7 @@ std::vector<EntropyEstimate> RelativePoseGrid::expected_posterior_entropy(
     const RowMatrixXd& A, const RowMatrixXd& P, const Eigen::VectorXd& log_weights, int mean_c0, int var_c0, int k,
     int n_samples, std::uint64_t seed, int n_threads) const {
   if (k < 1) throw std::invalid_argument("k: need at least one measurement output");
+  if (log_weights.size() != P.rows()) throw std::invalid_argument("log_weights: expected one per pose");
   const RowMatrixXd mean = interpolate_pairs(A, P, mean_c0, k, n_threads);
   RowMatrixXd var = interpolate_pairs(A, P, var_c0, k, n_threads);
   var = var.cwiseMax(1e-12);  // interpolated variances stay positive

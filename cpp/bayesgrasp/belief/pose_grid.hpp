@@ -33,7 +33,8 @@ class RelativePoseGrid {
   RowMatrixXd interpolate(const RowMatrixXd& rel) const;
 
   /// Values at the pose of each action (A, 3) relative to each object pose (N, 3), channels
-  /// [c0, c0 + nc): (A * N, nc), row a * N + j (the layout of relative_planar_pose).
+  /// [c0, c0 + nc): (A * N, nc), row a * N + j (the layout of relative_planar_pose). n_threads:
+  /// OpenMP threads over the actions (0 = all cores).
   RowMatrixXd interpolate_pairs(const RowMatrixXd& actions, const RowMatrixXd& poses, int c0, int nc,
                                 int n_threads = 1) const;
 
@@ -58,7 +59,7 @@ class RelativePoseGrid {
   // The same values channel by channel (column-major): a one-channel lookup (the stability
   // field of Eq. 3.1, the planners' innermost loop) then reads one small contiguous array
   // instead of strided rows of the whole table, which does not fit in cache; single precision
-  // halves that array again (relative error 6e-8, far below the table's interpolation error).
+  // halves that array again (relative rounding 2^-24, far below the table's interpolation error).
   Eigen::MatrixXf channel_major_;
   Eigen::VectorXd outside_;
 };

@@ -27,7 +27,8 @@ int ld(const ConstMatRef& a) { return as_int(std::max<Eigen::Index>(1, a.outerSt
 int ld(const MatRef& a) { return as_int(std::max<Eigen::Index>(1, a.outerStride()), "leading dimension"); }
 }  // namespace
 
-void gemm(bool ta, bool tb, double alpha, const ConstMatRef& A, const ConstMatRef& B, double beta, MatRef C) {
+void gemm(Op op_a, Op op_b, double alpha, const ConstMatRef& A, const ConstMatRef& B, double beta, MatRef C) {
+  const bool ta = op_a == Op::Transpose, tb = op_b == Op::Transpose;
   const Eigen::Index m = ta ? A.cols() : A.rows(), k = ta ? A.rows() : A.cols();
   const Eigen::Index kb = tb ? B.cols() : B.rows(), n = tb ? B.rows() : B.cols();
   if (k != kb || C.rows() != m || C.cols() != n) throw std::invalid_argument("blas::gemm: size mismatch");
@@ -53,7 +54,7 @@ namespace {
 // dtrmm_ and dtrsm_ share their signature: B = op(T) B or op(T)^-1 B, T on the left.
 using TriangularLeft = void (*)(const char*, const char*, const char*, const char*, const int*, const int*,
                                 const double*, const double*, const int*, double*, const int*);
-void triangular_left(TriangularLeft routine, const char* what, bool lower, bool trans, const ConstMatRef& T,
+void triangular_left(TriangularLeft routine, const char* what, Triangle triangle, Op op, const ConstMatRef& T,
                      MatRef B) {
   if (T.rows() != T.cols() || T.rows() != B.rows())
     throw std::invalid_argument(std::string("blas::") + what + ": size mismatch");
@@ -61,16 +62,18 @@ void triangular_left(TriangularLeft routine, const char* what, bool lower, bool 
   const int m = as_int(B.rows(), "rows"), n = as_int(B.cols(), "cols");
   const int lda = ld(T), ldb = ld(B);
   const double one = 1.0;
-  routine("L", lower ? "L" : "U", trans ? "T" : "N", "N", &m, &n, &one, T.data(), &lda, B.data(), &ldb);
+  const char* uplo = triangle == Triangle::Lower ? "L" : "U";
+  const char* trans = op == Op::Transpose ? "T" : "N";
+  routine("L", uplo, trans, "N", &m, &n, &one, T.data(), &lda, B.data(), &ldb);
 }
 }  // namespace
 
-void trmm_left(bool lower, bool trans, const ConstMatRef& T, MatRef B) {
-  triangular_left(dtrmm_, "trmm_left", lower, trans, T, B);
+void trmm_left(Triangle triangle, Op op, const ConstMatRef& T, MatRef B) {
+  triangular_left(dtrmm_, "trmm_left", triangle, op, T, B);
 }
 
-void trsm_left(bool lower, bool trans, const ConstMatRef& T, MatRef B) {
-  triangular_left(dtrsm_, "trsm_left", lower, trans, T, B);
+void trsm_left(Triangle triangle, Op op, const ConstMatRef& T, MatRef B) {
+  triangular_left(dtrsm_, "trsm_left", triangle, op, T, B);
 }
 
 }  // namespace bayesgrasp::gp::blas

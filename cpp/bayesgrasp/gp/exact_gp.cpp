@@ -3,6 +3,8 @@
 #include <cmath>
 #include <stdexcept>
 
+#include "bayesgrasp/gp/linalg.hpp"
+
 namespace bayesgrasp::gp {
 
 namespace {
@@ -15,8 +17,10 @@ struct ExactEval {
   double jitter = 0.0;
 };
 
+// The log marginal likelihood (and, if grad is non-null, the gradient of its negative with the
+// mean constants' entries for MeanType::Constant) at the given hyper-parameters.
 ExactEval exact_eval(const Eigen::MatrixXd& Xn, const Eigen::MatrixXd& Yn, const Kernel& k, double noise,
-                     const Eigen::VectorXd& c, double jitter0, Eigen::VectorXd* grad, bool constant_mean) {
+                     const Eigen::VectorXd& c, double jitter0, Eigen::VectorXd* grad, MeanType mean) {
   const Eigen::Index N = Xn.rows(), P = Yn.cols(), D = Xn.cols();
   const double var = k.variance();
   const Eigen::RowVectorXd inv_ls = (-k.log_lengthscale.array()).exp().matrix().transpose();
@@ -44,7 +48,7 @@ ExactEval exact_eval(const Eigen::MatrixXd& Xn, const Eigen::MatrixXd& Yn, const
     W *= -double(P);
     W.noalias() += e.alpha * e.alpha.transpose();
     W *= 0.5;
-    const int nc = constant_mean ? static_cast<int>(P) : 0;
+    const int nc = mean == MeanType::Constant ? static_cast<int>(P) : 0;
     grad->setZero(D + 2 + nc);
     Eigen::VectorXd gls = Eigen::VectorXd::Zero(D);
     double gvar = 0.0;
@@ -62,13 +66,13 @@ ExactEval exact_eval(const Eigen::MatrixXd& Xn, const Eigen::MatrixXd& Yn, const
 ExactGP::ExactGP(GPOptions options) : GaussianProcess(std::move(options)) {}
 
 double ExactGP::objective(const Eigen::VectorXd& theta, Eigen::VectorXd& grad) const {
-  if (Xn_.size() == 0) throw std::logic_error("objective: no training data; call fit() first");
+  check_training_data("objective");
   Kernel k;
   double noise;
   Eigen::VectorXd c;
   unpack(theta, k, noise, c, nullptr);
   const ExactEval e =
-      exact_eval(Xn_, Yn_, k, noise, c, opt_.jitter, &grad, opt_.mean == MeanType::Constant);
+      exact_eval(Xn_, Yn_, k, noise, c, opt_.jitter, &grad, opt_.mean);
   return -e.lml;
 }
 
@@ -80,25 +84,16 @@ void ExactGP::fit(const Eigen::MatrixXd& X, const Eigen::MatrixXd& Y) {
 }
 
 void ExactGP::build_cache() {
-  const ExactEval e = exact_eval(Xn_, Yn_, kernel_, noise_, mean_c_, opt_.jitter, nullptr, false);
-  lml_ = e.lml;
-  info_.log_marginal_likelihood = e.lml;
-  info_.jitter_used = e.jitter;
+  const ExactEval e = exact_eval(Xn_, Yn_, kernel_, noise_, mean_c_, opt_.jitter, nullptr, MeanType::Zero);
+  set_fitted_mean(e.lml, e.jitter, X_, e.alpha);
   const double var = kernel_.variance();
-  const Eigen::Index N = Xn_.rows(), P = outputs_;
-  cache_.type = kernel_.type;
-  cache_.inv_ls = (kernel_.log_lengthscale.array().exp() * x_scale_.array()).inverse().matrix();
-  cache_.basis = X_.array().rowwise() * cache_.inv_ls.transpose().array();
-  cache_.alpha = (e.alpha * var).array().rowwise() * y_scale_.transpose().array();
-  cache_.offset = (y_mean_ + y_scale_.cwiseProduct(mean_c_)).transpose();
   // var_f = var (1 - |sqrt(var) L^-1 f|^2): keep L / sqrt(var) and solve in prediction (the
   // same N^2 flops per input as multiplying by an explicit inverse, without its N^3 cost at fit).
   cache_.G = e.L / std::sqrt(var);
   cache_.G.triangularView<Eigen::StrictlyUpper>().setZero();
-  cache_.G_shape = 3;
-  cache_.var_f0 = (y_scale_.array().square() * var).matrix().transpose();
+  cache_.factor = VarianceFactor::InverseLower;
+  cache_.G_packed.clear();
   cache_.noise = (y_scale_.array().square() * (noise_ + e.jitter * var)).matrix().transpose();
-  (void)P;
 }
 
 }  // namespace bayesgrasp::gp

@@ -1,5 +1,6 @@
-// Exact GP regression: O(N^3) Cholesky of K + noise I; analytic log-marginal-likelihood gradients.
-// See gaussian_process.hpp for the common interface.
+// Exact GP regression: O(N^3) Cholesky of K + noise I (with adaptive jitter, linalg.hpp) and
+// analytic log-marginal-likelihood gradients; predictions solve with the Cholesky factor.
+// The common interface is in gaussian_process.hpp.
 #pragma once
 
 #include "bayesgrasp/gp/gaussian_process.hpp"

@@ -7,8 +7,8 @@
 //   SparseGP gp(o);                      // or ExactGP gp(o);
 //   gp.fit(X, Y);                        // X (N, D), Y (N, P); optimises hyper-parameters if o.optimize
 //   Eigen::MatrixXd m = gp.predict_mean(Xs);          // (Ns, P) fast path (fused kernel + dot)
-//   gp.predict(Xs, mean, var);                        // (Ns, P) each; var of the latent f (add noise
-//                                                     //  with include_noise = true)
+//   gp.predict(Xs, mean, var);                        // (Ns, P) each; var of the latent f (of an
+//                                                     //  observation with Predictive::Observation)
 //   Eigen::VectorXd lp = gp.log_predictive_density(Xs, Ys);  // (Ns,): sum over outputs of
 //                                                     //  log N(Ys(i,p) | mean, var_f + noise)
 //   std::mt19937_64 rng(seed);  auto S = gp.sample(Xs, n, rng);  // n matrices (Ns, P), marginal
@@ -17,21 +17,21 @@
 // Normalisation (o.normalize_x / o.normalize_y): inputs and outputs are standardised before the
 // fit; the hyper-parameters (lengthscales, variance, noise, mean constant) live in that
 // standardised space; every prediction is returned in the original units. All predictions are
-// const and thread-safe; batches of >= 2048 inputs use o.threads OpenMP threads.
-// Errors: std::invalid_argument for bad arguments, std::runtime_error for numerical failure
-// (never silent NaN).
+// const and thread-safe; batches of >= 2048 inputs use o.threads OpenMP threads (0 = all cores,
+// common/parallel.hpp).
+// Errors: std::invalid_argument for bad arguments and for calls that need a fitted model,
+// std::runtime_error for numerical failure (never silent NaN).
 #pragma once
 
 #include <Eigen/Core>
 
 #include <cstdint>
-#include <functional>
-#include <memory>
 #include <random>
 #include <string>
 #include <vector>
 
 #include "bayesgrasp/gp/kernel.hpp"
+#include "bayesgrasp/gp/prediction.hpp"
 
 namespace bayesgrasp::gp {
 
@@ -51,14 +51,14 @@ struct GPOptions {
   bool normalize_x = true;
   bool normalize_y = true;
   double jitter = 1e-8;          ///< initial diagonal jitter relative to the signal variance
-  int threads = 1;               ///< OpenMP threads for large prediction batches
+  int threads = 1;               ///< OpenMP threads for large prediction batches (0 = all cores)
   // SparseGP only
   int n_inducing = 200;          ///< M (capped at the number of distinct training inputs)
   bool optimize_inducing = false;
   /// SparseGP: optimise with the signal variance profiled out. The FITC covariance scales
   /// with (variance, noise) together, so for fixed lengthscales and noise/variance ratio the
   /// best overall scale is quad / (N P) in closed form; L-BFGS then searches one dimension
-  /// fewer (the same optimum; 19 vs 36 evaluations with SciPy's L-BFGS-B on bench_gp's data).
+  /// fewer and reaches the same optimum in fewer evaluations (BENCHMARKS.md).
   bool profile_scale = true;
   std::uint64_t seed = 0;        ///< k-means++ seed for the inducing inputs
   Eigen::MatrixXd inducing;      ///< (M, D) initial inducing inputs in input units; empty = k-means++
@@ -67,11 +67,11 @@ struct GPOptions {
 
 /// Result of fit(): how the optimisation went.
 struct FitInfo {
-  int iterations = 0;
+  int iterations = 0;           ///< L-BFGS-B iterations (0 without optimisation)
   int evaluations = 0;          ///< objective + gradient evaluations
-  double log_marginal_likelihood = 0.0;
+  double log_marginal_likelihood = 0.0;  ///< at the fitted hyper-parameters (standardised outputs)
   double jitter_used = 0.0;     ///< final jitter (relative) that made the Cholesky succeed
-  std::string message;
+  std::string message;          ///< "converged", "stopped: <reason>", or empty without optimisation
 };
 
 class GaussianProcess {
@@ -89,22 +89,23 @@ class GaussianProcess {
   // ---- prediction (original units) ----
   /// Predictive mean at the rows of X: (N, P).
   virtual Eigen::MatrixXd predict_mean(const Eigen::MatrixXd& X) const;
-  /// Predictive mean and variance, each (N, P). Variance of f, plus the noise if include_noise.
+  /// Predictive mean and variance, each (N, P): the variance of f, or of an observation.
   virtual void predict(const Eigen::MatrixXd& X, Eigen::MatrixXd& mean, Eigen::MatrixXd& var,
-                       bool include_noise = false) const;
+                       Predictive what = Predictive::Latent) const;
   /// Log density of the observed rows of Y at the rows of X under the predictive distribution
   /// with noise: sum over outputs of log N(Y(i,p) | mean(i,p), var(i,p) + noise_p). (N,)
   virtual Eigen::VectorXd log_predictive_density(const Eigen::MatrixXd& X, const Eigen::MatrixXd& Y) const;
-  /// n_samples independent draws per input from the marginal predictive distribution (with the
-  /// noise if include_noise): n_samples matrices (N, P).
-  virtual std::vector<Eigen::MatrixXd> sample(const Eigen::MatrixXd& X, int n_samples,
-                                              std::mt19937_64& rng, bool include_noise = true) const;
+  /// n_samples independent draws per input from the marginal predictive distribution (of f or
+  /// of an observation): n_samples matrices (N, P).
+  virtual std::vector<Eigen::MatrixXd> sample(const Eigen::MatrixXd& X, int n_samples, std::mt19937_64& rng,
+                                              Predictive what = Predictive::Observation) const;
   /// Joint draws over the rows of X (outputs independent): n_samples matrices (N, P).
-  virtual std::vector<Eigen::MatrixXd> sample_joint(const Eigen::MatrixXd& X, int n_samples,
-                                                    std::mt19937_64& rng, bool include_noise = true) const;
-  /// Predictive covariance (N, N) of output p (of f, plus noise on the diagonal if include_noise).
+  virtual std::vector<Eigen::MatrixXd> sample_joint(const Eigen::MatrixXd& X, int n_samples, std::mt19937_64& rng,
+                                                    Predictive what = Predictive::Observation) const;
+  /// Predictive covariance (N, N) of output p (of f, plus the noise on the diagonal for
+  /// Predictive::Observation).
   virtual Eigen::MatrixXd predict_cov(const Eigen::MatrixXd& X, int output = 0,
-                                      bool include_noise = false) const;
+                                      Predictive what = Predictive::Latent) const;
 
   // ---- hyper-parameters and objective (standardised space) ----
   virtual double log_marginal_likelihood() const { return lml_; }
@@ -113,7 +114,10 @@ class GaussianProcess {
   const Eigen::VectorXd& mean_constant() const { return mean_c_; }  ///< (P,), zeros for MeanType::Zero
   const GPOptions& options() const { return opt_; }
   const FitInfo& fit_info() const { return info_; }
-  void set_threads(int threads) { opt_.threads = threads < 1 ? 1 : threads; }
+  /// Sets the threads of large prediction batches (0 = all cores); throws for a negative count.
+  void set_threads(int threads);
+  /// The threads large prediction batches use: options().threads by the one thread rule.
+  int threads() const;
 
   /// Normalisation used in the fit: x_std = (x - x_mean) / x_scale, y likewise.
   const Eigen::VectorXd& x_mean() const { return x_mean_; }
@@ -138,35 +142,21 @@ class GaussianProcess {
   virtual double profiled_objective(const Eigen::VectorXd& theta_p, Eigen::VectorXd& grad, double* log_scale) const;
 
  protected:
-  // Scaled basis for the fused prediction kernels, in raw input coordinates:
-  //   mean = offset + f(r2(x, basis)) * alpha,  var_f = variance_p * (1 - |G f|^2)
-  struct Cache {
-    KernelType type = KernelType::SquaredExponential;
-    Eigen::VectorXd inv_ls;      // (D,)  1 / lengthscale in raw units
-    Eigen::MatrixXd basis;       // (M, D) basis inputs times inv_ls
-    Eigen::MatrixXd alpha;       // (M, P) weights in raw output units (include the variance)
-    Eigen::RowVectorXd offset;   // (P,)
-    Eigen::MatrixXd G;           // (M, M) variance factor; var_f = var_p * (1 - |G f|^2)
-    int G_shape = 0;             // 0 general, 1 lower triangular, 2 upper triangular,
-                                 // 3: G is lower triangular and the factor is G^-1 (solve)
-    Eigen::RowVectorXd var_f0;   // (P,) prior variance per output in raw units
-    Eigen::RowVectorXd noise;    // (P,) noise variance per output in raw units
-    // G (shape 2, upper triangular) packed in register tiles for the fused mean + variance
-    // kernel (see pack_factor()); empty = the blockwise Eigen path.
-    std::vector<double> G_packed;
-  };
-
-  /// Packs an upper-triangular cache_.G (G_shape 2) for the fused prediction kernel: the
-  /// per-input quadratic form |G f|^2 then costs M^2 flops in registers, computed on batches of
-  /// inputs right after their kernel vectors, with no (N x M) intermediate.
-  void pack_factor();
+  /// Throw std::invalid_argument naming `what` unless the model is fitted / has training data
+  /// (the objectives are evaluated during the fit, before the model counts as fitted).
   void check_fitted(const char* what) const;
+  void check_training_data(const char* what) const;
   void check_inputs(const Eigen::MatrixXd& X, const char* name) const;
   /// Standardises X, Y into Xn_, Yn_ and sets the normalisation; validates.
   void set_training_data(const Eigen::MatrixXd& X, const Eigen::MatrixXd& Y);
-  /// Runs L-BFGS-B on objective() from parameters(); returns the best theta found and sets
-  /// kernel_, noise_, mean_c_ from it.
+  /// Runs the hyper-parameter fit (hyperparameter_fit.hpp) from parameters(); n_inducing_params
+  /// > 0 when theta carries the inducing inputs too. Returns the best theta found and sets
+  /// kernel_, noise_, mean_c_ and the fit's info from it.
   Eigen::VectorXd optimise(int n_inducing_params);
+  /// Records a fit's log marginal likelihood and jitter and sets the mean part of the prediction
+  /// cache from the basis inputs (M, D) in raw units and the standardised weights (M, P):
+  /// kernel type, scaled basis, weights in raw units (times the variance), offset, prior variance.
+  void set_fitted_mean(double lml, double jitter, const Eigen::MatrixXd& basis_inputs, const Eigen::MatrixXd& weights);
   /// Splits theta into the hyper-parameters (and the inducing inputs if Z is non-null).
   void unpack(const Eigen::VectorXd& theta, Kernel& k, double& noise, Eigen::VectorXd& c,
               Eigen::MatrixXd* Z) const;
@@ -182,43 +172,7 @@ class GaussianProcess {
   Eigen::MatrixXd X_, Y_;    // raw
   Eigen::MatrixXd Xn_, Yn_;  // standardised
   Eigen::VectorXd x_mean_, x_scale_, y_mean_, y_scale_;
-  Cache cache_;
-
-  friend class IndependentOutputsGP;
+  PredictionCache cache_;
 };
-
-/// One model per output column, each with its own hyper-parameters (and inducing inputs).
-class IndependentOutputsGP : public GaussianProcess {
- public:
-  using Factory = std::function<std::unique_ptr<GaussianProcess>()>;
-  IndependentOutputsGP(GPOptions options, Factory factory);
-  void fit(const Eigen::MatrixXd& X, const Eigen::MatrixXd& Y) override;
-  Eigen::MatrixXd predict_mean(const Eigen::MatrixXd& X) const override;
-  void predict(const Eigen::MatrixXd& X, Eigen::MatrixXd& mean, Eigen::MatrixXd& var,
-               bool include_noise = false) const override;
-  Eigen::MatrixXd predict_cov(const Eigen::MatrixXd& X, int output = 0,
-                              bool include_noise = false) const override;
-  std::vector<Eigen::MatrixXd> sample_joint(const Eigen::MatrixXd& X, int n_samples,
-                                            std::mt19937_64& rng, bool include_noise = true) const override;
-  double log_marginal_likelihood() const override;
-  Eigen::VectorXd parameters() const override;
-  double objective(const Eigen::VectorXd& theta, Eigen::VectorXd& grad) const override;
-  int n_models() const { return static_cast<int>(models_.size()); }
-  const GaussianProcess& model(int p) const { return *models_.at(p); }
-
- private:
-  Factory factory_;
-  std::vector<std::unique_ptr<GaussianProcess>> models_;
-};
-
-/// Cholesky with adaptive jitter: tries A + jitter*scale*I for jitter = jitter0, x10, ... up to
-/// max_jitter; returns the lower factor and sets *used. Throws std::runtime_error (naming `what`)
-/// if it never succeeds or A is not finite.
-Eigen::MatrixXd robust_cholesky(const Eigen::MatrixXd& A, double jitter0, double scale, const char* what,
-                                double* used = nullptr, double max_jitter = 1e-2);
-
-/// k-means++ seeding (seeded) followed by `iters` Lloyd iterations; returns up to k centres (k, D)
-/// (fewer if X has fewer distinct rows).
-Eigen::MatrixXd kmeans_pp(const Eigen::MatrixXd& X, int k, std::uint64_t seed, int iters = 10);
 
 }  // namespace bayesgrasp::gp

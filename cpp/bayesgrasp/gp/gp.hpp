@@ -4,5 +4,6 @@
 
 #include "bayesgrasp/gp/exact_gp.hpp"
 #include "bayesgrasp/gp/gaussian_process.hpp"
+#include "bayesgrasp/gp/independent_outputs_gp.hpp"
 #include "bayesgrasp/gp/kernel.hpp"
 #include "bayesgrasp/gp/sparse_gp.hpp"

@@ -1,8 +1,8 @@
 // Sparse GP regression with the FITC approximation (Snelson & Ghahramani 2006):
 //   p(y) = N(0, Q_nn + diag(K_nn - Q_nn) + noise I),  Q_nn = K_nm K_mm^-1 K_mn,
-// with M inducing inputs Z (k-means++ initialised, optionally optimised). One objective and
-// gradient evaluation costs O(N M^2) through Cholesky factors of M x M matrices only.
-// See gaussian_process.hpp for the common interface.
+// with M inducing inputs Z (k-means++ initialised, kmeans.hpp; optionally optimised). One
+// objective and gradient evaluation (fitc.hpp) costs O(N M^2) through Cholesky factors of M x M
+// matrices only. The common interface is in gaussian_process.hpp.
 #pragma once
 
 #include "bayesgrasp/gp/gaussian_process.hpp"

@@ -1,8 +1,8 @@
 // Reusable scratch memory for the large (M x N) matrices of the FITC objective. One buffer per
 // matrix, kept between evaluations (no page faults after the first), aligned to 2 MiB and
 // advised for transparent huge pages (Linux, madvise mode): the objective streams several
-// 8 MB matrices through BLAS packing and column passes, and with 4 KiB pages their TLB misses
-// cost about 5% of an evaluation (measured on the benchmark workload).
+// megabyte-sized matrices through BLAS packing and column passes, and with 4 KiB pages their
+// TLB misses are a measurable share of an evaluation.
 #pragma once
 
 #include <Eigen/Core>

@@ -20,8 +20,7 @@ Result simulated_annealing(const BatchObjective& fun, const Bounds& b, const Ann
   if (!(o.target_acceptance > 0.0 && o.target_acceptance < 1.0))
     throw std::invalid_argument("target_acceptance: must be in (0, 1)");
   const int n = o.n_chains, d = b.dim();
-  if (o.init.size() && (o.init.rows() != n || o.init.cols() != d))
-    throw std::invalid_argument("init: expected shape (n_chains, D)");
+  validate_population(o, n, d, "n_chains");
 
   Rng rng(o.seed);
   std::normal_distribution<double> normal;

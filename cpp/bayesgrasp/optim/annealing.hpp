@@ -2,13 +2,12 @@
 // per iteration) with bounded Gaussian random-walk proposals and geometric cooling.
 #pragma once
 
-#include <limits>
-
 #include "bayesgrasp/optim/objective.hpp"
 
 namespace bayesgrasp::optim {
 
-struct AnnealingOptions {
+/// PopulationOptions::init: (n_chains, D) starting points.
+struct AnnealingOptions : PopulationOptions {
   int n_chains = 16;
   int max_iter = 1000;        ///< proposals per chain after the initial evaluation
   double t0 = -1.0;           ///< initial temperature; <= 0: the std of f over the initial chains (1 if that is 0)
@@ -22,10 +21,6 @@ struct AnnealingOptions {
   int adapt_interval = 10;
   double target_acceptance = 0.2;
   double adapt_factor = 1.5;
-  std::uint64_t seed = 0;
-  double target = -std::numeric_limits<double>::infinity();
-  bool record_history = false;
-  RowMatrixXd init;           ///< optional (n_chains, D) starting points
 };
 
 /// Proposals leaving the box are reflected back into it. Evaluations = n_chains * (iterations + 1).

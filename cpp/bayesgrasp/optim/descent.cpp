@@ -9,50 +9,51 @@ Eigen::VectorXd project(const Eigen::VectorXd& x, const Bounds& b) {
   return x.cwiseMax(b.low).cwiseMin(b.high);
 }
 
-void validate_start(const Eigen::VectorXd& x0, const Bounds& b) {
+void validate_start(const Eigen::VectorXd& x0, const Bounds& b, double h) {
   if (x0.size() == 0) throw std::invalid_argument("x0: must have at least one entry");
   if (!x0.allFinite()) throw std::invalid_argument("x0: contains NaN or infinity");
   if (b.low.size() || b.high.size()) {
     validate_bounds(b);
     if (b.dim() != x0.size()) throw std::invalid_argument("bounds: dimension differs from x0");
   }
+  if (!(h > 0.0)) throw std::invalid_argument("h: must be positive");
+}
+
+double start_value(Evaluator& eval, const Eigen::VectorXd& x) {
+  const double f = eval.at(x);
+  if (!std::isfinite(f)) throw std::invalid_argument("x0: objective is not finite at the start point");
+  return f;
+}
+
+CentralDifferences::CentralDifferences(const Eigen::VectorXd& x, double h)
+    : points(2 * x.size(), x.size()), steps(x.size()) {
+  for (Eigen::Index k = 0; k < x.size(); ++k) {
+    steps[k] = h * std::max(1.0, std::abs(x[k]));
+    points.row(2 * k) = x.transpose();
+    points.row(2 * k + 1) = x.transpose();
+    points(2 * k, k) += steps[k];
+    points(2 * k + 1, k) -= steps[k];
+  }
 }
 
 Eigen::VectorXd numerical_gradient(Evaluator& eval, const Eigen::VectorXd& x, double h) {
-  const int d = static_cast<int>(x.size());
-  RowMatrixXd S(2 * d, d);
-  Eigen::VectorXd hk(d), f;
-  for (int k = 0; k < d; ++k) {
-    hk[k] = h * std::max(1.0, std::abs(x[k]));
-    S.row(2 * k) = x.transpose();
-    S.row(2 * k + 1) = x.transpose();
-    S(2 * k, k) += hk[k];
-    S(2 * k + 1, k) -= hk[k];
-  }
-  eval(S, f);
-  Eigen::VectorXd g(d);
-  for (int k = 0; k < d; ++k) g[k] = (f[2 * k] - f[2 * k + 1]) / (2.0 * hk[k]);
+  const CentralDifferences cd(x, h);
+  Eigen::VectorXd f;
+  eval(cd.points, f);
+  Eigen::VectorXd g(x.size());
+  for (Eigen::Index k = 0; k < x.size(); ++k) g[k] = (f[2 * k] - f[2 * k + 1]) / (2.0 * cd.steps[k]);
   return g;
 }
 
 Result steepest_descent(const BatchObjective& fun, const Eigen::VectorXd& x0_, const Bounds& b,
                         const DescentOptions& o) {
-  validate_start(x0_, b);
-  if (!(o.h > 0.0)) throw std::invalid_argument("h: must be positive");
+  validate_start(x0_, b, o.h);
   if (!(o.t0 > 0.0)) throw std::invalid_argument("t0: must be positive");
   if (!(o.backtrack > 0.0 && o.backtrack < 1.0)) throw std::invalid_argument("backtrack: must be in (0, 1)");
   if (!(o.armijo > 0.0 && o.armijo < 1.0)) throw std::invalid_argument("armijo: must be in (0, 1)");
   Evaluator eval(fun);
   Eigen::VectorXd x = project(x0_, b);
-  RowMatrixXd one(1, x.size());
-  Eigen::VectorXd fv;
-  auto f1 = [&](const Eigen::VectorXd& y) {
-    one.row(0) = y.transpose();
-    eval(one, fv);
-    return fv[0];
-  };
-  double f = f1(x);
-  if (!std::isfinite(f)) throw std::invalid_argument("x0: objective is not finite at the start point");
+  double f = start_value(eval, x);
   Result r;
   if (o.record_history) r.history.push_back(f);
   double t = o.t0;
@@ -68,7 +69,7 @@ Result steepest_descent(const BatchObjective& fun, const Eigen::VectorXd& x0_, c
     double fn = f;
     for (int k = 0; k < o.max_backtrack; ++k, t *= o.backtrack) {
       xn = project(x - t * g, b);
-      fn = f1(xn);
+      fn = eval.at(xn);
       if (fn <= f - o.armijo * g.dot(x - xn)) { accepted = true; break; }
     }
     if (!accepted) { r.converged = true; r.message = "line search found no decrease"; break; }
@@ -79,10 +80,7 @@ Result steepest_descent(const BatchObjective& fun, const Eigen::VectorXd& x0_, c
     t *= 2.0;
     if (df <= o.ftol * std::max(1.0, std::abs(f))) { ++it; r.converged = true; r.message = "relative decrease below ftol"; break; }
   }
-  r.x = x;
-  r.f = f;
-  r.iterations = it;
-  r.evaluations = eval.evaluations();
+  set_outcome(r, x, f, it, eval.evaluations());
   return r;
 }
 

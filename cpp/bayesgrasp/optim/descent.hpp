@@ -6,8 +6,15 @@
 
 namespace bayesgrasp::optim {
 
-/// Central differences in one batch of 2D rows; step h_k = h * max(1, |x_k|).
-/// Returns the gradient; adds 2D to *evaluations if given.
+/// The central-difference stencil around x: rows 2k and 2k + 1 of `points` are x + h_k e_k and
+/// x - h_k e_k, with the step h_k = h * max(1, |x_k|) in `steps`.
+struct CentralDifferences {
+  RowMatrixXd points;     ///< (2D, D)
+  Eigen::VectorXd steps;  ///< (D,)
+  CentralDifferences(const Eigen::VectorXd& x, double h);
+};
+
+/// The gradient by central differences, the stencil evaluated as one batch of 2D rows.
 Eigen::VectorXd numerical_gradient(Evaluator& eval, const Eigen::VectorXd& x, double h);
 
 struct DescentOptions {
@@ -29,7 +36,10 @@ Result steepest_descent(const BatchObjective& fun, const Eigen::VectorXd& x0, co
 
 /// Clips x into the box (no-op for empty bounds).
 Eigen::VectorXd project(const Eigen::VectorXd& x, const Bounds& b);
-/// Checks x0 is finite and matches the bounds' dimension (if any); validates non-empty bounds.
-void validate_start(const Eigen::VectorXd& x0, const Bounds& b);
+/// Checks x0 is finite and matches the bounds' dimension (if any), non-empty bounds, and the
+/// relative finite-difference step h > 0: what every local optimiser needs.
+void validate_start(const Eigen::VectorXd& x0, const Bounds& b, double h);
+/// The objective at the start point x; throws std::invalid_argument (naming x0) if not finite.
+double start_value(Evaluator& eval, const Eigen::VectorXd& x);
 
 }  // namespace bayesgrasp::optim

@@ -15,8 +15,7 @@ Result firefly(const BatchObjective& fun, const Bounds& b, const FireflyOptions&
   if (!(o.alpha_decay > 0.0 && o.alpha_decay <= 1.0))
     throw std::invalid_argument("alpha_decay: must be in (0, 1]");
   const int n = o.n_fireflies, d = b.dim();
-  if (o.init.size() && (o.init.rows() != n || o.init.cols() != d))
-    throw std::invalid_argument("init: expected shape (n_fireflies, D)");
+  validate_population(o, n, d, "n_fireflies");
 
   Rng rng(o.seed);
   const Eigen::VectorXd range = b.range();

@@ -4,23 +4,18 @@
 // range), so gamma and alpha do not depend on the units of the problem.
 #pragma once
 
-#include <limits>
-
 #include "bayesgrasp/optim/objective.hpp"
 
 namespace bayesgrasp::optim {
 
-struct FireflyOptions {
+/// PopulationOptions::init: (n_fireflies, D) starting points.
+struct FireflyOptions : PopulationOptions {
   int n_fireflies = 25;
   int max_iter = 100;          ///< generations after the initial evaluation
   double beta0 = 1.0;          ///< attractiveness at distance 0
   double gamma = 1.0;          ///< light absorption (unit-box coordinates)
   double alpha = 0.2;          ///< initial randomisation (fraction of the range)
   double alpha_decay = 0.97;   ///< alpha_k = alpha * alpha_decay^k
-  std::uint64_t seed = 0;
-  double target = -std::numeric_limits<double>::infinity();
-  bool record_history = false;
-  RowMatrixXd init;            ///< optional (n_fireflies, D) starting points
 };
 
 /// Moves are synchronous: brightness from the start of a generation, the whole population

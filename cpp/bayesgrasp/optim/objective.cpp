@@ -16,6 +16,22 @@ void validate_bounds(const Bounds& b) {
       throw std::invalid_argument("bounds: low > high in dimension " + std::to_string(i));
 }
 
+void validate_population(const PopulationOptions& o, int n, int d, const char* size_name) {
+  if (o.init.size() == 0) return;
+  if (o.init.rows() != n || o.init.cols() != d)
+    throw std::invalid_argument(std::string("init: expected shape (") + size_name + ", D) = (" + std::to_string(n) +
+                                ", " + std::to_string(d) + "), got (" + std::to_string(o.init.rows()) + ", " +
+                                std::to_string(o.init.cols()) + ")");
+  if (!o.init.allFinite()) throw std::invalid_argument("init: contains NaN or infinity");
+}
+
+double Evaluator::at(const Eigen::VectorXd& x) {
+  one_.resize(1, x.size());
+  one_.row(0) = x.transpose();
+  (*this)(one_, f_one_);
+  return f_one_[0];
+}
+
 void Evaluator::operator()(const RowMatrixXd& X, Eigen::VectorXd& f) {
   f.resize(X.rows());
   fun_(X, f);
@@ -71,12 +87,16 @@ BatchObjective builtin_objective(const std::string& name) {
                               "' (expected sphere, rastrigin, ackley or rosenbrock)");
 }
 
-void finish(Result& r, const Eigen::VectorXd& best_x, double best_f, int iterations, long long evaluations,
-            double target) {
+void set_outcome(Result& r, const Eigen::VectorXd& best_x, double best_f, int iterations, long long evaluations) {
   r.x = best_x;
   r.f = best_f;
   r.iterations = iterations;
   r.evaluations = evaluations;
+}
+
+void finish(Result& r, const Eigen::VectorXd& best_x, double best_f, int iterations, long long evaluations,
+            double target) {
+  set_outcome(r, best_x, best_f, iterations, evaluations);
   r.converged = best_f <= target;
   r.message = r.converged ? "target reached" : "iteration budget used";
 }

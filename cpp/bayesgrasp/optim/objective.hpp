@@ -9,6 +9,7 @@
 
 #include <cstdint>
 #include <functional>
+#include <limits>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -34,6 +35,18 @@ struct Bounds {
 /// Throws std::invalid_argument naming the problem (bindings map it to ValueError).
 void validate_bounds(const Bounds& b);
 
+/// What the population optimisers (PSO, simulated annealing, firefly) share.
+struct PopulationOptions {
+  std::uint64_t seed = 0;
+  double target = -std::numeric_limits<double>::infinity();  ///< stop once the best value is <= target
+  bool record_history = false;
+  RowMatrixXd init;  ///< optional (population size, D) starting points (clipped into the box)
+};
+
+/// Checks the shared options for a population of n in d dimensions: init empty, or (n, d) and
+/// finite. `size_name` names the population size in the message ("n_particles", ...).
+void validate_population(const PopulationOptions& o, int n, int d, const char* size_name);
+
 /// What every optimiser reports.
 struct Result {
   Eigen::VectorXd x;             ///< best candidate found
@@ -45,8 +58,11 @@ struct Result {
   std::string message;
 };
 
-/// Fills a global optimiser's result: best point and value, counts, and whether the value
-/// reached `target` (else the iteration budget was used).
+/// Sets the outcome of a run: best point and value, iterations and evaluations.
+void set_outcome(Result& r, const Eigen::VectorXd& best_x, double best_f, int iterations, long long evaluations);
+
+/// Fills a global optimiser's result: set_outcome, and whether the value reached `target` (else
+/// the iteration budget was used).
 void finish(Result& r, const Eigen::VectorXd& best_x, double best_f, int iterations, long long evaluations,
             double target);
 
@@ -55,11 +71,15 @@ class Evaluator {
  public:
   explicit Evaluator(const BatchObjective& fun) : fun_(fun) {}
   void operator()(const RowMatrixXd& X, Eigen::VectorXd& f);
+  /// The objective at one point x (a batch of one row).
+  double at(const Eigen::VectorXd& x);
   long long evaluations() const { return n_; }
 
  private:
   const BatchObjective& fun_;
   long long n_ = 0;
+  RowMatrixXd one_;
+  Eigen::VectorXd f_one_;
 };
 
 /// Standard test functions (batch form), global minimum 0 at the origin (Rosenbrock: at ones).

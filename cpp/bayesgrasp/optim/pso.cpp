@@ -10,10 +10,13 @@ Result pso(const BatchObjective& fun, const Bounds& b, const PSOOptions& o) {
   validate_bounds(b);
   if (o.n_particles < 1) throw std::invalid_argument("n_particles: must be at least 1");
   if (o.max_iter < 0) throw std::invalid_argument("max_iter: must be >= 0");
-  if (!(o.vmax_fraction > 0.0)) throw std::invalid_argument("vmax_fraction: must be positive");
+  if (!(o.vmax_fraction > 0.0) || !std::isfinite(o.vmax_fraction))
+    throw std::invalid_argument("vmax_fraction: must be positive and finite");
+  if (!std::isfinite(o.inertia)) throw std::invalid_argument("inertia: must be finite");
+  if (!std::isfinite(o.c1)) throw std::invalid_argument("c1: must be finite");
+  if (!std::isfinite(o.c2)) throw std::invalid_argument("c2: must be finite");
   const int n = o.n_particles, d = b.dim();
-  if (o.init.size() && (o.init.rows() != n || o.init.cols() != d))
-    throw std::invalid_argument("init: expected shape (n_particles, D)");
+  validate_population(o, n, d, "n_particles");
 
   Rng rng(o.seed);
   const Eigen::VectorXd range = b.range();
@@ -68,10 +71,7 @@ Result pso(const BatchObjective& fun, const Bounds& b, const PSOOptions& o) {
       if (stall >= o.stall_iter) { ++it; r.converged = true; r.message = "no improvement for stall_iter iterations"; break; }
     }
   }
-  r.x = gx;
-  r.f = gf;
-  r.iterations = it;
-  r.evaluations = eval.evaluations();
+  set_outcome(r, gx, gf, it, eval.evaluations());
   if (gf <= o.target) { r.converged = true; r.message = "target reached"; }
   if (r.message.empty()) r.message = "iteration budget used";
   return r;

@@ -2,25 +2,20 @@
 // parameters of Clerc & Kennedy (2002): inertia 0.7298, c1 = c2 = 1.49618.
 #pragma once
 
-#include <limits>
-
 #include "bayesgrasp/optim/objective.hpp"
 
 namespace bayesgrasp::optim {
 
-struct PSOOptions {
+/// PopulationOptions::init: (n_particles, D) initial positions.
+struct PSOOptions : PopulationOptions {
   int n_particles = 40;
   int max_iter = 200;              ///< swarm updates after the initial evaluation
   double inertia = 0.7298;
   double c1 = 1.49618;             ///< cognitive (own best) weight
   double c2 = 1.49618;             ///< social (swarm best) weight
   double vmax_fraction = 0.5;      ///< |v_d| <= vmax_fraction * (high_d - low_d)
-  std::uint64_t seed = 0;
-  double target = -std::numeric_limits<double>::infinity();  ///< stop once best <= target
   int stall_iter = 0;              ///< stop after this many iterations without improvement > ftol (0: off)
   double ftol = 0.0;
-  bool record_history = false;
-  RowMatrixXd init;                ///< optional (n_particles, D) initial positions (clipped to the box)
 };
 
 /// Minimises fun over the box. Evaluations = n_particles * (iterations + 1).

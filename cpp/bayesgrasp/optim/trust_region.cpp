@@ -19,21 +19,65 @@ struct ResidualEvaluator {
     n += X.rows();
     return R;
   }
+  /// The residuals at one point x.
+  Eigen::VectorXd at(const Eigen::VectorXd& x) {
+    RowMatrixXd one(1, x.size());
+    one.row(0) = x.transpose();
+    return (*this)(one).row(0).transpose();
+  }
 };
+
+// The Jacobian (m x D) of the residuals at x by central differences, one batch of 2D rows.
+Eigen::MatrixXd jacobian(ResidualEvaluator& ev, const Eigen::VectorXd& x, double h, Eigen::Index m) {
+  const CentralDifferences cd(x, h);
+  const RowMatrixXd R = ev(cd.points);
+  if (R.cols() != m) throw std::invalid_argument("residuals: number of residuals changed between calls");
+  Eigen::MatrixXd J(m, x.size());
+  for (Eigen::Index k = 0; k < x.size(); ++k)
+    J.col(k) = (R.row(2 * k) - R.row(2 * k + 1)).transpose() / (2.0 * cd.steps[k]);
+  return J;
+}
+
+// The dogleg step of the model g.p + 1/2 p^T B p inside the trust radius: the full (quasi-)Newton
+// step if it fits, else the Cauchy point or the segment towards the Newton step at the radius.
+Eigen::VectorXd dogleg(const Eigen::MatrixXd& B, const Eigen::VectorXd& g, double radius) {
+  const Eigen::LLT<Eigen::MatrixXd> llt(B);
+  const Eigen::VectorXd pb = llt.solve(-g);
+  if (pb.norm() <= radius) return pb;
+  const double gBg = g.dot(B * g);
+  const Eigen::VectorXd pu = -(g.squaredNorm() / gBg) * g;
+  if (pu.norm() >= radius) return (radius / pu.norm()) * pu;
+  // pu + tau (pb - pu), ||.|| = radius
+  const Eigen::VectorXd dp = pb - pu;
+  const double a = dp.squaredNorm(), bb = 2.0 * pu.dot(dp), c = pu.squaredNorm() - radius * radius;
+  const double tau = (-bb + std::sqrt(bb * bb - 4.0 * a * c)) / (2.0 * a);
+  return pu + tau * dp;
+}
+
+// BFGS update of B with the step s and gradient change y, skipped unless s.y > 0 (B stays
+// positive definite). Before the first update B is scaled to y.y / s.y times the identity
+// (Nocedal & Wright, Eq. 6.20).
+void bfgs_update(Eigen::MatrixXd& B, const Eigen::VectorXd& s, const Eigen::VectorXd& y, bool& scaled) {
+  const double sy = s.dot(y);
+  if (!(sy > 1e-12 * s.norm() * y.norm())) return;
+  if (!scaled) {
+    B = Eigen::MatrixXd::Identity(B.rows(), B.cols()) * (y.squaredNorm() / sy);
+    scaled = true;
+  }
+  const Eigen::VectorXd Bs = B * s;
+  B += (y * y.transpose()) / sy - (Bs * Bs.transpose()) / s.dot(Bs);
+}
 
 }  // namespace
 
 Result levenberg_marquardt(const BatchResiduals& fun, const Eigen::VectorXd& x0, const Bounds& b,
                            const LMOptions& o) {
-  validate_start(x0, b);
-  if (!(o.h > 0.0)) throw std::invalid_argument("h: must be positive");
+  validate_start(x0, b, o.h);
   if (!(o.lambda0 > 0.0)) throw std::invalid_argument("lambda0: must be positive");
   const int d = static_cast<int>(x0.size());
   ResidualEvaluator ev{fun};
   Eigen::VectorXd x = project(x0, b);
-  RowMatrixXd one(1, d);
-  one.row(0) = x.transpose();
-  Eigen::VectorXd r = ev(one).row(0).transpose();
+  Eigen::VectorXd r = ev.at(x);
   if (!r.allFinite()) throw std::invalid_argument("x0: residuals are not finite at the start point");
   const int m = static_cast<int>(r.size());
   double f = 0.5 * r.squaredNorm();
@@ -41,8 +85,6 @@ Result levenberg_marquardt(const BatchResiduals& fun, const Eigen::VectorXd& x0,
   if (o.record_history) res.history.push_back(f);
   res.message = "iteration budget used";
   double lambda = -1.0, nu = 2.0;
-  RowMatrixXd S(2 * d, d);
-  Eigen::MatrixXd J(m, d);
   bool need_jac = true;
   Eigen::MatrixXd A;
   Eigen::VectorXd g;
@@ -50,17 +92,7 @@ Result levenberg_marquardt(const BatchResiduals& fun, const Eigen::VectorXd& x0,
   for (; it < o.max_iter; ++it) {
     if (f <= o.ftol) { res.converged = true; res.message = "residual below ftol"; break; }
     if (need_jac) {
-      Eigen::VectorXd hk(d);
-      for (int k = 0; k < d; ++k) {
-        hk[k] = o.h * std::max(1.0, std::abs(x[k]));
-        S.row(2 * k) = x.transpose();
-        S.row(2 * k + 1) = x.transpose();
-        S(2 * k, k) += hk[k];
-        S(2 * k + 1, k) -= hk[k];
-      }
-      const RowMatrixXd R = ev(S);
-      if (R.cols() != m) throw std::invalid_argument("residuals: number of residuals changed between calls");
-      for (int k = 0; k < d; ++k) J.col(k) = (R.row(2 * k) - R.row(2 * k + 1)).transpose() / (2.0 * hk[k]);
+      const Eigen::MatrixXd J = jacobian(ev, x, o.h, m);
       if (!J.allFinite()) { res.message = "Jacobian is not finite"; break; }
       A = J.transpose() * J;
       g = J.transpose() * r;
@@ -75,8 +107,7 @@ Result levenberg_marquardt(const BatchResiduals& fun, const Eigen::VectorXd& x0,
     if (dx.norm() < o.xtol * (x.norm() + o.xtol)) { res.converged = true; res.message = "step below xtol"; break; }
     const Eigen::VectorXd xn = project(x + dx, b);
     const Eigen::VectorXd step = xn - x;
-    one.row(0) = xn.transpose();
-    const Eigen::VectorXd rn = ev(one).row(0).transpose();
+    const Eigen::VectorXd rn = ev.at(xn);
     const double fn = rn.allFinite() ? 0.5 * rn.squaredNorm() : std::numeric_limits<double>::infinity();
     // Predicted reduction of the Gauss-Newton model: -(g.s + 1/2 s^T A s).
     const double pred = -(g.dot(step) + 0.5 * step.dot(A * step));
@@ -95,30 +126,19 @@ Result levenberg_marquardt(const BatchResiduals& fun, const Eigen::VectorXd& x0,
     }
     if (o.record_history) res.history.push_back(f);
   }
-  res.x = x;
-  res.f = f;
-  res.iterations = it;
-  res.evaluations = ev.n;
+  set_outcome(res, x, f, it, ev.n);
   return res;
 }
 
 Result trust_region(const BatchObjective& fun, const Eigen::VectorXd& x0, const Bounds& b,
                     const TrustRegionOptions& o) {
-  validate_start(x0, b);
-  if (!(o.h > 0.0)) throw std::invalid_argument("h: must be positive");
+  validate_start(x0, b, o.h);
   if (!(o.radius0 > 0.0)) throw std::invalid_argument("radius0: must be positive");
   if (!(o.eta >= 0.0 && o.eta < 0.25)) throw std::invalid_argument("eta: must be in [0, 0.25)");
   const int d = static_cast<int>(x0.size());
   Evaluator eval(fun);
-  Eigen::VectorXd x = project(x0, b), fv;
-  RowMatrixXd one(1, d);
-  auto f1 = [&](const Eigen::VectorXd& y) {
-    one.row(0) = y.transpose();
-    eval(one, fv);
-    return fv[0];
-  };
-  double f = f1(x);
-  if (!std::isfinite(f)) throw std::invalid_argument("x0: objective is not finite at the start point");
+  Eigen::VectorXd x = project(x0, b);
+  double f = start_value(eval, x);
   Eigen::VectorXd g = numerical_gradient(eval, x, o.h);
   Eigen::MatrixXd B = Eigen::MatrixXd::Identity(d, d);
   bool scaled = false;
@@ -130,53 +150,23 @@ Result trust_region(const BatchObjective& fun, const Eigen::VectorXd& x0, const 
   for (; it < o.max_iter; ++it) {
     if (g.lpNorm<Eigen::Infinity>() < o.gtol) { res.converged = true; res.message = "gradient below gtol"; break; }
     if (radius < o.xtol * (x.norm() + o.xtol)) { res.converged = true; res.message = "trust radius below xtol"; break; }
-    // Dogleg step.
-    Eigen::VectorXd p;
-    const Eigen::LLT<Eigen::MatrixXd> llt(B);
-    const Eigen::VectorXd pb = llt.solve(-g);
-    if (pb.norm() <= radius) {
-      p = pb;
-    } else {
-      const double gBg = g.dot(B * g);
-      const Eigen::VectorXd pu = -(g.squaredNorm() / gBg) * g;
-      if (pu.norm() >= radius) {
-        p = (radius / pu.norm()) * pu;
-      } else {  // pu + tau (pb - pu), ||.|| = radius
-        const Eigen::VectorXd dp = pb - pu;
-        const double a = dp.squaredNorm(), bb = 2.0 * pu.dot(dp), c = pu.squaredNorm() - radius * radius;
-        const double tau = (-bb + std::sqrt(bb * bb - 4.0 * a * c)) / (2.0 * a);
-        p = pu + tau * dp;
-      }
-    }
-    const Eigen::VectorXd xn = project(x + p, b);
+    const Eigen::VectorXd xn = project(x + dogleg(B, g, radius), b);
     const Eigen::VectorXd s = xn - x;
-    const double fn = f1(xn);
+    const double fn = eval.at(xn);
     const double pred = -(g.dot(s) + 0.5 * s.dot(B * s));
     const double rho = (pred > 0.0 && std::isfinite(fn)) ? (f - fn) / pred : -1.0;
     if (rho < 0.25) radius = 0.25 * s.norm() > 0 ? 0.25 * s.norm() : 0.25 * radius;
     else if (rho > 0.75 && s.norm() > 0.99 * radius) radius = std::min(2.0 * radius, o.max_radius);
     if (rho > o.eta && fn < f) {
       const Eigen::VectorXd gn = numerical_gradient(eval, xn, o.h);
-      const Eigen::VectorXd y = gn - g;
-      const double sy = s.dot(y);
-      if (sy > 1e-12 * s.norm() * y.norm()) {
-        if (!scaled) {  // Nocedal & Wright (6.20): scale the initial Hessian before the first update
-          B = Eigen::MatrixXd::Identity(d, d) * (y.squaredNorm() / sy);
-          scaled = true;
-        }
-        const Eigen::VectorXd Bs = B * s;
-        B += (y * y.transpose()) / sy - (Bs * Bs.transpose()) / s.dot(Bs);
-      }
+      bfgs_update(B, s, gn - g, scaled);
       x = xn;
       f = fn;
       g = gn;
     }
     if (o.record_history) res.history.push_back(f);
   }
-  res.x = x;
-  res.f = f;
-  res.iterations = it;
-  res.evaluations = eval.evaluations();
+  set_outcome(res, x, f, it, eval.evaluations());
   return res;
 }
 

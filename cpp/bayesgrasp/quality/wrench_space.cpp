@@ -9,7 +9,7 @@
 #include <stdexcept>
 #include <string>
 
-#include <omp.h>
+#include "bayesgrasp/common/parallel.hpp"
 
 extern "C" {
 #include <libqhull_r/qhull_ra.h>
@@ -47,12 +47,11 @@ Vec3 tangent_hint(const Vec3& n, const Vec3& p, const Vec3& com, const Vec3& cen
 
 void validate_quality_params(const QualityParams& params, const Vec3& com, double torque_scale) {
   if (!std::isfinite(params.mu) || params.mu < 0.0)
-    throw std::invalid_argument("mu must be finite and >= 0, got " + std::to_string(params.mu));
-  if (params.n_edges < 3)
-    throw std::invalid_argument("n_edges must be >= 3, got " + std::to_string(params.n_edges));
+    throw std::invalid_argument("mu: must be finite and >= 0, got " + std::to_string(params.mu));
+  if (params.n_edges < 3) throw std::invalid_argument("n_edges: must be >= 3, got " + std::to_string(params.n_edges));
   if (!std::isfinite(torque_scale) || !(torque_scale > 0.0))
-    throw std::invalid_argument("torque_scale must be positive and finite, got " + std::to_string(torque_scale));
-  if (!com.allFinite()) throw std::invalid_argument("com contains NaN or infinity");
+    throw std::invalid_argument("torque_scale: must be positive and finite, got " + std::to_string(torque_scale));
+  if (!com.allFinite()) throw std::invalid_argument("com: contains NaN or infinity");
 }
 
 Wrenches contact_wrenches(const Contacts& contacts, const Vec3& com, double torque_scale,
@@ -60,11 +59,13 @@ Wrenches contact_wrenches(const Contacts& contacts, const Vec3& com, double torq
   validate_quality_params(params, com, torque_scale);
   int n_obj = 0;
   Vec3 centroid = Vec3::Zero();
-  for (const Contact& c : contacts) {
+  for (std::size_t i = 0; i < contacts.size(); ++i) {
+    const Contact& c = contacts[i];
     if (c.on_table) continue;
-    if (!c.point.allFinite() || !c.normal.allFinite())
-      throw std::invalid_argument("contact point or normal contains NaN or infinity");
-    if (c.normal.norm() < 1e-12) throw std::invalid_argument("contact normal is zero");
+    const std::string row = ": row " + std::to_string(i);
+    if (!c.point.allFinite()) throw std::invalid_argument("points" + row + " contains NaN or infinity");
+    if (!c.normal.allFinite()) throw std::invalid_argument("normals" + row + " contains NaN or infinity");
+    if (c.normal.norm() < 1e-12) throw std::invalid_argument("normals" + row + " is zero");
     centroid += c.point;
     ++n_obj;
   }
@@ -145,15 +146,15 @@ bool run_qhull(const Wrenches& W, const char* opts, bool want_volume, GraspQuali
 
 }  // namespace
 
-GraspQuality hull_quality(const Wrenches& W, bool want_volume) {
+GraspQuality hull_quality(const Wrenches& W, const QualityParams& params) {
   GraspQuality q;
   q.n_wrenches = static_cast<int>(W.rows());
   if (W.rows() < 7 || !W.allFinite()) return q;  // a 6-D simplex needs 7 points
-  // First without facet merging ("Q0", about 3x faster in 6-D); if Qhull meets a precision
+  // First without facet merging ("Q0", the faster run in 6-D); if Qhull meets a precision
   // problem it cannot resolve that way (nearly coplanar wrenches, common for symmetric
   // grasps), again with its default merging and triangulated output ("Qt"). Input that
   // does not span 6-D fails both: epsilon = volume = 0.
-  if (run_qhull(W, "Q0", want_volume, q) || run_qhull(W, "Qt", want_volume, q)) return q;
+  if (run_qhull(W, "Q0", params.volume, q) || run_qhull(W, "Qt", params.volume, q)) return q;
   q.epsilon = 0.0;
   q.volume = 0.0;
   q.hull_ok = false;
@@ -163,7 +164,7 @@ GraspQuality hull_quality(const Wrenches& W, bool want_volume) {
 GraspQuality grasp_quality(const Contacts& contacts, const Vec3& com, double torque_scale,
                            const QualityParams& params) {
   const Wrenches W = contact_wrenches(contacts, com, torque_scale, params);
-  GraspQuality q = hull_quality(W, params.volume);
+  GraspQuality q = hull_quality(W, params);
   int n_obj = 0;
   for (const Contact& c : contacts) n_obj += c.on_table ? 0 : 1;
   q.n_contacts = n_obj;
@@ -177,7 +178,7 @@ std::vector<GraspQuality> grasp_quality_batch(const std::vector<Contacts>& grasp
   const long n = static_cast<long>(grasps.size());
   std::vector<GraspQuality> out(grasps.size());
   std::exception_ptr error;
-  const int threads = n_threads > 0 ? n_threads : omp_get_max_threads();
+  const int threads = thread_count(n_threads, "threads");
 #pragma omp parallel for schedule(dynamic, 4) num_threads(threads)
   for (long i = 0; i < n; ++i) {
     try {

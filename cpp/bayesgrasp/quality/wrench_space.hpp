@@ -30,7 +30,7 @@
 // are exactly invariant to rigid motions of the whole grasp (object, contacts and centre
 // of mass together) unless the last rule is reached.
 //
-// Convex hulls by Qhull (reentrant libqhull_r: first "Q0", no merging, about 3x faster in
+// Convex hulls by Qhull (reentrant libqhull_r: first "Q0", no merging, the faster run in
 // 6-D; if that meets a precision error, again with default merging, "Qt"), one local qhT
 // per call and no global state: every function here is thread-safe.
 #pragma once
@@ -56,7 +56,7 @@ using Wrenches = Eigen::Matrix<double, Eigen::Dynamic, 6, Eigen::RowMajor>;
 struct QualityParams {
   double mu = kDefaultFriction;   // Coulomb friction coefficient, >= 0
   int n_edges = kDefaultConeEdges;  // friction-cone edges, >= 3 (ignored when mu == 0)
-  bool volume = true;  // compute the GWS volume (about 15% of the cost); else volume = 0
+  bool volume = true;  // compute the GWS volume (a share of the cost, BENCHMARKS.md); else volume = 0
 };
 
 struct GraspQuality {
@@ -73,21 +73,23 @@ void validate_quality_params(const QualityParams& params, const Vec3& com, doubl
 
 /// The primitive wrenches of the object contacts (table contacts skipped): n_edges rows per
 /// contact (one row per contact when mu == 0), contact by contact. Contact normals are
-/// normalised here; contacts with a zero or non-finite point/normal throw
-/// std::invalid_argument.
+/// normalised here; a contact with a zero or non-finite point/normal throws
+/// std::invalid_argument naming its row ("normals: row i is zero").
 Wrenches contact_wrenches(const Contacts& contacts, const Vec3& com, double torque_scale,
                           const QualityParams& params = {});
 
-/// Epsilon and volume of conv(rows of W). Degenerate input (fewer than 7 rows, rows not
-/// spanning 6-D, Qhull precision failure) gives epsilon = 0, volume = 0, hull_ok = false.
-GraspQuality hull_quality(const Wrenches& W, bool want_volume = true);
+/// Epsilon and (if params.volume) volume of conv(rows of W). Degenerate input (fewer than 7
+/// rows, rows not spanning 6-D, Qhull precision failure) gives epsilon = 0, volume = 0,
+/// hull_ok = false.
+GraspQuality hull_quality(const Wrenches& W, const QualityParams& params = {});
 
 /// contact_wrenches + hull_quality.
 GraspQuality grasp_quality(const Contacts& contacts, const Vec3& com, double torque_scale,
                            const QualityParams& params = {});
 
-/// grasp_quality for many grasps of the same object, in OpenMP threads (`n_threads` <= 0:
-/// OpenMP's default). The result equals the serial one element by element.
+/// grasp_quality for many grasps of the same object, in n_threads OpenMP threads (0 = all
+/// cores, common/parallel.hpp; negative throws). The result equals the serial one element by
+/// element.
 std::vector<GraspQuality> grasp_quality_batch(const std::vector<Contacts>& grasps, const Vec3& com,
                                               double torque_scale, const QualityParams& params = {},
                                               int n_threads = 0);

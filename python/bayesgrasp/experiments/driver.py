@@ -1,5 +1,6 @@
-"""Running an experiment: build each object's models once, run every (method, object, run) not
-yet stored, write the report. Any registered experiment (:mod:`.registry`) runs this way."""
+"""Running an experiment: build what the runs share once (models, task grasps), run every
+(method, object, run) not yet stored, write the report. Any registered experiment
+(:mod:`.registry`) runs this way."""
 from __future__ import annotations
 
 from pathlib import Path
@@ -24,9 +25,8 @@ def run(name: str, out_dir, ctx: Optional[RunContext] = None, runs: Optional[int
         raise ValueError(f"workers: must be at least 1, got {workers}")
     objects = list(exp.objects if objects is None else objects)
     out = Path(out_dir)
-    # Models first, in this process (their disk cache is then shared by the workers).
-    for o in objects:
-        ctx.models(o)
+    if exp.prepare is not None:
+        exp.prepare(exp, objects, ctx)
     store = ResultStore(out / "results.sqlite")
     results: Dict[str, list] = {}
     worker_ctx = ctx.for_workers()

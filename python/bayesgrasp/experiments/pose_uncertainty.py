@@ -172,6 +172,12 @@ def landscapes_run(experiment: str, obj: str, run_index: int, seed: int, *, ctx:
 
 
 # ---- the registered experiments ---------------------------------------------------------------------
+def prepare_models(exp: Experiment, objects: List[str], ctx: RunContext) -> None:
+    """Every object's grasp models, built (or loaded) once in this process."""
+    for o in objects:
+        ctx.models(o)
+
+
 def _episodes(exp: Experiment, method: str, ctx: RunContext):
     fn = partial(episode_run, base=exp.name, method=method, stop_when_stable=(exp.name != "pub4"), ctx=ctx)
     return f"{exp.name}/{method}", fn
@@ -200,14 +206,14 @@ def belief_figures(exp: Experiment, objects: List[str], ctx: RunContext, out: Pa
 
 
 register(Experiment("pub2", FIVE, 100, "stability maximisation (Pub. II)", _episodes, report.write_episodes,
-                    ("stability",), belief_figures))
+                    ("stability",), belief_figures, prepare_models))
 register(Experiment("baselines", FIVE, 30, "all planners and the two baselines", _episodes, report.write_episodes,
-                    METHODS))
+                    METHODS, prepare=prepare_models))
 register(Experiment("pub4", ("cube", "mug", "cylinder"), 30,
                     "exploration vs stability only, 4 grasps per run (Pub. IV)", _episodes, report.write_episodes,
-                    ("explore", "stability"), belief_figures))
+                    ("explore", "stability"), belief_figures, prepare_models))
 register(Experiment("entropy_order", ("cube", "mug"), 30,
                     "predicted vs realised entropy order of three grasps (Fig. 3.6)", _explore_runs(entropy_order_run),
-                    report.write_entropy_order, ("explore",)))
+                    report.write_entropy_order, ("explore",), prepare=prepare_models))
 register(Experiment("landscapes", ("mug", "cube"), 3, "weight vs kernel entropy landscapes; 1,000 vs 10,000 samples",
-                    _explore_runs(landscapes_run), report.write_landscapes, ("explore",)))
+                    _explore_runs(landscapes_run), report.write_landscapes, ("explore",), prepare=prepare_models))

@@ -22,6 +22,9 @@ class Experiment:
     * ``make_run(experiment, method, ctx)`` -> (series key in the result store, RunFunction);
     * ``report(experiment, results, out)`` -> summary dict; ``results`` maps method -> [(RunKey, dict)];
       writes summary.md, summary.json, tables and plots into ``out``;
+    * ``prepare(experiment, objects, ctx)`` (optional): what the runs share, built once in the
+      driver's process before them (models, task grasps: their disk cache is then shared by the
+      workers);
     * ``finish(experiment, objects, ctx, out)`` (optional): extra figures after the report.
     """
 
@@ -33,6 +36,7 @@ class Experiment:
     report: Callable[["Experiment", Dict[str, list], Path], dict]
     methods: Sequence[str] = ("stability",)
     finish: Optional[Callable[["Experiment", List[str], "RunContext", Path], None]] = None
+    prepare: Optional[Callable[["Experiment", List[str], "RunContext"], None]] = None
 
 
 EXPERIMENTS: Dict[str, Experiment] = {}

@@ -286,13 +286,20 @@ def write_episodes(exp, results: Dict[str, list], out: Path) -> dict:
     return _finish(out, md, summary)
 
 
+def _by_object(results: list) -> Dict[str, list]:
+    """The stored (key, result) pairs grouped by object, objects sorted by name."""
+    groups: Dict[str, list] = {}
+    for k, r in results:
+        groups.setdefault(k.object, []).append(r)
+    return dict(sorted(groups.items()))
+
+
 def write_entropy_order(exp, results: Dict[str, list], out: Path) -> dict:
     """Fig. 3.6: does the realised entropy keep the predicted order of three grasps?"""
     out, md, summary = _start(exp.name, out)
-    res = results["explore"]
+    groups = _by_object(results["explore"])
     rows = []
-    for obj in sorted({k.object for k, _ in res}):
-        rs = [r for k, r in res if k.object == obj]
+    for obj, rs in groups.items():
         rows.append({"object": obj, "runs": len(rs), "order_kept": float(np.mean([r["order_kept"] for r in rs])),
                      "best_below_worst": float(np.mean([r["best_below_worst"] for r in rs])),
                      "kendall_tau": float(np.mean([r["kendall_tau"] for r in rs])),
@@ -306,9 +313,8 @@ def write_entropy_order(exp, results: Dict[str, list], out: Path) -> dict:
            "worst's (chance: 1/2); kendall_tau: rank agreement of the three; predicted_* / realised_*: mean "
            "expected and realised posterior weight entropies (nats; the prior's is log 500 = 6.21).", ""]
     summary["rows"] = rows
-    for obj in sorted({k.object for k, _ in res}):
-        r0 = next(r for k, r in res if k.object == obj)
-        p = plot_landscape(r0, out / f"landscape_{obj}.png", f"{obj}: expected entropy of grasps (Fig. 3.6)")
+    for obj, rs in groups.items():
+        p = plot_landscape(rs[0], out / f"landscape_{obj}.png", f"{obj}: expected entropy of grasps (Fig. 3.6)")
         md += [f"![{obj}]({p.name})", ""]
     return _finish(out, md, summary)
 
@@ -316,10 +322,8 @@ def write_entropy_order(exp, results: Dict[str, list], out: Path) -> dict:
 def write_landscapes(exp, results: Dict[str, list], out: Path) -> dict:
     """Weight vs kernel expected-entropy landscapes and the 1-DOF sample-count comparison."""
     out, md, summary = _start(exp.name, out)
-    res = results["explore"]
     rows = []
-    for obj in sorted({k.object for k, _ in res}):
-        rs = [r for k, r in res if k.object == obj]
+    for obj, rs in _by_object(results["explore"]).items():
         row = {"object": obj, "runs": len(rs), "pearson": float(np.mean([r["pearson"] for r in rs])),
                "spearman": float(np.mean([r["spearman"] for r in rs]))}
         rows.append(row)

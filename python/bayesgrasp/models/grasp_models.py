@@ -19,6 +19,7 @@ import numpy as np
 from scipy.special import expit
 
 from .. import gp as _gp
+from ..belief import relative_planar_pose
 from .settings import ModelSettings
 from .table import ModelTable
 
@@ -29,12 +30,9 @@ DEFAULT_CALIBRATION = (1.702, 0.0)
 def relative_top_grasps(grasps, object_poses) -> np.ndarray:
     """Top grasps (A, 3) in the world and planar object poses (N, 3) -> (A, N, 3) grasps in each
     object's frame: R(-oyaw) (a_xy - o_xy), wrap(a_yaw - o_yaw) into [-pi, pi)."""
-    a = np.atleast_2d(np.asarray(grasps, dtype=float))[:, None, :]
-    o = np.atleast_2d(np.asarray(object_poses, dtype=float))[None, :, :]
-    dx, dy = a[..., 0] - o[..., 0], a[..., 1] - o[..., 1]
-    c, s = np.cos(o[..., 2]), np.sin(o[..., 2])
-    yaw = np.mod(a[..., 2] - o[..., 2] + np.pi, 2 * np.pi) - np.pi
-    return np.stack([c * dx + s * dy, -s * dx + c * dy, yaw], axis=-1)
+    a = np.atleast_2d(np.asarray(grasps, dtype=float))
+    o = np.atleast_2d(np.asarray(object_poses, dtype=float))
+    return relative_planar_pose(a, o).reshape(len(a), len(o), -1)
 
 
 def features(rel) -> np.ndarray:

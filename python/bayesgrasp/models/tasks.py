@@ -93,6 +93,19 @@ class TaskRule:
         return all(parts.count(p) >= n for p, n in self.min_part_contacts.items())
 
 
+@dataclass(frozen=True)
+class TaskGrasp:
+    """A demonstrated grasp of a training model for a task: the hand pose (4x4, model frame) and
+    spread, its epsilon and whether the lift test held it."""
+
+    model: str
+    task: str
+    pose: np.ndarray
+    spread: float
+    epsilon: float
+    lifted: bool
+
+
 def _wrap(a):
     return np.mod(np.asarray(a) + np.pi, 2 * np.pi) - np.pi
 

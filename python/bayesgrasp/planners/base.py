@@ -24,7 +24,7 @@ from typing import List, Optional, Sequence
 import numpy as np
 
 from .. import optim
-from ..belief import ParticleBelief, relative_planar_pose
+from ..belief import ParticleBelief, absolute_planar_pose_paired, relative_planar_pose
 from ..models import GraspModels
 
 
@@ -209,10 +209,7 @@ class Planner:
         best = self.table.best_relative_grasps(64)
         j = self._rng.choice(len(poses), size=k, p=weights / weights.sum())
         rel = best[self._rng.integers(0, len(best), k)]
-        o = poses[j]
-        c, s = np.cos(o[:, 2]), np.sin(o[:, 2])
-        return np.column_stack([o[:, 0] + c * rel[:, 0] - s * rel[:, 1], o[:, 1] + s * rel[:, 0] + c * rel[:, 1],
-                                wrap_angle(o[:, 2] + rel[:, 2])])
+        return absolute_planar_pose_paired(rel, poses[j])
 
     def maximise_stability(self, poses: np.ndarray, weights: np.ndarray):
         """PSO over (x, y, yaw) of sum_j w_j P(S | A, O_j) (Eq. 3.1). Returns (action, value, nfev)."""

@@ -36,23 +36,11 @@ import numpy as np
 
 from .. import _core, optim
 from ..hand import Hand
+from ..models.tasks import TaskGrasp
 
 _task = _core.task
 
 METHODS = ("laplace", "regularised", "gaussian", "baseline")
-
-
-@dataclass(frozen=True)
-class TaskGrasp:
-    """A demonstrated grasp of a training model for a task: the hand pose (4x4, model frame) and
-    spread, its epsilon and whether the lift test held it."""
-
-    model: str
-    task: str
-    pose: np.ndarray
-    spread: float
-    epsilon: float
-    lifted: bool
 
 
 @dataclass(frozen=True)
