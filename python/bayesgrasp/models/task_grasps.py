@@ -39,7 +39,7 @@ class TaskGraspSettings:
     """candidates: approaches simulated per spread; spreads (rad); lift_tests: the best candidates
     by epsilon lift-tested per model and task; keep: grasps stored; standoff (m); seed."""
 
-    candidates: int = 300
+    candidates: int = 1500
     spreads: Sequence[float] = TASK_SPREADS
     lift_tests: int = 40
     keep: int = 5
@@ -70,6 +70,21 @@ def sample_directions(rule: TaskRule, n: int, rng: np.random.Generator, max_draw
         if have >= n:
             return np.vstack(out)[:n]
     raise ValueError(f"task {rule.category}/{rule.name}: its approach constraints admit (almost) no direction")
+
+
+def sample_rolls(hand, directions: np.ndarray, rng: np.random.Generator, spread_deg: float = 20.0) -> np.ndarray:
+    """Rolls about each approach direction. A hand coming from the side with its fingers spread
+    vertically reaches into the table, so for directions less than 45 deg from the horizontal the
+    roll puts the hand's y axis (the fingers' line at spread 0) horizontal - one of the two such
+    rolls at random, jittered by ``spread_deg`` - and is uniform otherwise."""
+    out = rng.uniform(0, 2 * np.pi, len(directions))
+    for i, d in enumerate(directions):
+        if abs(d[2]) > np.sin(np.radians(45)):
+            continue
+        a = hand.approach_pose(d, 0.0, np.zeros(3))[2, 1]
+        b = hand.approach_pose(d, np.pi / 2, np.zeros(3))[2, 1]
+        out[i] = np.arctan2(-a, b) + np.pi * rng.integers(2) + np.radians(spread_deg) * rng.normal()
+    return out
 
 
 def sample_targets(obj: ObjectModel, parts: Sequence[str], n: int, rng: np.random.Generator) -> np.ndarray:
@@ -121,7 +136,7 @@ def generate_task_grasps(obj: Union[str, ObjectModel], rule: TaskRule, hand: str
     for spread in s.spreads:
         d = sample_directions(rule, s.candidates, rng)
         t = sample_targets(o, rule.targets, s.candidates, rng)
-        roll = rng.uniform(0, 2 * np.pi, s.candidates)
+        roll = sample_rolls(world.hand, d, rng)
         b = world.approach_batch(d, t, roll, spread=spread, standoff=s.standoff)
         ok = _rule_ok(b, rule) & (np.asarray(b.epsilon) > 0)
         found += [(float(b.epsilon[i]), float(spread), np.asarray(b.hand_pose_object[i])) for i in np.flatnonzero(ok)]

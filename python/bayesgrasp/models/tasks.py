@@ -4,7 +4,8 @@ A rule says which approach directions a task allows and which parts of the objec
 touch. Directions are in the object's frame; the approach direction ``d`` is the direction the
 hand moves in (the hand frame's +z, out of the palm), so ``-d`` points to where it comes from.
 
-Approach constraints (all given must hold):
+Approach constraints (all given must hold; and for every task the hand does not come from under
+the table, ``-d`` has z >= 0):
 
 * ``from_axis {axis, max_angle_deg}``: the angle between ``-d`` and ``axis`` is at most the limit
   (mug top: the hand comes from above);
@@ -66,7 +67,7 @@ class TaskRule:
         d = np.atleast_2d(np.asarray(directions, dtype=float))
         d = d / np.linalg.norm(d, axis=1, keepdims=True)
         src = -d
-        ok = np.ones(len(d), dtype=bool)
+        ok = src[:, 2] >= -1e-9      # every task: the hand cannot come from under the table
         for kind, c in self.approach.items():
             if kind == "from_axis":
                 ok &= np.degrees(np.arccos(np.clip(src @ c["axis"], -1, 1))) <= c["max_angle_deg"]
