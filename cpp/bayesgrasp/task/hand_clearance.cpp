@@ -73,6 +73,8 @@ Clearance hand_clearance(const HandModel& hand, const Eigen::VectorXd& q, const 
   Clearance out;
   out.table.setZero(N);
   out.cloud.setZero(N);
+  Eigen::AlignedBox3d cloud_box;
+  for (Eigen::Index k = 0; k < cloud.rows(); ++k) cloud_box.extend(cloud.row(k).transpose());
   const int nt = thread_count_for(threads, N);
 #pragma omp parallel for schedule(dynamic, 4) num_threads(nt)
   for (int i = 0; i < N; ++i) {
@@ -81,12 +83,14 @@ Clearance hand_clearance(const HandModel& hand, const Eigen::VectorXd& q, const 
     for (int l = 0; l < hand.num_links(); ++l)
       for (const Shape& s : hand.links()[l].shapes)
         if (options.table) below = std::max(below, options.margin - lowest_z(s, links[l]));
-    for (const PlacedShape& ps : place(hand, links, options.margin))
+    for (const PlacedShape& ps : place(hand, links, options.margin)) {
+      if (cloud_box.isEmpty() || cloud_box.exteriorDistance(ps.centre_world) > ps.radius) continue;
       for (Eigen::Index k = 0; k < cloud.rows(); ++k) {
         const Vec3 p = cloud.row(k).transpose();
         if ((p - ps.centre_world).squaredNorm() > ps.radius * ps.radius) continue;
         deepest = std::max(deepest, shape_depth(*ps.shape, ps.world_to_link * p, options.margin));
       }
+    }
     out.table[i] = below;
     out.cloud[i] = deepest;
   }

@@ -73,6 +73,7 @@ class CategorySettings:
     pso_iter: int = 25
     clearance_margin: float = 0.002
     clearance_scale: float = 0.001
+    clearance_voxel: float = 0.005  # the cloud is reduced to one point per voxel of this size for the check (m)
     min_weight: float = 1e-3        # models whose normalised weight is below this are not search starts
     threads: int = 1
 
@@ -131,6 +132,14 @@ def psi(epsilon, scale: float, floor: float) -> np.ndarray:
     return np.where(q > 0, np.maximum(1.0 - np.exp(-np.maximum(q, 0) / scale), floor), floor)
 
 
+def voxel_points(P: np.ndarray, voxel: float) -> np.ndarray:
+    """One point (the first) per occupied voxel: the cloud the clearance check needs."""
+    if len(P) == 0:
+        return np.zeros((0, 3))
+    _, first = np.unique(np.floor(P / voxel).astype(np.int64), axis=0, return_index=True)
+    return np.ascontiguousarray(P[np.sort(first)])
+
+
 def normalised_weights(registrations: Sequence[Registration]) -> np.ndarray:
     """phi(delta_i) normalised over the models that registered (0 for the others)."""
     phi = np.array([r.phi if r.success else 0.0 for r in registrations], dtype=float)
@@ -150,9 +159,10 @@ class CategoryPlanner:
             raise ValueError("registrations: need at least one registered model")
         names = [r.model for r in self.registrations]
         self.grasps = [g for g in task_grasps if g.model in names]
-        self.cloud = np.zeros((0, 3)) if cloud is None else np.ascontiguousarray(np.asarray(cloud, float))
-        if self.cloud.ndim != 2 or self.cloud.shape[1] != 3 or not np.isfinite(self.cloud).all():
-            raise ValueError(f"cloud: expected finite (N, 3) points, got shape {self.cloud.shape}")
+        cloud = np.zeros((0, 3)) if cloud is None else np.asarray(cloud, float)
+        if cloud.ndim != 2 or cloud.shape[1] != 3 or not np.isfinite(cloud).all():
+            raise ValueError(f"cloud: expected finite (N, 3) points, got shape {cloud.shape}")
+        self.cloud = voxel_points(cloud, self.settings.clearance_voxel)
         self.seed = int(seed)
         self.weights = normalised_weights(self.registrations)
         self._build_mixture()
