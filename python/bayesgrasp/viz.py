@@ -322,3 +322,37 @@ def plot_grasp(world, grasp, path, title: Optional[str] = None):
         world.scene, path, title=title,
         extra_meshes=hand_meshes(world.hand, grasp.joint_angles, grasp.hand_pose, alpha=0.9),
         extra=(lambda ax: draw_points(ax, pts, color="red", size=25)) if len(pts) else None)
+
+
+def plot_category_grasp(cloud, models: Sequence, transforms: Sequence, weights: Sequence[float], hand, joint_angles,
+                        hand_pose, path, title: Optional[str] = None, max_points: int = 3000):
+    """PNG of a category grasp (Eq. 4.1): the observed cloud (red points), every training model
+    placed by its registration (grey, more opaque for a larger weight; the legend gives each
+    weight), the table patch and the hand closed at the executed grasp."""
+    import matplotlib.patches as mpatches
+
+    fig, ax = new_axes(figsize=(8, 6.5))
+    C = np.asarray(cloud, float)
+    if len(C) > max_points:
+        C = C[np.random.default_rng(0).choice(len(C), max_points, replace=False)]
+    wmax = max(max(weights), 1e-12)
+    meshes, handles = [], []
+    colors = plt.get_cmap("tab10")
+    for k, (m, T, w) in enumerate(zip(models, transforms, weights)):
+        T = np.asarray(T, float)
+        V = np.asarray(m.vertices) @ T[:3, :3].T + T[:3, 3]
+        meshes.append((V, np.asarray(m.faces), colors(k % 10), 0.08 + 0.35 * w / wmax))
+        handles.append(mpatches.Patch(color=colors(k % 10), label=f"{getattr(m, 'name', k)}: weight {w:.2f}"))
+    meshes += hand_meshes(hand, joint_angles, hand_pose, alpha=0.9)
+    lo, hi = C.min(axis=0) - 0.12, C.max(axis=0) + 0.12
+    Vt, Ft = grid_quad_mesh(lo[0], hi[0], lo[1], hi[1], 0.0, n=4)
+    meshes.append((Vt, Ft, "tan", 0.3))
+    draw_meshes(ax, meshes)
+    draw_points(ax, C, color="red", size=1.5)
+    handles.append(mpatches.Patch(color="red", label="observed cloud"))
+    handles.append(mpatches.Patch(color="tab:gray", label="hand at the executed grasp"))
+    ax.legend(handles=handles, fontsize=7, loc="upper left")
+    set_equal_aspect(ax, lo, np.maximum(hi, lo + 0.05))
+    if title:
+        ax.set_title(title, fontsize=9)
+    return save_figure(fig, path)

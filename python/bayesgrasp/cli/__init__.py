@@ -4,7 +4,8 @@ Sub-commands:
   demo        the main job: plan, grasp, update the belief, re-plan, on a built-in mug
   plan        the same loop for any object (built-in or mesh file) at a given true pose
   experiment  the thesis's experiments (pub2, baselines, pub4, entropy_order, landscapes)
-  grasp       close the hand on an object at a top-grasp pose; quality and lift test
+  grasp       close the hand on an object from a top grasp, an approach direction or a hand pose
+  category    grasp a new member of a known category for a task (Eq. 4.1)
   register    simulated depth view, table segmentation, registration against models
   objects     list the built-in objects
 
@@ -16,10 +17,10 @@ import argparse
 import os
 import sys
 
-from . import experiment, grasp, objects, plan, register
+from . import category, experiment, grasp, objects, plan, register
 from .args import CliError, join_negative_values
 
-COMMANDS = (grasp, plan, experiment, register, objects)
+COMMANDS = (grasp, plan, category, experiment, register, objects)
 
 
 def build_parser() -> argparse.ArgumentParser:

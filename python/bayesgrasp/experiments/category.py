@@ -127,7 +127,8 @@ def execute(obj, pose, plan: CategoryPlan, rule: TaskRule, ctx: RunContext) -> d
     return {"executed": True, "reason": "", "hand_pose": np.asarray(g.hand_pose).tolist(), "spread": plan.spread,
             "epsilon": float(g.epsilon), "force_closure": float(g.epsilon) > 0.0, "lifted": lifted,
             "task_ok": task_ok, "success": lifted and task_ok, "failure": failure, "contact_parts": parts,
-            "collision_at_start": bool(g.collision_at_start), "stopped_by_table": bool(g.stopped_by_table)}
+            "collision_at_start": bool(g.collision_at_start), "stopped_by_table": bool(g.stopped_by_table),
+            "joint_angles": np.asarray(g.joint_angles).tolist(), "joint_names": list(g.joint_names)}
 
 
 @dataclass
@@ -150,10 +151,13 @@ def see(obj: str, pose, category_name: str, exclude: Sequence[str] = (), eye_off
 
 
 def plan_and_execute(ep: CategoryEpisode, category_name: str, task: str, method: str, ctx: RunContext,
-                     settings: Optional[CategorySettings] = None, seed: int = 0) -> dict:
-    """Eq. 4.1 for one task and method on the episode's registrations, then the execution."""
+                     settings: Optional[CategorySettings] = None, seed: int = 0,
+                     grasps: Optional[Sequence] = None) -> dict:
+    """Eq. 4.1 for one task and method on the episode's registrations, then the execution.
+    ``grasps``: the demonstrated grasps to use (default: generated from the task's rule, cached)."""
     rule = task_rule(category_name, task)
-    grasps = [g for g in demonstrated(ep.models, rule, ctx) if g.task == task]
+    grasps = demonstrated(ep.models, rule, ctx) if grasps is None else grasps
+    grasps = [g for g in grasps if g.task == task]
     s = settings or CategorySettings(method=method)
     planner = CategoryPlanner(ctx.hand, grasps, ep.registrations, cloud=ep.observation.cloud, settings=s, seed=seed)
     plan = planner.plan()

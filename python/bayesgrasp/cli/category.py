@@ -1,0 +1,91 @@
+"""``bayesgrasp category``: grasp a new object of a known category for a task (thesis §4.2, Eq. 4.1):
+one simulated view of the object, registration against the category's training models (the
+object itself left out when it is one of them), the grasp of Eq. 4.1, executed (approach along the
+planned pose, close, lift test) and checked against the task's rule."""
+from __future__ import annotations
+
+import json
+
+import numpy as np
+
+from .args import CliError, add_context_options, context, floats, output_file
+
+
+def add(sub) -> None:
+    c = sub.add_parser("category", help="plan and execute a task grasp on a new member of a known category",
+                       description=__doc__)
+    c.add_argument("--category", required=True, help="mug, bottle or knife (knives train on the hammers)")
+    c.add_argument("--task", required=True, help="the task (mug: top, side, handle; bottle: side; knife: handle)")
+    c.add_argument("--scene-object", required=True, help="the new object (built-in name or mesh file)")
+    c.add_argument("--pose", default="0,0,0", metavar="X,Y,YAW", help="its pose on the table")
+    c.add_argument("--exclude", nargs="*", default=None, metavar="NAME",
+                   help="training models to leave out (default: the scene object itself, if it is one)")
+    c.add_argument("--method", default="laplace", choices=["laplace", "regularised", "gaussian", "baseline"],
+                   help="Eq. 4.1's density, or the best-single-grasp baseline")
+    c.add_argument("--complete", action="store_true", help="use the object's whole surface as the cloud")
+    c.add_argument("--task-grasps", default=None, metavar="FILE",
+                   help="demonstrated grasps to use instead of generating them (JSON {\"grasps\": [{model, task, pose "
+                        "(4x4, model frame), spread, epsilon, lifted}]}; the generator's cache files have this format, "
+                        "so hand-made grasps can be added to a copy of one)")
+    c.add_argument("--json", action="store_true", help="print one JSON object")
+    c.add_argument("--png", default=None, metavar="FILE", help="the cloud, the registered models and the hand")
+    add_context_options(c)
+    c.set_defaults(run=run)
+
+
+def run(args) -> int:
+    from ..experiments.category import plan_and_execute, see
+    from ..models.tasks import task_rule
+
+    pose = floats(args.pose, 3, "--pose")
+    png = output_file(args.png, "--png")
+    task_rule(args.category, args.task)   # a clear error for an unknown category or task
+    exclude = args.exclude if args.exclude is not None else [args.scene_object]
+    ctx = context(args)
+    ep = see(args.scene_object, pose, args.category, exclude=exclude, seed=args.seed, complete=args.complete)
+    if not any(r.success for r in ep.registrations):
+        raise CliError("no training model registered to the cloud (is the object in view, is it of this category?)")
+    grasps = None
+    if args.task_grasps:
+        from ..models.task_grasps import load_task_grasp_file
+
+        grasps = load_task_grasp_file(args.task_grasps)
+    out = plan_and_execute(ep, args.category, args.task, args.method, ctx, seed=args.seed, grasps=grasps)
+    doc = {"grasp": {"pose": out["pose"], "spread": out.get("spread"), "frame": "table"}, "method": args.method,
+           "category": args.category, "task": args.task, "scene_object": args.scene_object, "object_pose": pose,
+           "models": [{"model": m, "weight": out["weights"][m], "contribution": out["contributions"][m]}
+                      for m in ep.models],
+           "epsilon": out["epsilon"], "lifted": out["lifted"], "task_ok": out["task_ok"], "success": out["success"],
+           "failure": out["failure"], "reason": out["reason"] or None, "contact_parts": out.get("contact_parts", [])}
+    if args.json:
+        print(json.dumps(doc))
+    else:
+        _print(doc)
+    if png and out["executed"]:
+        _png(ep, out, ctx, png, doc)
+        print(f"saved {png}")
+    return 0
+
+
+def _print(doc: dict) -> None:
+    print(f"{doc['scene_object']} ({doc['category']}, task {doc['task']}), method {doc['method']}")
+    for m in doc["models"]:
+        print(f"  {m['model']:<10} weight {m['weight']:.3f}  contribution {m['contribution']:.4f}")
+    if doc["reason"]:
+        print(f"  no grasp: {doc['reason']}")
+        return
+    print(f"  epsilon {doc['epsilon']:.4f}, {'lifted' if doc['lifted'] else 'dropped'}, contacts on "
+          f"{', '.join(doc['contact_parts']) or 'nothing'}: {'task-compatible' if doc['task_ok'] else 'wrong part'}"
+          f" -> {'SUCCESS' if doc['success'] else 'failure (' + str(doc['failure']) + ')'}")
+
+
+def _png(ep, out: dict, ctx, png, doc: dict) -> None:
+    from ..hand import Hand
+    from ..objects import load_object
+    from ..viz import plot_category_grasp
+
+    plot_category_grasp(ep.observation.cloud, [load_object(m) for m in ep.models],
+                        [r.transform for r in ep.registrations], [out["weights"][m] for m in ep.models],
+                        Hand.load(ctx.hand), np.asarray(out["joint_angles"]), np.asarray(out["hand_pose"]), png,
+                        title=f"{doc['scene_object']}, {doc['task']}, {doc['method']}: "
+                              f"{'success' if doc['success'] else doc['failure']}")
