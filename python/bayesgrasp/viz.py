@@ -356,3 +356,41 @@ def plot_category_grasp(cloud, models: Sequence, transforms: Sequence, weights: 
     if title:
         ax.set_title(title, fontsize=9)
     return save_figure(fig, path)
+
+
+def plot_fusion_rounds(names: Sequence[str], rounds: Sequence[dict], true_pose, path, title: Optional[str] = None):
+    """PNG of a vision-then-touch episode: the models' weights per round (left) and, from above,
+    each model's believed position and yaw per round with the executed grasps and the true pose
+    (right; later rounds darker)."""
+    fig, (a, b) = plt.subplots(1, 2, figsize=(11, 4.2))
+    W = np.array([[r["weights"][n] for n in names] for r in rounds])
+    for k, n in enumerate(names):
+        a.plot(range(len(rounds)), W[:, k], marker="o", label=n)
+    a.set_xlabel("round (0: the first grasp, from vision)")
+    a.set_ylabel("model weight w_i")
+    a.set_xticks(range(len(rounds)))
+    a.set_ylim(0, 1.02)
+    a.grid(alpha=0.3)
+    a.legend(fontsize=7)
+    cmap = plt.get_cmap("tab10")
+    for t, r in enumerate(rounds):
+        shade = 0.3 + 0.7 * (t + 1) / len(rounds)
+        for k, n in enumerate(names):
+            x, y, yaw = r["poses"][n]
+            b.arrow(100 * x, 100 * y, 1.5 * np.cos(yaw), 1.5 * np.sin(yaw), color=cmap(k % 10), alpha=shade,
+                    width=0.05, head_width=0.4)
+        gx, gy, gyaw = r["grasp"]
+        b.plot(100 * gx, 100 * gy, "s" if r["lifted"] else "x", color="k", alpha=shade, ms=8,
+               label="grasp (square: lifted)" if t == 0 else None)
+    tx, ty, tyaw = true_pose
+    b.plot(100 * tx, 100 * ty, "r+", ms=16, mew=2.5, label="true pose")
+    b.arrow(100 * tx, 100 * ty, 2 * np.cos(tyaw), 2 * np.sin(tyaw), color="r", width=0.08)
+    b.set_aspect("equal")
+    b.set_xlabel("x (cm)")
+    b.set_ylabel("y (cm)")
+    b.set_title("models' poses per round (arrows: yaw), grasps", fontsize=9)
+    b.legend(fontsize=7)
+    b.grid(alpha=0.3)
+    if title:
+        fig.suptitle(title, fontsize=10)
+    return save_figure(fig, path)

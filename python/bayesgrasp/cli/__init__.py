@@ -6,6 +6,7 @@ Sub-commands:
   experiment  the thesis's experiments (pub2, baselines, pub4, entropy_order, landscapes)
   grasp       close the hand on an object from a top grasp, an approach direction or a hand pose
   category    grasp a new member of a known category for a task (Eq. 4.1)
+  fuse        vision then touch: per-model poses and weights from the fingers (Eqs. 4.4-4.6)
   register    simulated depth view, table segmentation, registration against models
   objects     list the built-in objects
 
@@ -17,10 +18,10 @@ import argparse
 import os
 import sys
 
-from . import category, experiment, grasp, objects, plan, register
+from . import category, experiment, fuse, grasp, objects, plan, register
 from .args import CliError, join_negative_values
 
-COMMANDS = (grasp, plan, category, experiment, register, objects)
+COMMANDS = (grasp, plan, category, fuse, experiment, register, objects)
 
 
 def build_parser() -> argparse.ArgumentParser:

@@ -78,6 +78,9 @@ def add_context_options(p: argparse.ArgumentParser, lift: bool = False, seed: bo
                                                  "$BAYESGRASP_CACHE defaulting to ~/.cache/bayesgrasp)")
     if seed:
         p.add_argument("--seed", type=int, default=0, help="seed")
+    p.add_argument("--set", action="append", default=[], metavar="models.FIELD=VALUE",
+                   help="override a grasp-model setting (bayesgrasp.models.ModelSettings), e.g. models.n_samples=500; "
+                        "repeatable")
     if lift:
         p.add_argument("--no-lift", action="store_true", help="skip the physical lift tests (faster)")
 
@@ -91,4 +94,41 @@ def context(args: argparse.Namespace, progress: bool = True):
         raise CliError("--no-lift: needs --success epsilon (success 'lift' is decided by the lift test)")
     return RunContext(hand=getattr(args, "hand", "barrett_bh8"), cache_dir=getattr(args, "cache", None),
                       success=success, lift=lift, seed=getattr(args, "seed", 0),
-                      progress=stderr_progress if progress else None)
+                      progress=stderr_progress if progress else None,
+                      model_settings=model_settings(getattr(args, "set", []), success))
+
+
+def model_settings(assignments, success: str):
+    """ModelSettings from ``models.FIELD=VALUE`` overrides (None when there are none); values are
+    read as the field's type (int, float, bool, or None for the spread)."""
+    import dataclasses
+
+    from ..models import ModelSettings
+
+    if not assignments:
+        return None
+    fields = {f.name for f in dataclasses.fields(ModelSettings)}
+    values = {"success": success}
+    for a in assignments:
+        key, sep, text = a.partition("=")
+        group, _, name = key.partition(".")
+        if not sep or group != "models" or name not in fields:
+            raise CliError(f"--set: expected models.FIELD=VALUE with FIELD one of {', '.join(sorted(fields))}; got {a!r}")
+        default = getattr(ModelSettings(), name)
+        try:
+            if text.lower() == "none" and name == "spread":
+                values[name] = None
+            elif isinstance(default, bool):
+                values[name] = {"true": True, "false": False}[text.lower()]
+            elif isinstance(default, int):
+                values[name] = int(text)
+            elif isinstance(default, float) or default is None:
+                values[name] = float(text)
+            else:
+                values[name] = text
+        except (ValueError, KeyError):
+            raise CliError(f"--set: {key}: cannot read {text!r} as {type(default).__name__}") from None
+    try:
+        return ModelSettings(**values)
+    except ValueError as e:
+        raise CliError(f"--set: {e}") from None

@@ -23,7 +23,8 @@ class RunContext:
     (epsilon above the models' eps_stable, the thesis's simulation criterion); lift: run the lift
     test (required by success "lift"; with "epsilon" it runs on stable grasps); threads: C++
     threads for batches (0 = all cores); seed: the base seed; progress: a callable taking a message
-    (None: silent; not sent to worker processes)."""
+    (None: silent; not sent to worker processes); model_settings: how the grasp models are built
+    (None: the defaults for the success criterion)."""
 
     hand: str = "barrett_bh8"
     cache_dir: Optional[str] = None
@@ -32,6 +33,7 @@ class RunContext:
     threads: int = 1
     seed: int = 0
     progress: Optional[Callable[[str], None]] = field(default=None, compare=False)
+    model_settings: Optional[ModelSettings] = None   # None: ModelSettings(success=self.success)
 
     def __post_init__(self):
         if self.success not in SUCCESS_CRITERIA:
@@ -50,7 +52,7 @@ class RunContext:
     def models(self, obj: Union[str, ObjectModel], settings: Optional[ModelSettings] = None) -> GraspModels:
         """The object's grasp models for this context's hand, cache and success criterion
         (memoised per process)."""
-        settings = settings or ModelSettings(success=self.success)
+        settings = settings or self.model_settings or ModelSettings(success=self.success)
         return get_models(obj, self.hand, settings, cache_dir=self.cache_dir, progress=self.progress)
 
     def for_workers(self) -> "RunContext":

@@ -62,15 +62,18 @@ class FusionTrial:
 
     def __init__(self, obj: str, pose, ctx: RunContext, task: str = "top", settings: Optional[FusionSettings] = None,
                  exclude: Sequence[str] = (), eye_offset=None, seed: int = 0,
-                 model_settings: Optional[ModelSettings] = None):
-        cat = obj.split("/")[0] if "/" in obj else "mug"
+                 model_settings: Optional[ModelSettings] = None, grasps: Optional[Sequence] = None,
+                 category: Optional[str] = None):
+        cat = category or (obj.split("/")[0] if "/" in str(obj) else "mug")
         self.obj, self.pose, self.ctx, self.seed = obj, np.asarray(pose, float), ctx, seed
         kw = {} if eye_offset is None else {"eye_offset": eye_offset}
         self.episode = see(obj, pose, cat, exclude=tuple(exclude) or (obj,), seed=seed, **kw)
+        if not any(r.success for r in self.episode.registrations):
+            raise ValueError("no training model registered to the cloud: there is no vision belief to start from")
         self.names = self.episode.models
         self.models = [ctx.models(m, model_settings) for m in self.names]
         rule = task_rule(cat, task)
-        grasps = demonstrated(self.names, rule, ctx)
+        grasps = demonstrated(self.names, rule, ctx) if grasps is None else grasps
         self.task_grasps = [planar_top_grasps([g for g in grasps if g.model == m]) for m in self.names]
         regs = self.episode.registrations
         self.w0 = np.array([r.phi if r.success else 0.0 for r in regs])

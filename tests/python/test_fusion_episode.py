@@ -1,0 +1,90 @@
+"""Vision then touch end to end (small models and grasps): a held-out mug, two training mugs."""
+import json
+
+import numpy as np
+import pytest
+
+from bayesgrasp.cli import main
+from bayesgrasp.experiments.context import RunContext
+from bayesgrasp.experiments.tactile_fusion import FusionTrial, planar_top_grasps, transitions
+from bayesgrasp.models import ModelSettings
+from bayesgrasp.models.task_grasps import TaskGraspSettings, generate_task_grasps, grasp_to_json
+from bayesgrasp.models.tasks import task_rule
+
+SMALL = ModelSettings(n_samples=400, n_inducing=60, max_iter=40, n_lift_samples=200, n_calibration=150, n_pilot=60,
+                      n_pilot_lifts=15)
+KEEP = ("mug/1", "mug/2")
+EXCLUDE = tuple(f"mug/{i}" for i in range(7) if f"mug/{i}" not in KEEP)
+
+
+@pytest.fixture(scope="module")
+def grasps():
+    out = []
+    for m in KEEP:
+        out += generate_task_grasps(m, task_rule("mug", "top"),
+                                    settings=TaskGraspSettings(candidates=150, spreads=(0.0, float(np.radians(60))),
+                                                               lift_tests=6, keep=2))
+    return out
+
+
+@pytest.fixture(scope="module")
+def cache(tmp_path_factory):
+    return str(tmp_path_factory.mktemp("models"))
+
+
+def test_planar_top_grasps_of_palm_down_poses():
+    from bayesgrasp.hand import Hand
+    from bayesgrasp.models.tasks import TaskGrasp
+
+    g = TaskGrasp("m", "top", Hand.top_grasp_pose(0.01, -0.02, 0.7, 0.1), 0.0, 0.1, True)
+    np.testing.assert_allclose(planar_top_grasps([g])[0], [0.01, -0.02, 0.7], atol=1e-12)
+
+
+@pytest.mark.parametrize("mode", ["random", "vision"])
+def test_a_trial_runs_rounds_until_a_lift_with_normalised_weights(grasps, cache, mode):
+    ctx = RunContext(cache_dir=cache, model_settings=SMALL)
+    trial = FusionTrial("mug/3", (0.01, 0.02, 0.7), ctx, exclude=EXCLUDE, seed=3, grasps=grasps)
+    assert trial.names == list(KEEP)
+    r = trial.run(mode)
+    rounds = r["rounds"]
+    assert 2 <= len(rounds) <= 4                    # round 1 is always made (the thesis's accounting)
+    for k, x in enumerate(rounds):
+        assert x["round"] == k and sum(x["weights"]) == pytest.approx(1.0)
+        assert isinstance(x["lifted"], bool) and np.isfinite(x["epsilon"])
+    # rounds 2 and 3 only while nothing was lifted
+    for k in range(2, len(rounds)):
+        assert not any(x["lifted"] for x in rounds[:k])
+
+
+def test_the_accounting_of_transitions_by_hand():
+    def trial(lifted, eps):
+        return (None, {"rounds": [{"lifted": l, "epsilon": e} for l, e in zip(lifted, eps)],
+                       "vision_only": {"lifted": lifted[0]}})
+    res = [trial([False, True], [0.0, 0.1]),            # unstable -> stable: better
+           trial([True, False], [0.2, 0.0]),            # stable -> unstable: worse
+           trial([False, False, False, True], [0.0, 0.0, 0.0, 0.1]),   # same, stable in round 3
+           trial([False, False, True], [0.0, 0.0, 0.2])]               # same, stable in round 2
+    t = transitions(res)
+    assert (t["better"], t["worse"], t["same_both_unstable"]) == (1, 1, 2)
+    assert (t["unstable_to_stable"], t["stable_to_unstable"]) == (1, 1)
+    assert t["still_unstable_after_round_1"] == 2
+    assert (t["became_stable_round_2"], t["became_stable_round_3"]) == (1, 1)
+    assert t["cumulative_success_by_round"] == [1, 2, 3, 4] and t["vision_only_success"] == 1
+
+
+def test_fuse_cli(grasps, cache, tmp_path, capsys):
+    png = tmp_path / "f.png"
+    args = ["fuse", "--scene-object", "mug/3", "--pose", "0.01,0.02,0.7", "--exclude", *EXCLUDE, "mug/3",
+            "--cache", cache, "--rounds", "2", "--json", "--png", str(png)]
+    for k, v in {"n_samples": 400, "n_inducing": 60, "max_iter": 40, "n_lift_samples": 200, "n_calibration": 150,
+                 "n_pilot": 60, "n_pilot_lifts": 15}.items():
+        args += ["--set", f"models.{k}={v}"]
+    f = tmp_path / "g.json"
+    f.write_text(json.dumps({"grasps": [grasp_to_json(g) for g in grasps]}))
+    assert main(args + ["--task-grasps", str(f)]) == 0
+    doc = json.loads(capsys.readouterr().out)
+    assert doc["rounds"] and set(doc["rounds"][0]) >= {"grasp", "weights", "poses", "epsilon", "lifted"}
+    assert doc["success"] == any(r["lifted"] for r in doc["rounds"])
+    assert png.stat().st_size > 1000
+    assert main(["fuse", "--scene-object", "mug/3", "--set", "models.n_samples=x"]) == 2
+    assert "--set" in capsys.readouterr().err
