@@ -14,6 +14,7 @@ void bind_belief(py::module_& m);
 void bind_optim(py::module_& m);
 void bind_vision(py::module_& m);
 void bind_task(py::module_& m);
+void bind_touch(py::module_& m);
 }  // namespace bayesgrasp::bind
 
 namespace {
@@ -40,6 +41,7 @@ PYBIND11_MODULE(_core, m) {
       {"optim", "PSO, steepest descent, simulated annealing, firefly, trust region.", bind_optim},
       {"vision", "Simulated depth camera, table segmentation, FPFH + RANSAC + ICP registration.", bind_vision},
       {"task", "Task grasping (Eq. 4.1): pose densities, grasp mixtures, hand clearance.", bind_task},
+      {"touch", "One touch (Pub. I): the executed grasp re-simulated against candidate object states.", bind_touch},
   };
   for (const Submodule& s : submodules) {
     py::module_ sub = m.def_submodule(s.name, s.doc);

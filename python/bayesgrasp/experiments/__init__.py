@@ -14,6 +14,7 @@ from .runner import ResultStore, RunKey, run_experiment, run_seed
 from . import pose_uncertainty  # noqa: E402,F401  (isort: skip)
 from . import category_grasping  # noqa: E402,F401  (isort: skip)
 from . import tactile_fusion  # noqa: E402,F401  (isort: skip)
+from . import single_touch  # noqa: E402,F401  (isort: skip)
 
 __all__ = ["EXPERIMENTS", "EpisodeSettings", "Experiment", "ResultStore", "RunContext", "RunKey", "experiment_names",
            "get_experiment", "run", "run_episode", "run_experiment", "run_seed"]
