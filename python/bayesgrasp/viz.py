@@ -393,4 +393,36 @@ def plot_fusion_rounds(names: Sequence[str], rounds: Sequence[dict], true_pose, 
     b.grid(alpha=0.3)
     if title:
         fig.suptitle(title, fontsize=10)
+
+
+def plot_touch_landscape(landscape: dict, path, title: str = "") -> Path:
+    """Pub. I's fitness landscape of one touch: f over (x, y) (log colour scale) at the truth's yaw
+    and scale, and f over yaw at the truth's and at the estimate's position, with the truth, the
+    initial guess and the estimate marked. ``landscape``: xs, ys (grid axes), f_xy (len(xs), len(ys)),
+    yaws, f_yaw_truth, f_yaw_estimate, and truth / initial / estimate as (x, y, yaw, scale)."""
+    L = landscape
+    truth, initial, est = (np.asarray(L[k], dtype=float) for k in ("truth", "initial", "estimate"))
+    fig, (a, b) = plt.subplots(1, 2, figsize=(12, 5))
+    F = np.log10(np.asarray(L["f_xy"], dtype=float).T + 1e-3)
+    m = a.pcolormesh(np.asarray(L["xs"]) * 100, np.asarray(L["ys"]) * 100, F, shading="auto", cmap="viridis")
+    fig.colorbar(m, ax=a, label="log10(f + 0.001)")
+    for p, marker, label in ((truth, "*", "truth"), (initial, "s", "initial guess"), (est, "o", "estimate")):
+        a.plot(p[0] * 100, p[1] * 100, marker, color="w", mec="k", ms=11, label=label)
+    a.set_xlabel("x (cm)")
+    a.set_ylabel("y (cm)")
+    a.set_aspect("equal")
+    a.legend(fontsize=8, loc="upper right")
+    a.set_title(f"f over (x, y) at the true yaw {np.degrees(truth[2]):.1f} deg")
+    yaws = np.degrees(np.asarray(L["yaws"], dtype=float))
+    b.semilogy(yaws, np.asarray(L["f_yaw_truth"]) + 1e-3, label="at the true position")
+    b.semilogy(yaws, np.asarray(L["f_yaw_estimate"]) + 1e-3, label="at the estimated position")
+    for p, style, label in ((truth, "k-", "truth"), (initial, "k:", "initial guess"), (est, "r--", "estimate")):
+        b.axvline(np.degrees(p[2]), color=style[0], linestyle=style[1:], label=label)
+    b.set_xlabel("yaw (deg)")
+    b.set_ylabel("f + 0.001")
+    b.legend(fontsize=8)
+    b.set_title("f over yaw")
+    if title:
+        fig.suptitle(title)
+    fig.tight_layout()
     return save_figure(fig, path)

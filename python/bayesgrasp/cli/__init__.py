@@ -9,6 +9,7 @@ Sub-commands:
   fuse        vision then touch: per-model poses and weights from the fingers (Eqs. 4.4-4.6)
   register    simulated depth view, table segmentation, registration against models
   objects     list the built-in objects
+  touch       what one touch tells about an object's pose and size (Pub. I)
 
 Comma-separated numbers may start with a minus sign: ``--top -0.01,0,0``.
 """
@@ -18,10 +19,10 @@ import argparse
 import os
 import sys
 
-from . import category, experiment, fuse, grasp, objects, plan, register
+from . import category, experiment, fuse, grasp, objects, plan, register, touch
 from .args import CliError, join_negative_values
 
-COMMANDS = (grasp, plan, category, fuse, experiment, register, objects)
+COMMANDS = (grasp, plan, category, fuse, experiment, register, objects, touch)
 
 
 def build_parser() -> argparse.ArgumentParser:
