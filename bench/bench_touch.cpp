@@ -4,15 +4,14 @@
 //   Estimate/<optimiser>/<object>   3 DoF (x, y, yaw); 4 DoF adds the scale (its simulators per
 //                                   quantised scale built in the first iteration and kept)
 // Objects: a 6 cm cube (12 triangles), a cylinder r = 3.5 cm, h = 12 cm (64 sides, 256
-// triangles), and with --mesh=PATH an OBJ file in the object's frame (bench/run_touch.sh exports
-// the built-in mug). Google Benchmark reports wall and CPU time per estimate; on a shared machine
+// triangles), and with --mesh=PATH a mesh in the object's frame (see read_mesh; bench/run_touch.sh
+// exports the built-in mug). Google Benchmark reports wall and CPU time per estimate; on a shared machine
 // the CPU column is the one to read.
 #include <benchmark/benchmark.h>
 
 #include <cmath>
 #include <cstring>
 #include <fstream>
-#include <sstream>
 #include <string>
 
 #include "bayesgrasp/touch/estimate.hpp"
@@ -40,43 +39,24 @@ TriMesh polygon_prism(int n, double r, double h, double phase) {
   return m;
 }
 
-/// Vertices ("v x y z") and triangles ("f a b c", 1-based, "a/..." accepted) of an OBJ file.
-TriMesh read_obj(const std::string& path) {
+/// A mesh as plain numbers: "N M", then N vertex rows x y z, then M triangle rows a b c (0-based).
+TriMesh read_mesh(const std::string& path) {
   std::ifstream in(path);
-  if (!in) throw std::runtime_error("cannot read " + path);
-  std::vector<Vec3> V;
-  std::vector<Eigen::Vector3i> F;
-  std::string line;
-  while (std::getline(in, line)) {
-    std::istringstream s(line);
-    std::string tag;
-    s >> tag;
-    if (tag == "v") {
-      Vec3 v;
-      s >> v.x() >> v.y() >> v.z();
-      V.push_back(v);
-    } else if (tag == "f") {
-      Eigen::Vector3i f;
-      for (int k = 0; k < 3; ++k) {
-        std::string w;
-        s >> w;
-        f[k] = std::stoi(w.substr(0, w.find('/'))) - 1;
-      }
-      F.push_back(f);
-    }
-  }
-  TriMesh m;
-  m.V.resize(static_cast<int>(V.size()), 3);
-  m.F.resize(static_cast<int>(F.size()), 3);
-  for (size_t i = 0; i < V.size(); ++i) m.V.row(static_cast<int>(i)) = V[i].transpose();
-  for (size_t i = 0; i < F.size(); ++i) m.F.row(static_cast<int>(i)) = F[i].transpose();
-  return m;
+  long n = 0, m = 0;
+  if (!(in >> n >> m) || n < 3 || m < 1) throw std::runtime_error("cannot read a mesh from " + path);
+  TriMesh mesh;
+  mesh.V.resize(n, 3);
+  mesh.F.resize(m, 3);
+  for (long i = 0; i < 3 * n; ++i) in >> mesh.V(i / 3, i % 3);
+  for (long i = 0; i < 3 * m; ++i) in >> mesh.F(i / 3, i % 3);
+  if (!in) throw std::runtime_error("truncated mesh file " + path);
+  return mesh;
 }
 
 TriMesh object(int which) {
   if (which == 0) return polygon_prism(4, 0.03 * std::sqrt(2.0), 0.06, M_PI / 4);
   if (which == 1) return polygon_prism(64, 0.035, 0.12, 0.0);
-  return read_obj(g_mesh);
+  return read_mesh(g_mesh);
 }
 
 const char* kObjects[] = {"cube", "cylinder", "mesh"};
