@@ -3,9 +3,9 @@
 //
 //   Estimate/<optimiser>/<object>   3 DoF (x, y, yaw); 4 DoF adds the scale (its simulators per
 //                                   quantised scale built in the first iteration and kept)
-// Objects: a 6 cm cube (12 triangles), a cylinder r = 3.5 cm, h = 12 cm (64 sides, 256
-// triangles), and with --mesh=PATH a mesh in the object's frame (see read_mesh; bench/run_touch.sh
-// exports the built-in mug). Google Benchmark reports wall and CPU time per estimate; on a shared machine
+// Objects: the 6 cm cube (12 triangles), and each --mesh=NAME=PATH, a mesh in the object's frame
+// (see read_mesh; bench/run_touch.sh exports the library's cylinder and mug). Google Benchmark
+// reports wall and CPU time per estimate; on a shared machine
 // the CPU column is the one to read.
 #include <benchmark/benchmark.h>
 
@@ -22,20 +22,15 @@ using namespace bayesgrasp::touch;
 namespace {
 
 const std::string kBarrett = std::string(BAYESGRASP_SOURCE_DIR) + "/python/bayesgrasp/data/hands/barrett_bh8.json";
-std::string g_mesh;
 
-TriMesh polygon_prism(int n, double r, double h, double phase) {
+/// The library's cube: 6 cm, centred on the z axis, standing on the table.
+TriMesh cube() {
   TriMesh m;
-  m.V.resize(2 * n, 3);
-  m.F.resize(4 * n - 4, 3);
-  for (int i = 0; i < n; ++i) {
-    const double a = phase + 2 * M_PI * i / n;
-    m.V.row(i) << r * std::cos(a), r * std::sin(a), 0.0;
-    m.V.row(n + i) << r * std::cos(a), r * std::sin(a), h;
-  }
-  int f = 0;
-  for (int i = 0; i < n; ++i) m.F.row(f++) << i, (i + 1) % n, n + (i + 1) % n, m.F.row(f++) << i, n + (i + 1) % n, n + i;
-  for (int i = 1; i + 1 < n; ++i) m.F.row(f++) << 0, i + 1, i, m.F.row(f++) << n, n + i, n + i + 1;
+  m.V.resize(8, 3);
+  m.V << -0.03, -0.03, 0, 0.03, -0.03, 0, -0.03, 0.03, 0, 0.03, 0.03, 0,  //
+      -0.03, -0.03, 0.06, 0.03, -0.03, 0.06, -0.03, 0.03, 0.06, 0.03, 0.03, 0.06;
+  m.F.resize(12, 3);
+  m.F << 0, 2, 3, 0, 3, 1, 4, 5, 7, 4, 7, 6, 0, 1, 5, 0, 5, 4, 2, 6, 7, 2, 7, 3, 0, 4, 6, 0, 6, 2, 1, 3, 7, 1, 7, 5;
   return m;
 }
 
@@ -53,24 +48,14 @@ TriMesh read_mesh(const std::string& path) {
   return mesh;
 }
 
-TriMesh object(int which) {
-  if (which == 0) return polygon_prism(4, 0.03 * std::sqrt(2.0), 0.06, M_PI / 4);
-  if (which == 1) return polygon_prism(64, 0.035, 0.12, 0.0);
-  return read_mesh(g_mesh);
-}
-
-const char* kObjects[] = {"cube", "cylinder", "mesh"};
+/// The objects: the cube, then the --mesh=NAME=PATH files in the order given.
+std::vector<std::pair<std::string, TriMesh>> g_objects;
 
 void BM_Estimate(benchmark::State& state) {
   const auto optimizer = static_cast<Optimizer>(state.range(0));
-  const int which = static_cast<int>(state.range(1));
+  const auto& [name, mesh] = g_objects[state.range(1)];
   const bool size = state.range(2) != 0;
-  if (which == 2 && g_mesh.empty()) {
-    state.SkipWithError("no --mesh given");
-    return;
-  }
   const HandModel hand = HandModel::from_file(kBarrett);
-  const TriMesh mesh = object(which);
   const TouchModel model(hand, mesh);
   // the world: the object at (1 cm, -1.5 cm, 20 deg), scale 1.1 when the size is unknown
   const State truth(0.01, -0.015, 0.35, size ? 1.1 : 1.0);
@@ -92,26 +77,32 @@ void BM_Estimate(benchmark::State& state) {
   }
   state.counters["evaluations"] = o.budget;
   state.counters["position_error_mm"] = 1e3 * error;
-  state.SetLabel(std::string(kObjects[which]) + (size ? ", 4 DoF" : ", 3 DoF"));
+  state.SetLabel(name + (size ? ", 4 DoF" : ", 3 DoF"));
 }
 
 void args(benchmark::internal::Benchmark* b) {
   for (int opt : {static_cast<int>(Optimizer::PSO), static_cast<int>(Optimizer::Descent),
                   static_cast<int>(Optimizer::Annealing), static_cast<int>(Optimizer::Firefly)})
-    for (int obj : {0, 1, 2}) b->Args({opt, obj, 0});
-  for (int obj : {0, 1, 2}) b->Args({static_cast<int>(Optimizer::PSO), obj, 1});
+    for (int obj = 0; obj < static_cast<int>(g_objects.size()); ++obj) b->Args({opt, obj, 0});
+  const int pso = static_cast<int>(Optimizer::PSO);
+  for (int obj = 0; obj < static_cast<int>(g_objects.size()); ++obj) b->Args({pso, obj, 1});
 }
 
 }  // namespace
 
-BENCHMARK(BM_Estimate)->Apply(args)->ArgNames({"optimizer", "object", "size"})->Unit(benchmark::kMillisecond);
-
 int main(int argc, char** argv) {
+  g_objects.emplace_back("cube", cube());
   std::vector<char*> rest;
   for (int i = 0; i < argc; ++i) {
-    if (std::strncmp(argv[i], "--mesh=", 7) == 0) g_mesh = argv[i] + 7;
+    const char* a = argv[i];
+    const char* eq = std::strncmp(a, "--mesh=", 7) == 0 ? std::strchr(a + 7, '=') : nullptr;
+    if (eq) g_objects.emplace_back(std::string(a + 7, eq), read_mesh(eq + 1));
     else rest.push_back(argv[i]);
   }
+  benchmark::RegisterBenchmark("Estimate", BM_Estimate)
+      ->Apply(args)
+      ->ArgNames({"optimizer", "object", "size"})
+      ->Unit(benchmark::kMillisecond);
   int n = static_cast<int>(rest.size());
   benchmark::Initialize(&n, rest.data());
   benchmark::RunSpecifiedBenchmarks();

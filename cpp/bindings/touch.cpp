@@ -26,9 +26,24 @@ py::array_t<bool> bools(const FlagMatrix& m) {
   return out;
 }
 
-std::vector<uint8_t> flags(const py::array_t<bool, py::array::c_style | py::array::forcecast>& a, const char* name) {
+std::vector<uint8_t> flags(const py::array_t<bool, py::array::c_style | py::array::forcecast>& a,
+                           const char* name) {
   if (a.ndim() != 1) throw py::value_error(std::string(name) + ": expected a 1-D array of flags, got " + shape_str(a));
   return std::vector<uint8_t>(a.data(), a.data() + a.shape(0));
+}
+
+using BoolArray = py::array_t<bool, py::array::c_style | py::array::forcecast>;
+
+/// Readings from arrays: shapes are checked here, values (finiteness, sizes) by the core when used.
+TouchReadings readings_from(const DArray& joints, const BoolArray& contact, const DArray& hand_pose) {
+  if (joints.ndim() != 1) throw py::value_error("joints: expected a 1-D array, got " + shape_str(joints));
+  if (hand_pose.ndim() != 2 || hand_pose.shape(0) != 4 || hand_pose.shape(1) != 4)
+    throw py::value_error("hand_pose: expected shape (4, 4), got " + shape_str(hand_pose));
+  TouchReadings r;
+  r.joints = Eigen::Map<const Eigen::VectorXd>(joints.data(), joints.shape(0));
+  r.contact = flags(contact, "contact");
+  r.hand_pose.matrix() = Eigen::Map<const Eigen::Matrix<double, 4, 4, Eigen::RowMajor>>(hand_pose.data());
+  return r;
 }
 
 void bind_enums(py::module_& m) {
@@ -51,12 +66,14 @@ void bind_enums(py::module_& m) {
 }
 
 void bind_grasp_and_readings(py::module_& m) {
-  py::class_<TouchGrasp> g(m, "TouchGrasp", "The executed grasp (world frame): a top grasp or a closing at a hand pose.");
+  py::class_<TouchGrasp> g(m, "TouchGrasp",
+                           "The executed grasp (world frame): a top grasp or a closing at a hand pose.");
   py::enum_<TouchGrasp::Kind>(g, "Kind").value("top_grasp", TouchGrasp::Kind::TopGrasp)
       .value("closing", TouchGrasp::Kind::Closing);
   g.def_static("top", &TouchGrasp::top, py::arg("x"), py::arg("y"), py::arg("yaw"), py::arg("spread"),
                py::arg("standoff") = 0.0, "Palm-down descent at (x, y, yaw) to the first contact, then closing.")
-      .def_static("closing", [](const DArray& H, double spread) { return TouchGrasp::closing(pose(H, "hand_pose"), spread); },
+      .def_static(
+          "closing", [](const DArray& H, double spread) { return TouchGrasp::closing(pose(H, "hand_pose"), spread); },
                   py::arg("hand_pose"), py::arg("spread"), "Closing at a known 4x4 world hand pose.")
       .def_readonly("kind", &TouchGrasp::kind, "kind : TouchGrasp.Kind\n    top_grasp or closing")
       .def_readonly("x", &TouchGrasp::x, "x : float\n    top grasp x (m)")
@@ -68,22 +85,12 @@ void bind_grasp_and_readings(py::module_& m) {
                              "hand_pose : numpy.ndarray (4, 4)\n    closing: the hand pose");
 
   py::class_<TouchReadings>(m, "TouchReadings", "What the hand read after closing.")
-      .def(py::init([](const DArray& joints, const py::array_t<bool, py::array::c_style | py::array::forcecast>& contact,
-                       const DArray& hand_pose) {
-             TouchReadings r;
-             r.joints = Eigen::Map<const Eigen::VectorXd>(joints.data(), joints.size());
-             if (joints.ndim() != 1) throw py::value_error("joints: expected a 1-D array, got " + shape_str(joints));
-             r.contact = flags(contact, "contact");
-             r.hand_pose.matrix() = Eigen::Map<const Eigen::Matrix<double, 4, 4, Eigen::RowMajor>>(
-                 hand_pose.ndim() == 2 && hand_pose.shape(0) == 4 && hand_pose.shape(1) == 4
-                     ? hand_pose.data()
-                     : throw py::value_error("hand_pose: expected shape (4, 4), got " + shape_str(hand_pose)));
-             return r;
-           }),
+      .def(py::init(&readings_from),
            py::arg("joints"), py::arg("contact"), py::arg("hand_pose"),
            "joints (J,) rad; contact (L,) bool per link; hand_pose (4, 4). Checked when used (ValueError).")
       .def_static("from_grasp", &readings_of, py::arg("result"), "The readings of a simulated GraspResult.")
-      .def_readonly("joints", &TouchReadings::joints, "joints : numpy.ndarray (J,)\n    joint angles (rad), hand layout")
+      .def_readonly("joints", &TouchReadings::joints,
+                    "joints : numpy.ndarray (J,)\n    joint angles (rad), hand layout")
       .def_property_readonly("contact", [](const TouchReadings& r) { return bools(r.contact); },
                              "contact : numpy.ndarray (L,) bool\n    per link: it touches the object")
       .def_property_readonly("hand_pose", [](const TouchReadings& r) { return to_numpy(r.hand_pose); },
@@ -140,8 +147,10 @@ void bind_results(py::module_& m) {
       .def_readonly("joints", &TouchPredictions::joints, "joints : numpy.ndarray (N, J)\n    joint angles (rad)")
       .def_property_readonly("contact", [](const TouchPredictions& p) { return bools(p.contact); },
                              "contact : numpy.ndarray (N, L) bool\n    per link: touches the candidate")
-      .def_readonly("hand_height", &TouchPredictions::hand_height, "hand_height : numpy.ndarray (N,)\n    z of the hand (m)")
-      .def_property_readonly("collision_at_start", [](const TouchPredictions& p) { return bools(p.collision_at_start); },
+      .def_readonly("hand_height", &TouchPredictions::hand_height,
+                    "hand_height : numpy.ndarray (N,)\n    z of the hand (m)")
+      .def_property_readonly("collision_at_start",
+                             [](const TouchPredictions& p) { return bools(p.collision_at_start); },
                              "collision_at_start : numpy.ndarray (N,) bool")
       .def_readonly("surface_distance", &TouchPredictions::surface_distance,
                     "surface_distance : numpy.ndarray (N, L)\n    measured hand's links to the candidate's surface (m)")
@@ -173,6 +182,12 @@ void bind_results(py::module_& m) {
                     "cpu_seconds : float\n    processor time of the search (all threads)");
 }
 
+/// States as the core takes them (an array that is not 2-D becomes 0 x 0: the core names the problem).
+RowMatrixXd states_from(const DArray& a) {
+  if (a.ndim() != 2) return RowMatrixXd(0, 0);
+  return Eigen::Map<const RowMatrixXd>(a.data(), a.shape(0), a.shape(1));
+}
+
 void bind_model(py::module_& m) {
   py::class_<TouchModel>(m, "TouchModel", R"doc(The executed grasp re-simulated against candidate object states.
 
@@ -189,9 +204,9 @@ Args:
       .def_property_readonly("cached_scales", &TouchModel::cached_scales, "cached_scales : int\n    simulators built")
       .def(
           "predict",
-          [](const TouchModel& t, const TouchGrasp& g, const DArray& states, const TouchReadings* measured, int threads) {
-            const RowMatrixXd S = Eigen::Map<const RowMatrixXd>(states.data(), states.ndim() == 2 ? states.shape(0) : 0,
-                                                                states.ndim() == 2 ? states.shape(1) : 0);
+          [](const TouchModel& t, const TouchGrasp& g, const DArray& states, const TouchReadings* measured,
+             int threads) {
+            const RowMatrixXd S = states_from(states);
             py::gil_scoped_release release;
             return measured ? t.predict(g, S, *measured, threads) : t.predict(g, S, threads);
           },
@@ -202,8 +217,7 @@ Args:
           "fitness",
           [](const TouchModel& t, const TouchGrasp& g, const TouchReadings& measured, const DArray& states,
              const FitnessOptions& o, int threads) {
-            const RowMatrixXd S = Eigen::Map<const RowMatrixXd>(states.data(), states.ndim() == 2 ? states.shape(0) : 0,
-                                                                states.ndim() == 2 ? states.shape(1) : 0);
+            const RowMatrixXd S = states_from(states);
             py::gil_scoped_release release;
             return evaluate_fitness(t, g, measured, S, o, threads);
           },

@@ -19,7 +19,10 @@ TriMesh prism(const std::vector<Eigen::Vector2d>& poly, double h) {
   const int n = static_cast<int>(poly.size());
   TriMesh m;
   m.V.resize(2 * n, 3);
-  for (int i = 0; i < n; ++i) m.V.row(i) << poly[i].x(), poly[i].y(), 0.0, m.V.row(n + i) << poly[i].x(), poly[i].y(), h;
+  for (int i = 0; i < n; ++i) {
+    m.V.row(i) << poly[i].x(), poly[i].y(), 0.0;
+    m.V.row(n + i) << poly[i].x(), poly[i].y(), h;
+  }
   m.F.resize(4 * n - 4, 3);
   int f = 0;
   for (int i = 0; i < n; ++i) {
@@ -154,9 +157,9 @@ TEST(Touch, SymmetricObjectsAreFlatInYaw) {
   for (const auto& [mesh, period] : objects) {
     Touch t(mesh, State(0.01, 0.0, 0.2, 1.0), TouchGrasp::top(0.0, 0.0, 0.0, 0.0));
     const TouchModel model(t.hand, t.object);
-    const FitnessTerms f = evaluate_fitness(
-        model, t.grasp, t.measured,
-        rows({t.truth, State(0.01, 0.0, 0.2 + period * kDeg, 1.0), State(0.01, 0.0, 0.2 - 2 * period * kDeg, 1.0)}), {});
+    const RowMatrixXd S =
+        rows({t.truth, State(0.01, 0.0, 0.2 + period * kDeg, 1.0), State(0.01, 0.0, 0.2 - 2 * period * kDeg, 1.0)});
+    const FitnessTerms f = evaluate_fitness(model, t.grasp, t.measured, S, {});
     for (int i = 0; i < 3; ++i) EXPECT_LT(f.total[i], 0.01) << period << " " << i;
   }
 }

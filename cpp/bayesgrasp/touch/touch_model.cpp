@@ -144,7 +144,10 @@ TouchPredictions TouchModel::run(const TouchGrasp& grasp, const RowMatrixXd& sta
     p.hand_height[i] = r.hand_pose.translation().z();
     p.collision_at_start[i] = r.collision_at_start;
     if (!measured) continue;
-    for (int l = 0; l < L; ++l) p.surface_distance(i, l) = out[i].distance[l], p.penetrating(i, l) = out[i].penetrating[l];
+    for (int l = 0; l < L; ++l) {
+      p.surface_distance(i, l) = out[i].distance[l];
+      p.penetrating(i, l) = out[i].penetrating[l];
+    }
   }
   return p;
 }
