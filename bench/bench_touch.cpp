@@ -5,8 +5,7 @@
 //                                   quantised scale built in the first iteration and kept)
 // Objects: the 6 cm cube (12 triangles), and each --mesh=NAME=PATH, a mesh in the object's frame
 // (see read_mesh; bench/run_touch.sh exports the library's cylinder and mug). Google Benchmark
-// reports wall and CPU time per estimate; on a shared machine
-// the CPU column is the one to read.
+// reports wall and CPU time per estimate; on a shared machine the CPU column is the one to read.
 #include <benchmark/benchmark.h>
 
 #include <cmath>

@@ -73,7 +73,6 @@ TouchModel::TouchModel(const HandModel& hand, const TriMesh& object, const Touch
     throw std::invalid_argument("scale_step: must be positive and finite, got " + std::to_string(step));
   if (!(options_.scale_min > 0.0) || !(options_.scale_max >= options_.scale_min) || !std::isfinite(options_.scale_max))
     throw std::invalid_argument("scale_min, scale_max: need 0 < scale_min <= scale_max < inf");
-  simulator(1.0);  // the nominal object is always there (and validates the mesh for the simulator)
 }
 
 double TouchModel::quantised_scale(double scale) const {

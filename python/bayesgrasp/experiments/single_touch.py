@@ -77,18 +77,20 @@ def _errors(obj: str, state, truth) -> dict:
             "size_error": float(abs(state[3] - truth[3]) / truth[3])}
 
 
-def _one_case(obj: str, case: str, optimizer: str, rng: np.random.Generator, seed: int, ctx: RunContext):
+def _one_case(obj: str, case: str, optimizer: str, rng: np.random.Generator, seed: int, ctx: RunContext,
+              contact_term: str = "flags", hand: Optional[str] = None):
     truth, initial = problem(case, rng)
-    model = touch_model(obj, ctx.hand)
+    model = touch_model(obj, hand or ctx.hand)
     settings = TouchSettings(optimizer=optimizer, unknowns=case, budget=BUDGET, seed=seed,
-                             box=(ERROR_XY, ERROR_YAW, SCALES[0], SCALES[1]))
+                             box=(ERROR_XY, ERROR_YAW, SCALES[0], SCALES[1]), contact_term=contact_term)
     planner = TouchPlanner(model, initial, settings)
     grasp = planner.touch_grasp()
     readings = read(touch_world(obj, truth[:3], truth[3], model.hand), grasp)
     r = planner.update(grasp, readings)
     rec = {"truth": truth.tolist(), "initial": initial.tolist(), "estimate": planner.estimate.tolist(),
            "status": r.status.name, "contacts": int(readings.contact_count), "fitness": r.fitness,
-           "initial_fitness": r.initial_fitness, "evaluations": int(r.evaluations), "seconds": r.seconds, "cpu_seconds": r.cpu_seconds,
+           "initial_fitness": r.initial_fitness, "evaluations": int(r.evaluations), "seconds": r.seconds,
+           "cpu_seconds": r.cpu_seconds,
            "trace": [list(map(int, r.trace_evaluations[::10])), list(r.trace_fitness[::10])],
            "before": _errors(obj, initial, truth), "after": _errors(obj, planner.estimate, truth)}
     return rec, planner, truth
@@ -174,11 +176,13 @@ def _markdown_case(rows: List[dict], case: str) -> str:
     head = ["optimizer", "object", "runs", "position mm", "orientation deg", "size %", "fitness", "evals", "CPU s",
             "position mm before", "orientation deg before"]
     lines = ["| " + " | ".join(head) + " |", "|" + "---|" * len(head)]
+    order = list(OPTIMIZERS) + list(VARIANTS)
     for r in sorted(rows, key=lambda r: (OBJECTS.index(r["object"]) if r["object"] in OBJECTS else 99,
-                                         OPTIMIZERS.index(r["optimizer"]) if r["optimizer"] in OPTIMIZERS else 99)):
+                                         order.index(r["optimizer"]) if r["optimizer"] in order else 99)):
         size = _cell(r["size_pct_after"]) if case == "pose_and_scale" else "–"
         lines.append("| " + " | ".join([
-            r["optimizer"], r["object"], str(r["runs"]), _cell(r["position_mm_after"]) if case != "orientation" else "given",
+            r["optimizer"], r["object"], str(r["runs"]),
+            _cell(r["position_mm_after"]) if case != "orientation" else "given",
             _cell(r["orientation_deg_after"]), size, _cell(r["fitness"], 3), f"{r['evaluations']['median']:.0f}",
             f"{r['cpu_seconds']['median']:.2f}", _cell(r["position_mm_before"]) if case != "orientation" else "0",
             _cell(r["orientation_deg_before"])]) + " |")
@@ -238,7 +242,8 @@ def findings(results: Dict[str, list]) -> List[dict]:
         f = {opt: _median(r3, opt, o, "fitness") for opt in results}
         f = {k: v for k, v in f.items() if v is not None}
         ranks[o] = 1 + sum(v < f.get("pso", np.inf) for v in f.values()) if "pso" in f else None
-    out.append({"finding": "PSO is consistently good", "yes": bool(ranks and all(r is not None and r <= 2 for r in ranks.values())),
+    consistent = bool(ranks and all(r is not None and r <= 2 for r in ranks.values()))
+    out.append({"finding": "PSO is consistently good", "yes": consistent,
                 "figures": "PSO's rank by median final fitness (3 DoF) among " + ", ".join(results) + ": " +
                            ", ".join(f"{o} {r}" for o, r in ranks.items())})
     yaw1 = {o: _median(r1, "pso", o, "orientation_deg_after") for o in shaped}
@@ -325,3 +330,37 @@ def write_report(exp: Experiment, results: Dict[str, list], out) -> dict:
 
 register(Experiment("pub1", OBJECTS, 30, "what one touch tells about an object: four optimisers (Pub. I)",
                     _make_run, write_report, OPTIMIZERS))
+
+
+# ---- variants: the continuous contact term, another hand ---------------------------------------
+#: method -> (optimiser, contact term, hand or None for the run context's)
+VARIANTS = {"pso/flags": ("pso", "flags", None), "pso/surface": ("pso", "surface", None),
+            "descent/flags": ("descent", "flags", None), "descent/surface": ("descent", "surface", None),
+            "pso/robotiq_3f": ("pso", "flags", "robotiq_3f")}
+
+
+def variant_run(experiment: str, obj: str, run_index: int, seed: int, *, method: str, ctx: RunContext) -> dict:
+    """pub1's 3-DoF problem of the same run index, with another contact term or hand."""
+    optimizer, term, hand = VARIANTS[method]
+    base = run_seed(ctx.seed, "pub1", obj, run_index)
+    rec, _, _ = _one_case(obj, "pose", optimizer, np.random.default_rng(base), base, ctx, term, hand)
+    return {"object": obj, "method": method, "cases": {"pose": rec}}
+
+
+def _make_variant(exp: Experiment, method: str, ctx: RunContext):
+    return f"{exp.name}/{method}", partial(variant_run, method=method, ctx=ctx)
+
+
+def write_variants(exp: Experiment, results: Dict[str, list], out) -> dict:
+    out, md, summary = report._start(exp.name, out)
+    md += ["pub1's 3-DoF problems with the continuous contact term (surface) and with the Robotiq 3F hand.",
+           "Cells: median [25th, 75th percentile]; the method column is optimiser/contact term or hand.", ""]
+    rows = case_rows(results, "pose")
+    summary["pose"] = rows
+    md += [_markdown_case(rows, "pose").replace("| optimizer |", "| method |")]
+    return report._finish(out, md, summary)
+
+
+register(Experiment("pub1_variants", ("cube", "mug", "hammer/0"), 10,
+                    "pub1 (3 DoF) with the continuous contact term and with another hand", _make_variant,
+                    write_variants, tuple(VARIANTS)))
