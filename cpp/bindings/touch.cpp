@@ -153,9 +153,11 @@ void bind_results(py::module_& m) {
                              [](const TouchPredictions& p) { return bools(p.collision_at_start); },
                              "collision_at_start : numpy.ndarray (N,) bool")
       .def_readonly("surface_distance", &TouchPredictions::surface_distance,
-                    "surface_distance : numpy.ndarray (N, L)\n    measured hand's links to the candidate's surface (m)")
+                    "surface_distance : numpy.ndarray (N, L)\n    links of the measured hand that touched: distance to "
+                    "the candidate's surface (m); NaN for the others")
       .def_property_readonly("penetrating", [](const TouchPredictions& p) { return bools(p.penetrating); },
-                             "penetrating : numpy.ndarray (N, L) bool\n    measured hand's links inside the candidate")
+                             "penetrating : numpy.ndarray (N, L) bool\n    links of the measured hand that did not touch: "
+                             "inside the candidate")
       .def_readonly("scales", &TouchPredictions::scales, "scales : numpy.ndarray (N,)\n    quantised scales simulated");
   py::class_<FitnessTerms>(m, "FitnessTerms", "Pub. I's fitness per candidate and its terms.")
       .def_readonly("joint", &FitnessTerms::joint, "joint : numpy.ndarray (N,)")

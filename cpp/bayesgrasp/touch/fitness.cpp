@@ -32,9 +32,9 @@ double nonnegative_term(double v, const char* name) {
 double surface_term(const TouchPredictions& p, int i, const TouchReadings& m, double tol, double scale) {
   double c = 0.0;
   for (int l = 0; l < p.surface_distance.cols(); ++l) {
-    const double d = p.surface_distance(i, l);
-    if (!std::isfinite(d)) continue;  // a link without shapes
     if (m.contact[l]) {
+      const double d = p.surface_distance(i, l);  // NaN: a link without shapes; +inf: beyond the cap
+      if (std::isnan(d)) continue;
       const double e = std::min(1.0, std::max(0.0, d - tol) / scale);
       c += e * e;
     } else if (p.penetrating(i, l)) {
@@ -96,10 +96,12 @@ FitnessTerms fitness(const TouchPredictions& p, const TouchReadings& m, const To
 FitnessTerms evaluate_fitness(const TouchModel& model, const TouchGrasp& grasp, const TouchReadings& measured,
                               const RowMatrixXd& states, const FitnessOptions& o, int threads) {
   check_fitness_options(o, model.hand().num_joints());
+  const double tol = model.options().sim.contact_tolerance;
+  // the surface term saturates at d = tol + surface_scale: farther distances need no exact query
   const TouchPredictions p = o.contact_term == ContactTerm::Surface
-                                 ? model.predict(grasp, states, measured, threads)
+                                 ? model.predict(grasp, states, measured, threads, 1.01 * (tol + o.surface_scale))
                                  : (check_readings(model.hand(), measured), model.predict(grasp, states, threads));
-  return fitness(p, measured, grasp, model.options().sim.contact_tolerance, o);
+  return fitness(p, measured, grasp, tol, o);
 }
 
 }  // namespace bayesgrasp::touch

@@ -1,6 +1,7 @@
 #include "bayesgrasp/touch/touch_model.hpp"
 
 #include <cmath>
+#include <limits>
 #include <stdexcept>
 #include <string>
 
@@ -35,21 +36,25 @@ GraspResult resimulate(const GraspSimulator& sim, const TouchGrasp& g, const bel
   return r;
 }
 
-/// Per link, the measured closed hand (placed in the candidate's frame) against the candidate's
-/// surface: the distance (>= 0) and whether the link penetrates it.
-void surface_distances(const GraspSimulator& sim, const TouchReadings& m, const belief::PlanarFrame& o,
+/// Per link, the measured closed hand (placed in the candidate's frame) against the candidate: a
+/// link that touched, its distance to the surface (below `cap`, else +inf); one that did not,
+/// whether it penetrates.
+void surface_distances(const GraspSimulator& sim, const TouchReadings& m, const belief::PlanarFrame& o, double cap,
                        CandidateReadings& out) {
   const sim::SimScene& s = sim.scene();
   const Iso3 H = planar_pose(o.x, o.y, o.yaw).inverse() * m.hand_pose;
   const std::vector<Iso3> poses = s.hand.link_poses(H, m.joints);
   const int L = s.hand.num_links();
-  out.distance.assign(L, sim::kInf);
+  out.distance.assign(L, std::numeric_limits<double>::quiet_NaN());
   out.penetrating.assign(L, 0);
   int queries = 0;
   for (int l = 0; l < L; ++l) {
     if (s.links[l].empty()) continue;
-    out.distance[l] = std::max(0.0, sim::nearest_points(s, l, poses[l], queries).distance);
-    out.penetrating[l] = sim::penetrates(s, l, poses[l], queries) ? 1 : 0;
+    if (m.contact[l]) {
+      out.distance[l] = std::max(0.0, sim::nearest_points(s, l, poses[l], queries, cap).distance);
+    } else {
+      out.penetrating[l] = sim::penetrates(s, l, poses[l], queries) ? 1 : 0;
+    }
   }
 }
 
@@ -100,17 +105,18 @@ int TouchModel::cached_scales() const {
 }
 
 TouchPredictions TouchModel::predict(const TouchGrasp& grasp, const RowMatrixXd& states, int threads) const {
-  return run(grasp, states, nullptr, threads);
+  return run(grasp, states, nullptr, threads, 0.0);
 }
 
 TouchPredictions TouchModel::predict(const TouchGrasp& grasp, const RowMatrixXd& states,
-                                     const TouchReadings& measured, int threads) const {
+                                     const TouchReadings& measured, int threads, double surface_cap) const {
   check_readings(hand_, measured);
-  return run(grasp, states, &measured, threads);
+  if (!(surface_cap > 0.0)) throw std::invalid_argument("surface_cap: must be positive");
+  return run(grasp, states, &measured, threads, surface_cap);
 }
 
 TouchPredictions TouchModel::run(const TouchGrasp& grasp, const RowMatrixXd& states, const TouchReadings* measured,
-                                 int threads) const {
+                                 int threads, double surface_cap) const {
   check_grasp(hand_, grasp);
   check_states(states);
   const int N = static_cast<int>(states.rows()), J = hand_.num_joints(), L = hand_.num_links();
@@ -128,7 +134,7 @@ TouchPredictions TouchModel::run(const TouchGrasp& grasp, const RowMatrixXd& sta
     const belief::PlanarFrame o(states(i, 0), states(i, 1), states(i, 2));
     CandidateReadings c;
     c.grasp = resimulate(*sims[i], grasp, o);
-    if (measured) surface_distances(*sims[i], *measured, o, c);
+    if (measured) surface_distances(*sims[i], *measured, o, surface_cap, c);
     return c;
   });
   p.joints.resize(N, J);

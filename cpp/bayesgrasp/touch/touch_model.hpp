@@ -14,6 +14,7 @@
 // The same batch serves Pub. I's fitness (touch/fitness.hpp) and the likelihoods of Pub. VI.
 #pragma once
 
+#include <limits>
 #include <map>
 #include <memory>
 #include <mutex>
@@ -38,9 +39,10 @@ struct TouchPredictions {
   Eigen::Matrix<uint8_t, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor> contact;  ///< N x L
   Eigen::VectorXd hand_height;                ///< N, world z of the hand where it closed
   std::vector<uint8_t> collision_at_start;    ///< N, the open hand started inside the candidate
-  /// Per link, at the *measured* closed configuration placed in each candidate's frame: the
-  /// distance to the candidate's surface (m, >= 0; kInf for links without shapes) and whether
-  /// the link penetrates it. Filled only by predict(..., measured) (the continuous fitness).
+  /// Per link, at the *measured* closed configuration placed in each candidate's frame (filled
+  /// only by predict(..., measured), for the continuous fitness): for a link that touched, its
+  /// distance to the candidate's surface (m, >= 0; +inf beyond the cap); for a link that did not,
+  /// whether it penetrates the candidate. NaN distances: links without shapes or that did not touch.
   RowMatrixXd surface_distance;                                                      ///< N x L
   Eigen::Matrix<uint8_t, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor> penetrating;  ///< N x L
   Eigen::VectorXd scales;          ///< N quantised scales
@@ -60,9 +62,9 @@ class TouchModel {
   /// (N, 4) rows (x, y, yaw, scale). `threads` as common/parallel.hpp (0 = all cores).
   TouchPredictions predict(const TouchGrasp& grasp, const RowMatrixXd& states, int threads = 1) const;
   /// The same, plus the surface distances of the measured configuration (for the continuous
-  /// contact term).
+  /// contact term), looked for up to `surface_cap` (m; farther is +inf).
   TouchPredictions predict(const TouchGrasp& grasp, const RowMatrixXd& states, const TouchReadings& measured,
-                           int threads = 1) const;
+                           int threads = 1, double surface_cap = std::numeric_limits<double>::infinity()) const;
 
   /// The simulator of the object at scale s quantised (built on first use; thread-safe).
   std::shared_ptr<const GraspSimulator> simulator(double scale) const;
@@ -73,7 +75,7 @@ class TouchModel {
 
  private:
   TouchPredictions run(const TouchGrasp& grasp, const RowMatrixXd& states, const TouchReadings* measured,
-                       int threads) const;
+                       int threads, double surface_cap) const;
 
   HandModel hand_;
   TriMesh object_;

@@ -328,8 +328,14 @@ def write_report(exp: Experiment, results: Dict[str, list], out) -> dict:
     return report._finish(out, md, summary)
 
 
+def prepare_models(exp: Experiment, objects: List[str], ctx: RunContext) -> None:
+    """The grasp models of every object (Fig. 2.1's second grasp plans on them), built once."""
+    for o in objects:
+        ctx.models(o)
+
+
 register(Experiment("pub1", OBJECTS, 30, "what one touch tells about an object: four optimisers (Pub. I)",
-                    _make_run, write_report, OPTIMIZERS))
+                    _make_run, write_report, OPTIMIZERS, prepare=prepare_models))
 
 
 # ---- variants: the continuous contact term, another hand ---------------------------------------
