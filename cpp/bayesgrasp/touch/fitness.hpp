@@ -16,12 +16,13 @@
 //            A link touching a surface 1 cm (d_s) away counts as much as a wrong flag.
 //
 // Weights (FitnessOptions defaults) and why: the spread is commanded, not sensed (w_0 = 0); every
-// phalanx joint counts the same (w_j = 1). sigma_q = 0.05 rad (about 3 degrees): the change of a
-// finger's closing angle when the object moves by a few millimetres, well above the simulator's
-// round-off and below the 0.1-0.3 rad a centimetre of displacement makes; lambda_c = 1: one
-// wrong contact flag weighs as one joint off by sigma_q. sigma_z = 5 mm: a descent stopping half a
-// centimetre off weighs as one joint off by sigma_q. The true state predicts the measured readings
-// and has f = 0.
+// phalanx joint counts the same (w_j = 1). sigma_q = 0.05 rad (about 3 degrees): about the change
+// of a finger's closing angle when the object moves by a few millimetres, far above the
+// simulator's resolution (the contact tolerance over a phalanx length, 0.2 mm / 55 mm = 0.004 rad),
+// so that states a few millimetres apart are told apart by the joints alone. lambda_c = 1: one
+// wrong contact flag weighs as much as one joint off by sigma_q. sigma_z = 5 mm: a descent
+// stopping half a centimetre off weighs as much, too. The true state predicts the measured
+// readings up to that resolution, so f(truth) ~ 0 (exactly 0 when the object frame is the world's).
 #pragma once
 
 #include "bayesgrasp/touch/touch_model.hpp"

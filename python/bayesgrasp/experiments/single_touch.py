@@ -299,6 +299,7 @@ def plot_errors(results: Dict[str, list], case: str, path) -> None:
         ax.set_xticklabels(objs)
         ax.set_ylabel(label)
         ax.set_yscale("symlog", linthresh=1.0)
+        ax.set_ylim(bottom=0.0)
     axes[0, 0].legend([plt.Rectangle((0, 0), 1, 1, color=f"C{j}") for j in range(len(series))], series,
                       ncol=len(series), fontsize=8)
     axes[0, 0].set_title(f"pub1, case {case}: errors after one touch (initial: before it)")
