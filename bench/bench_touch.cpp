@@ -76,7 +76,8 @@ void BM_Estimate(benchmark::State& state) {
   }
   state.counters["evaluations"] = o.budget;
   state.counters["position_error_mm"] = 1e3 * error;
-  state.SetLabel(name + (size ? ", 4 DoF" : ", 3 DoF"));
+  const char* names[] = {"descent", "annealing", "pso", "firefly", "trust_region"};
+  state.SetLabel(std::string(names[state.range(0)]) + ", " + name + (size ? ", 4 DoF" : ", 3 DoF"));
 }
 
 void args(benchmark::internal::Benchmark* b) {
