@@ -19,10 +19,7 @@ TriMesh prism(const std::vector<Eigen::Vector2d>& poly, double h) {
   const int n = static_cast<int>(poly.size());
   TriMesh m;
   m.V.resize(2 * n, 3);
-  for (int i = 0; i < n; ++i) {
-    m.V.row(i) << poly[i].x(), poly[i].y(), 0.0;
-    m.V.row(n + i) << poly[i].x(), poly[i].y(), h;
-  }
+  for (int k = 0; k < 2 * n; ++k) m.V.row(k) << poly[k % n].x(), poly[k % n].y(), k < n ? 0.0 : h;
   m.F.resize(4 * n - 4, 3);
   int f = 0;
   for (int i = 0; i < n; ++i) {
