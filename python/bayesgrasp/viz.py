@@ -393,6 +393,7 @@ def plot_fusion_rounds(names: Sequence[str], rounds: Sequence[dict], true_pose, 
     b.grid(alpha=0.3)
     if title:
         fig.suptitle(title, fontsize=10)
+    return save_figure(fig, path)
 
 
 def plot_touch_landscape(landscape: dict, path, title: str = "") -> Path:
