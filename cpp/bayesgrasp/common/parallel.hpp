@@ -1,10 +1,13 @@
 // The one rule for thread counts, used by every batched call and every binding:
-// 0 = all hardware threads, a positive count is capped at the hardware threads, negative is an error.
+// 0 = all hardware threads, a positive count is capped at the hardware threads, negative is an error;
+// and the one parallel loop over independent work items (parallel_map).
 #pragma once
 
 #include <omp.h>
 
 #include <algorithm>
+#include <exception>
+#include <vector>
 #include <stdexcept>
 #include <string>
 
@@ -25,6 +28,26 @@ inline int thread_count(long long requested, const char* name = "threads") {
 inline int thread_count_for(long long requested, long long items, const char* name = "threads") {
   const int t = thread_count(requested, name);
   return static_cast<int>(std::max<long long>(1, std::min<long long>(t, items)));
+}
+
+/// out[i] = fn(i) for i in [0, n), in OpenMP threads (thread_count: 0 = all cores), results in
+/// input order; the first exception thrown by fn is rethrown after the loop.
+template <class R, class F>
+std::vector<R> parallel_map(long n, int threads, int chunk, F&& fn) {
+  const int nt = thread_count_for(threads, n);
+  std::vector<R> out(static_cast<size_t>(n));
+  std::exception_ptr error;
+#pragma omp parallel for schedule(dynamic, chunk) num_threads(nt)
+  for (long i = 0; i < n; ++i) {
+    try {
+      out[i] = fn(i);
+    } catch (...) {
+#pragma omp critical(bg_parallel_map_error)
+      if (!error) error = std::current_exception();
+    }
+  }
+  if (error) std::rethrow_exception(error);
+  return out;
 }
 
 }  // namespace bayesgrasp

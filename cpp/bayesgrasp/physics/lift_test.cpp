@@ -10,7 +10,7 @@
 #include "bayesgrasp/physics/hand_bodies.hpp"
 #include "bayesgrasp/physics/lift_object.hpp"
 #include "bayesgrasp/physics/lift_script.hpp"
-#include "bayesgrasp/sim/parallel_map.hpp"
+#include "bayesgrasp/common/parallel.hpp"
 
 namespace bayesgrasp {
 

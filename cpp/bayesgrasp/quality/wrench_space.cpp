@@ -175,21 +175,8 @@ std::vector<GraspQuality> grasp_quality_batch(const std::vector<Contacts>& grasp
                                               double torque_scale, const QualityParams& params,
                                               int n_threads) {
   validate_quality_params(params, com, torque_scale);
-  const long n = static_cast<long>(grasps.size());
-  std::vector<GraspQuality> out(grasps.size());
-  std::exception_ptr error;
-  const int threads = thread_count(n_threads, "threads");
-#pragma omp parallel for schedule(dynamic, 4) num_threads(threads)
-  for (long i = 0; i < n; ++i) {
-    try {
-      out[i] = grasp_quality(grasps[i], com, torque_scale, params);
-    } catch (...) {
-#pragma omp critical(bg_quality_error)
-      if (!error) error = std::current_exception();
-    }
-  }
-  if (error) std::rethrow_exception(error);
-  return out;
+  return parallel_map<GraspQuality>(static_cast<long>(grasps.size()), n_threads, 4,
+                                     [&](long i) { return grasp_quality(grasps[i], com, torque_scale, params); });
 }
 
 }  // namespace bayesgrasp

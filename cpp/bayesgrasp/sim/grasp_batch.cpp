@@ -1,7 +1,7 @@
 // Batches: many grasps in threads, gathered into flat arrays (GraspBatch).
 #include "bayesgrasp/sim/grasp_batch.hpp"
 
-#include "bayesgrasp/sim/parallel_map.hpp"
+#include "bayesgrasp/common/parallel.hpp"
 
 namespace bayesgrasp {
 

@@ -7,7 +7,7 @@
 
 #include "bayesgrasp/belief/relative_pose.hpp"
 #include "bayesgrasp/sim/distance_queries.hpp"
-#include "bayesgrasp/sim/parallel_map.hpp"
+#include "bayesgrasp/common/parallel.hpp"
 
 namespace bayesgrasp::touch {
 

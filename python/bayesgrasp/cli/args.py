@@ -85,6 +85,27 @@ def add_context_options(p: argparse.ArgumentParser, lift: bool = False, seed: bo
         p.add_argument("--no-lift", action="store_true", help="skip the physical lift tests (faster)")
 
 
+def add_category_options(p: argparse.ArgumentParser, png_help: str) -> None:
+    """What `category` and `fuse` share: leave-one-out, demonstrated grasps from a file, JSON, PNG."""
+    p.add_argument("--exclude", nargs="*", default=None, metavar="NAME",
+                   help="training models to leave out (default: the scene object itself, if it is one)")
+    p.add_argument("--task-grasps", default=None, metavar="FILE",
+                   help="demonstrated grasps to use instead of generating them (JSON {\"grasps\": [{model, task, pose "
+                        "(4x4, model frame), spread, epsilon, lifted}]}; the generator's cache files have this format, "
+                        "so hand-made grasps can be added to a copy of one)")
+    p.add_argument("--json", action="store_true", help="print one JSON object")
+    p.add_argument("--png", default=None, metavar="FILE", help=png_help)
+
+
+def task_grasps_arg(args: argparse.Namespace):
+    """The --task-grasps file's grasps, or None (generate them)."""
+    if not getattr(args, "task_grasps", None):
+        return None
+    from ..models.task_grasps import load_task_grasp_file
+
+    return load_task_grasp_file(args.task_grasps)
+
+
 def context(args: argparse.Namespace, progress: bool = True):
     """The :class:`~bayesgrasp.experiments.context.RunContext` of a command, built once from its options."""
     from ..experiments.context import RunContext, stderr_progress

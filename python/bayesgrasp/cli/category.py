@@ -8,7 +8,7 @@ import json
 
 import numpy as np
 
-from .args import CliError, add_context_options, context, floats, output_file
+from .args import CliError, add_category_options, add_context_options, context, floats, output_file, task_grasps_arg
 
 
 def add(sub) -> None:
@@ -18,17 +18,10 @@ def add(sub) -> None:
     c.add_argument("--task", required=True, help="the task (mug: top, side, handle; bottle: side; knife: handle)")
     c.add_argument("--scene-object", required=True, help="the new object (built-in name or mesh file)")
     c.add_argument("--pose", default="0,0,0", metavar="X,Y,YAW", help="its pose on the table")
-    c.add_argument("--exclude", nargs="*", default=None, metavar="NAME",
-                   help="training models to leave out (default: the scene object itself, if it is one)")
     c.add_argument("--method", default="laplace", choices=["laplace", "regularised", "gaussian", "baseline"],
                    help="Eq. 4.1's density, or the best-single-grasp baseline")
     c.add_argument("--complete", action="store_true", help="use the object's whole surface as the cloud")
-    c.add_argument("--task-grasps", default=None, metavar="FILE",
-                   help="demonstrated grasps to use instead of generating them (JSON {\"grasps\": [{model, task, pose "
-                        "(4x4, model frame), spread, epsilon, lifted}]}; the generator's cache files have this format, "
-                        "so hand-made grasps can be added to a copy of one)")
-    c.add_argument("--json", action="store_true", help="print one JSON object")
-    c.add_argument("--png", default=None, metavar="FILE", help="the cloud, the registered models and the hand")
+    add_category_options(c, "the cloud, the registered models and the hand")
     add_context_options(c)
     c.set_defaults(run=run)
 
@@ -45,11 +38,7 @@ def run(args) -> int:
     ep = see(args.scene_object, pose, args.category, exclude=exclude, seed=args.seed, complete=args.complete)
     if not any(r.success for r in ep.registrations):
         raise CliError("no training model registered to the cloud (is the object in view, is it of this category?)")
-    grasps = None
-    if args.task_grasps:
-        from ..models.task_grasps import load_task_grasp_file
-
-        grasps = load_task_grasp_file(args.task_grasps)
+    grasps = task_grasps_arg(args)
     out = plan_and_execute(ep, args.category, args.task, args.method, ctx, seed=args.seed, grasps=grasps)
     doc = {"grasp": {"pose": out["pose"], "spread": out.get("spread"), "frame": "table"}, "method": args.method,
            "category": args.category, "task": args.task, "scene_object": args.scene_object, "object_pose": pose,

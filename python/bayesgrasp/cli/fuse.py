@@ -7,7 +7,7 @@ import json
 
 import numpy as np
 
-from .args import CliError, add_context_options, context, floats, output_file
+from .args import CliError, add_category_options, add_context_options, context, floats, output_file, task_grasps_arg
 
 
 def add(sub) -> None:
@@ -24,12 +24,7 @@ def add(sub) -> None:
                    help="per-model MAP poses (the thesis) or a joint particle belief over (model, pose)")
     f.add_argument("--recursive", action="store_true", help="Eq. 4.5 recursive: w_i ~ w_i(t-1) L_i")
     f.add_argument("--noise", type=float, default=0.0, help="joint-angle noise sd (rad) in the likelihood")
-    f.add_argument("--exclude", nargs="*", default=None, metavar="NAME",
-                   help="training models to leave out (default: the scene object itself, if it is one)")
-    f.add_argument("--task-grasps", default=None, metavar="FILE",
-                   help="demonstrated grasps to use instead of generating them (the format of `bayesgrasp category`)")
-    f.add_argument("--json", action="store_true", help="print one JSON object")
-    f.add_argument("--png", default=None, metavar="FILE", help="the weights and the models' poses per round")
+    add_category_options(f, "the weights and the models' poses per round")
     add_context_options(f)
     f.set_defaults(run=run)
 
@@ -46,11 +41,7 @@ def run(args) -> int:
     png = output_file(args.png, "--png")
     ctx = context(args)
     settings = FusionSettings(belief=args.belief, recursive=args.recursive, measurement_noise=args.noise)
-    grasps = None
-    if args.task_grasps:
-        from ..models.task_grasps import load_task_grasp_file
-
-        grasps = load_task_grasp_file(args.task_grasps)
+    grasps = task_grasps_arg(args)
     trial = FusionTrial(args.scene_object, pose, ctx, task=args.task, settings=settings,
                         exclude=args.exclude if args.exclude is not None else [args.scene_object], seed=args.seed,
                         category=args.category, grasps=grasps)
