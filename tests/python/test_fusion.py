@@ -33,7 +33,7 @@ def analytic(informative: bool):
     var = np.full((len(x), 2), 0.0025)
     grid = _core.belief.RelativePoseGrid(np.array([-R, -R]), np.array([R, R]), 25, 25, 36,
                                          np.column_stack([ps, mean, var]), np.array([0.0] + [np.nan] * 4))
-    return TableModels(ModelTable(grid, 2, R, np.zeros((1, 3))))
+    return TableModels(ModelTable(grid, 2, np.array([[-R, -R], [R, R]]), np.zeros((1, 3))))
 
 
 TRUE = np.array([0.01, -0.005, 0.0])

@@ -86,3 +86,20 @@ def test_epsilon_criterion_models_learn_epsilon(tmp_path):
     assert 5 <= stable.sum() <= len(stable) - 5
     p = m.stability_probability(rel)
     assert p[stable].mean() > p[~stable].mean() + 0.1
+
+
+def test_the_default_grasp_box_covers_the_object_and_scales_the_samples():
+    from bayesgrasp.models.settings import BOX_MIN_HALF, MAX_SAMPLE_SCALE
+    from bayesgrasp.objects import load_object
+
+    s = ModelSettings()
+    cube = s.grasp_box(load_object("cube"))            # 6 cm cube: the minimum box
+    np.testing.assert_allclose(cube, [[-BOX_MIN_HALF, -BOX_MIN_HALF], [BOX_MIN_HALF, BOX_MIN_HALF]])
+    assert s.scaled(2000, cube) == 2000
+    pitcher = load_object("pitcher")
+    box = s.grasp_box(pitcher)                          # the handle reaches 12 cm along +x
+    assert box[1, 0] >= pitcher.bounds[1, 0] + 0.009 and box[0, 1] <= pitcher.bounds[0, 1]
+    assert 2000 < s.scaled(2000, box) <= MAX_SAMPLE_SCALE * 2000
+    fixed = ModelSettings(xy_range=0.03)
+    np.testing.assert_allclose(fixed.grasp_box(pitcher), [[-0.03, -0.03], [0.03, 0.03]])
+    assert fixed.scaled(2000, fixed.grasp_box(pitcher)) == 2000

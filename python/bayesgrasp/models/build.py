@@ -90,7 +90,7 @@ def _fit_stability(world: World, settings: ModelSettings, rel, eps, spread: floa
     """The stability GP and the outcomes it was fitted on: lift outcomes (0/1) of the first
     n_lift_samples training grasps, or the epsilon of all of them."""
     if settings.success == "lift":
-        n = min(settings.n_lift_samples, len(rel))
+        n = min(settings.scaled(settings.n_lift_samples, settings.grasp_box(world.object)), len(rel))
         say(f"models for {world.object.name}: lift tests of {n} training grasps")
         lifted = success_labels(world, settings, rel[:n], eps[:n], spread)
         return _fit(features(rel[:n]), lifted.astype(float), settings, n), lifted
@@ -113,14 +113,16 @@ def _train(world: World, settings: ModelSettings, key: str, say: Say) -> GraspMo
     say(f"models for {name}: fitting FITC GPs on {len(rel)} grasps")
     measurement = _fit(X, q[:, joint_index], settings, len(rel))
     stability, outcomes = _fit_stability(world, settings, rel, eps, spread, say)
-    models = GraspModels(measurement, stability, settings, joint_index, {"spread": float(spread)})
+    models = GraspModels(measurement, stability, settings, joint_index,
+                         {"spread": float(spread), "grasp_box": settings.grasp_box(world.object).tolist()})
     calibration = _calibrate(models, world, settings, spread, say)
     models.info = {"key": key, "object": name, "calibration": list(calibration), "hand": world.hand.name,
                    "settings": asdict(settings), "samples": int(len(rel)),
                    "force_closure_fraction": float(np.mean(eps > 0)),
                    "stable_fraction": float(np.mean(eps > settings.eps_stable)),
                    "success_fraction": float(np.mean(outcomes)),
-                   "joint_index": joint_index.tolist(), "spread": float(spread), "spread_pilot": pilot}
+                   "joint_index": joint_index.tolist(), "spread": float(spread), "spread_pilot": pilot,
+                   "grasp_box": settings.grasp_box(world.object).tolist()}
     return models
 
 

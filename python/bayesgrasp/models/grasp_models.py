@@ -99,6 +99,13 @@ class GraspModels:
         """The finger spread (rad) of every grasp these models describe."""
         return float(self.info.get("spread", self.settings.spread if self.settings.spread is not None else np.pi / 2))
 
+    def grasp_box(self) -> np.ndarray:
+        """(2, 2): the x, y box the training grasps were sampled in (lows, highs)."""
+        if "grasp_box" in self.info:
+            return np.asarray(self.info["grasp_box"], dtype=float)
+        r = self.settings.xy_range
+        return np.array([[-r, -r], [r, r]])
+
     @property
     def n_joints(self) -> int:
         return len(self.joint_index)
@@ -107,7 +114,7 @@ class GraspModels:
         """The models tabulated over relative grasps for the planners (built on first use, kept).
 
         Channel 0 is P(S | A, O), channels 1..K the measurement mean of the K joints and K+1..2K its
-        variance (with noise). The grid spans the training box (+-``settings.xy_range``) and all
+        variance (with noise). The grid spans the training box (:meth:`grasp_box`) and all
         yaws; outside the box P(S) is 0 (the models know nothing there, and a GP's prior would
         claim stability) and the measurement channels take the nearest edge value.
         """

@@ -8,10 +8,17 @@ from typing import Optional
 import numpy as np
 
 #: Bumped when the simulator or the models change what a cache key means.
-CACHE_VERSION = 7
+CACHE_VERSION = 8
 
 #: What a successful grasp is: held in the lift test (the default) or epsilon above eps_stable.
 SUCCESS_CRITERIA = ("lift", "epsilon")
+
+#: The default grasp box (xy_range None): the object's footprint grown by BOX_MARGIN, and at least
+#: +-BOX_MIN_HALF around the object's origin; the sample counts grow with its area relative to
+#: (2 BOX_MIN_HALF)^2, at most MAX_SAMPLE_SCALE times (a pitcher's handle reaches 12 cm out).
+BOX_MARGIN = 0.01
+BOX_MIN_HALF = 0.06
+MAX_SAMPLE_SCALE = 2.5
 
 #: Grid nodes of highest P(S) a ModelTable keeps (the planners' PSO seeds).
 N_BEST = 64
@@ -30,7 +37,7 @@ class ModelSettings:
 
     n_samples: int = 2000         # simulated grasps (the measurement model's training set)
     n_inducing: int = 200         # FITC inducing inputs
-    xy_range: float = 0.06        # relative x, y sampled uniformly in +-xy_range (m)
+    xy_range: Optional[float] = None  # relative x, y sampled in +-xy_range (m); None: the object's footprint
     # Finger spread of the grasps (rad), or None (the default): chosen per object from
     # AUTO_SPREADS by a pilot sample, as the spread with the most grasps that are both stable
     # (epsilon) and held in the physical lift test (see training.choose_spread): a spread at which
@@ -51,7 +58,7 @@ class ModelSettings:
             raise ValueError(f"n_samples: need at least 10, got {self.n_samples}")
         if self.n_inducing < 1:
             raise ValueError(f"n_inducing: must be >= 1, got {self.n_inducing}")
-        if not (self.xy_range > 0 and np.isfinite(self.xy_range)):
+        if self.xy_range is not None and not (self.xy_range > 0 and np.isfinite(self.xy_range)):
             raise ValueError(f"xy_range: must be positive, got {self.xy_range}")
         if self.spread is not None and not (np.isfinite(self.spread) and 0.0 <= self.spread <= np.pi):
             raise ValueError(f"spread: must be None (choose per object) or in [0, pi], got {self.spread}")
@@ -61,6 +68,23 @@ class ModelSettings:
             raise ValueError(f"success: one of {', '.join(SUCCESS_CRITERIA)}; got {self.success!r}")
         if not 10 <= self.n_lift_samples:
             raise ValueError(f"n_lift_samples: need at least 10, got {self.n_lift_samples}")
+
+    def grasp_box(self, obj) -> np.ndarray:
+        """(2, 2) rows (x_lo, y_lo), (x_hi, y_hi): where relative top grasps are sampled for ``obj``
+        (an ObjectModel): +-xy_range, or (None) the object's footprint grown by BOX_MARGIN and
+        containing +-BOX_MIN_HALF."""
+        if self.xy_range is not None:
+            return np.array([[-self.xy_range, -self.xy_range], [self.xy_range, self.xy_range]])
+        b = np.asarray(obj.bounds, dtype=float)[:, :2]
+        return np.array([np.minimum(b[0] - BOX_MARGIN, -BOX_MIN_HALF), np.maximum(b[1] + BOX_MARGIN, BOX_MIN_HALF)])
+
+    def scaled(self, n: int, box) -> int:
+        """A sample count for the box: n for a fixed xy_range, else n times the box's area relative
+        to the default square (at least 1, at most MAX_SAMPLE_SCALE)."""
+        if self.xy_range is not None:
+            return int(n)
+        area = float(np.prod(np.asarray(box)[1] - np.asarray(box)[0]))
+        return int(round(n * min(MAX_SAMPLE_SCALE, max(1.0, area / (2 * BOX_MIN_HALF) ** 2))))
 
     @property
     def stability_threshold(self) -> float:

@@ -12,19 +12,20 @@ from .settings import N_BEST
 class ModelTable:
     """:class:`~bayesgrasp.models.GraspModels` on a grid: trilinear lookups, batched in C++."""
 
-    def __init__(self, grid, n_joints: int, xy_range: float, best: np.ndarray):
-        self.grid, self.n_joints, self.xy_range, self.best = grid, int(n_joints), float(xy_range), best
+    def __init__(self, grid, n_joints: int, box: np.ndarray, best: np.ndarray):
+        self.grid, self.n_joints, self.box, self.best = grid, int(n_joints), np.asarray(box, float), best
 
     @classmethod
     def build(cls, models: "GraspModels", xy_step: float, yaw_step: float) -> "ModelTable":
         if not (xy_step > 0 and yaw_step > 0):
             raise ValueError("table: steps must be positive")
-        r = models.settings.xy_range
-        nx = max(2, int(np.ceil(2 * r / xy_step)) + 1)
+        box = models.grasp_box()
+        nx = max(2, int(np.ceil((box[1, 0] - box[0, 0]) / xy_step)) + 1)
+        ny = max(2, int(np.ceil((box[1, 1] - box[0, 1]) / xy_step)) + 1)
         nyaw = max(4, int(np.ceil(2 * np.pi / yaw_step)))
-        xs = np.linspace(-r, r, nx)
+        xs, ys = np.linspace(box[0, 0], box[1, 0], nx), np.linspace(box[0, 1], box[1, 1], ny)
         yaws = -np.pi + 2 * np.pi * np.arange(nyaw) / nyaw
-        X, Y, T = np.meshgrid(xs, xs, yaws, indexing="ij")
+        X, Y, T = np.meshgrid(xs, ys, yaws, indexing="ij")
         rel = np.column_stack([X.ravel(), Y.ravel(), T.ravel()])
         k = models.n_joints
         values = np.empty((len(rel), 1 + 2 * k))
@@ -35,10 +36,10 @@ class ModelTable:
             values[s:s + 65536, 1:1 + k], values[s:s + 65536, 1 + k:] = mean, var
         outside = np.full(1 + 2 * k, np.nan)
         outside[0] = 0.0
-        grid = _core.belief.RelativePoseGrid(np.array([-r, -r]), np.array([r, r]), nx, nx, nyaw, values, outside)
+        grid = _core.belief.RelativePoseGrid(box[0].copy(), box[1].copy(), nx, ny, nyaw, values, outside)
         # the planners' PSO seeds: the nodes of highest P(S), best first
         top = np.argpartition(-values[:, 0], N_BEST - 1)[:N_BEST]
-        return cls(grid, k, r, rel[top[np.argsort(-values[top, 0])]])
+        return cls(grid, k, box, rel[top[np.argsort(-values[top, 0])]])
 
     def best_relative_grasps(self, k: int = 64) -> np.ndarray:
         """The k grid nodes with the highest P(S) (k, 3), best first (found when the table is built)."""

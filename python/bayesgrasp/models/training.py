@@ -13,19 +13,23 @@ from ..world import World
 from .settings import AUTO_SPREADS, ModelSettings
 
 
-def random_relative_grasps(rng: np.random.Generator, n: int, xy_range: float) -> np.ndarray:
-    """n relative top grasps (x, y, yaw): x, y uniform in +-xy_range, yaw uniform in [-pi, pi)."""
-    return np.column_stack([rng.uniform(-xy_range, xy_range, n), rng.uniform(-xy_range, xy_range, n),
+def random_relative_grasps(rng: np.random.Generator, n: int, box) -> np.ndarray:
+    """n relative top grasps (x, y, yaw): x, y uniform in the box ((2, 2): lows, highs), yaw uniform
+    in [-pi, pi)."""
+    box = np.asarray(box, dtype=float)
+    return np.column_stack([rng.uniform(box[0, 0], box[1, 0], n), rng.uniform(box[0, 1], box[1, 1], n),
                             rng.uniform(-np.pi, np.pi, n)])
 
 
 def simulate_training_data(world: World, settings: ModelSettings, seed_offset: int = 0, n: Optional[int] = None,
                            spread: Optional[float] = None):
-    """Relative grasps (n, 3), joint angles (n, J) and epsilon (n,) from the simulator; grasps
+    """Relative grasps (n, 3), joint angles (n, J) and epsilon (n,) from the simulator, in the
+    settings' grasp box for the object (n scaled with the box, see ModelSettings.scaled); grasps
     whose open hand started in collision are dropped."""
     rng = np.random.default_rng([settings.seed, seed_offset])
-    n = settings.n_samples if n is None else int(n)
-    rel = random_relative_grasps(rng, n, settings.xy_range)
+    box = settings.grasp_box(world.object)
+    n = settings.scaled(settings.n_samples if n is None else int(n), box)
+    rel = random_relative_grasps(rng, n, box)
     spread = settings.spread if spread is None else spread
     b = world.grasp_batch(rel, spread=spread, threads=0)
     ok = ~np.asarray(b.collision_at_start, dtype=bool)
@@ -62,7 +66,7 @@ def choose_spread(world: World, settings: ModelSettings, say=lambda m: None) -> 
     (best spread, {degrees: (fraction, lifted, tested)}); with no grasp lifted at any spread, the
     spread with the largest fraction."""
     rng = np.random.default_rng([settings.seed, 7])
-    rel = random_relative_grasps(rng, settings.n_pilot, settings.xy_range)
+    rel = random_relative_grasps(rng, settings.n_pilot, settings.grasp_box(world.object))
     table, scores = {}, []
     for sp in AUTO_SPREADS:
         b = world.grasp_batch(rel, spread=sp, threads=0)
