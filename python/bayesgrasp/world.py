@@ -133,10 +133,15 @@ class World:
         mu: friction coefficient for the quality metric and the lift test.
         spread: default finger spread (rad); None = the hand's default.
         standoff: how far the palm backs off from the first contact before closing (m).
+        table: whether the table (z = 0) is there for the hand and in the lift test. False
+            presents the object held off the table at its scene pose (on a holder the simulator
+            does not model, as objects float in GraspIt!): the hand may come from any side and
+            an object the hand does not hold falls.
     """
 
     def __init__(self, scene: Scene, hand: Union[Hand, str] = "barrett_bh8", object_index: int = 0,
-                 mu: float = DEFAULT_FRICTION, spread: Optional[float] = None, standoff: float = 0.0):
+                 mu: float = DEFAULT_FRICTION, spread: Optional[float] = None, standoff: float = 0.0,
+                 table: bool = True):
         if not (np.isfinite(mu) and mu >= 0):
             raise ValueError(f"mu: must be finite and >= 0, got {mu}")
         if not (np.isfinite(standoff) and standoff >= 0):
@@ -147,6 +152,7 @@ class World:
         self.mu = float(mu)
         self.spread = float(self.hand.core.spread_default if spread is None else spread)
         self.standoff = float(standoff)
+        self.table = bool(table)
         self._rebuild()
 
     @classmethod
@@ -160,7 +166,7 @@ class World:
     def _rebuild(self) -> None:
         V, F = self.scene.object_mesh_world(self.object_index)
         self.vertices, self.faces = V, F
-        self.sim = GraspSimulator(self.hand, V, F)
+        self.sim = GraspSimulator(self.hand, V, F, table=self.table)
         mp = self.scene.object_mass_properties_world(self.object_index)
         self.com = np.asarray(mp["com"], dtype=float)
         self.torque_scale = self.object.max_radius_from_com  # rigid motion keeps it
@@ -336,7 +342,7 @@ class World:
                 obj, T = self.object, self.scene.object_pose(self.object_index)
                 pieces = [p @ T[:3, :3].T + T[:3, 3] for p in physics.convex_decomposition(obj.vertices, obj.faces)]
             self._lift = physics.LiftTester(self.hand.path, self.vertices, self.faces, convex_pieces=pieces,
-                                            mu=self.mu, density=self.object.density)
+                                            mu=self.mu, density=self.object.density, table=self.table)
         return self._lift
 
 

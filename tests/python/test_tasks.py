@@ -95,7 +95,22 @@ def test_approach_rules_by_hand():
     handle = task_rule("mug", "handle")
     assert handle.approach_ok([[-1, 0, 0], [1, 0, 0]]).tolist() == [True, False]
     tool = task_rule("knife", "handle")
-    assert tool.approach_ok([[0, 0, -1], [0, 1, 0], [-1, 0, 0]]).tolist() == [True, True, False]
+    # tools are held off the table: from below (moving up, +z) is allowed too, along the handle never
+    assert not tool.table and task_rule("mug", "top").table
+    assert tool.approach_ok([[0, 0, -1], [0, 1, 0], [-1, 0, 0], [0, 0, 1]]).tolist() == [True, True, False, True]
+    assert not side.approach_ok([[0.6, 0, 0.8]]).any()            # a mug on the table: never from under it
+
+
+def test_a_tool_held_off_the_table_can_be_grasped_around_its_handle():
+    from bayesgrasp.world import World
+
+    # from above, across the 2.4 cm handle 5 cm from its end: on a table the hand stops on the
+    # table with nothing in it; held off the table the three fingers close on the handle and hold it
+    args = ([0, 0, -1], [0.05, 0, 0.012], 0.0)
+    on_table = World.single("hammer/0").approach(*args, spread=0.0, lift=True)
+    assert on_table.stopped_by_table and not on_table.lifted
+    g = World.single("hammer/0", table=False).approach(*args, spread=0.0, lift=True)
+    assert not g.stopped_by_table and [c.part for c in g.contacts] == ["handle"] * 3 and g.lifted
 
 
 def test_contact_rules_by_hand():
@@ -114,6 +129,8 @@ def test_contact_rules_by_hand():
     ({"category": "c", "parts": ["a"], "tasks": {"t": {"approach": {"from_axis": {"axis": [0, 0, 0], "max_angle_deg": 5}},
                                                        "contacts": {"allowed": ["a"]}}}}, "non-zero"),
     ({"category": "c", "parts": ["a"], "tasks": {}}, "at least one task"),
+    ({"category": "c", "parts": ["a"], "table": "no", "tasks": {"t": {"approach": {}, "contacts": {"allowed": ["a"]}}}},
+     "'table' must be true or false"),
     ({"category": "c", "parts": ["a"], "tasks": {"t": {"contacts": {"allowed": ["a"]}}}}, "needs 'approach'"),
 ])
 def test_bad_task_files_name_the_problem(tmp_path, doc, needle):

@@ -10,7 +10,7 @@ surface in the "complete model" mode the thesis warns is biased), :func:`registe
 """
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from functools import lru_cache
 from pathlib import Path
 from typing import Dict, List, Optional, Sequence, Tuple
@@ -109,7 +109,7 @@ def execute(obj, pose, plan: CategoryPlan, rule: TaskRule, ctx: RunContext) -> d
     if not plan.ok:
         return {"executed": False, "reason": plan.reason, "lifted": False, "task_ok": False, "success": False,
                 "epsilon": 0.0, "force_closure": False, "failure": "no contact"}
-    world = World.single(obj, pose=pose, hand=ctx.hand)
+    world = World.single(obj, pose=pose, hand=ctx.hand, table=rule.table)
     A = plan.pose
     g = world.approach(A[:3, 2], A[:3, 3], roll_of(A), spread=plan.spread, frame="world", lift=True)
     parts = [c.part for c in g.contacts if not c.on_table]
@@ -158,7 +158,7 @@ def plan_and_execute(ep: CategoryEpisode, category_name: str, task: str, method:
     rule = task_rule(category_name, task)
     grasps = demonstrated(ep.models, rule, ctx) if grasps is None else grasps
     grasps = [g for g in grasps if g.task == task]
-    s = settings or CategorySettings(method=method)
+    s = replace(settings or CategorySettings(method=method), table=rule.table)
     planner = CategoryPlanner(ctx.hand, grasps, ep.registrations, cloud=ep.observation.cloud, settings=s, seed=seed)
     plan = planner.plan()
     out = execute(ep.obj, ep.pose, plan, rule, ctx)

@@ -130,7 +130,7 @@ def generate_task_grasps(obj: Union[str, ObjectModel], rule: TaskRule, hand: str
     s = settings or TaskGraspSettings()
     say = say or (lambda m: None)
     o = load_object(obj)
-    world = World.single(o, pose=(0.0, 0.0, 0.0), hand=hand)
+    world = World.single(o, pose=(0.0, 0.0, 0.0), hand=hand, table=rule.table)
     rng = np.random.default_rng([s.seed, zlib.crc32(f"{o.name}/{rule.name}".encode())])
     found = []   # (epsilon, spread, pose) of grasps that satisfy the rule
     for spread in s.spreads:

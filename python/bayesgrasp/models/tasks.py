@@ -4,8 +4,11 @@ A rule says which approach directions a task allows and which parts of the objec
 touch. Directions are in the object's frame; the approach direction ``d`` is the direction the
 hand moves in (the hand frame's +z, out of the palm), so ``-d`` points to where it comes from.
 
-Approach constraints (all given must hold; and for every task the hand does not come from under
-the table, ``-d`` has z >= 0):
+A category's file may set ``"table": false``: its objects are then presented held off the table
+(on a holder the simulator does not model, as objects float in the thesis's GraspIt! set-up); a
+tool lying flat on a table leaves no room for the fingers under its handle (1.4-2.5 cm high), so
+the tools' files do. Approach constraints (all given must hold; and with a table the hand does
+not come from under it, ``-d`` has z >= 0):
 
 * ``from_axis {axis, max_angle_deg}``: the angle between ``-d`` and ``axis`` is at most the limit
   (mug top: the hand comes from above);
@@ -61,13 +64,14 @@ class TaskRule:
     min_object_contacts: int = 1
     min_part_contacts: Mapping[str, int] = field(default_factory=dict)
     targets: Tuple[str, ...] = ()
+    table: bool = True            # the object rests on the table (False: held off it, see the module)
 
     def approach_ok(self, directions) -> np.ndarray:
         """(N,) bool: approach directions (N, 3) in the object frame that satisfy the rule."""
         d = np.atleast_2d(np.asarray(directions, dtype=float))
         d = d / np.linalg.norm(d, axis=1, keepdims=True)
         src = -d
-        ok = src[:, 2] >= -1e-9      # every task: the hand cannot come from under the table
+        ok = src[:, 2] >= -1e-9 if self.table else np.ones(len(d), bool)  # never from under a table
         for kind, c in self.approach.items():
             if kind == "from_axis":
                 ok &= np.degrees(np.arccos(np.clip(src @ c["axis"], -1, 1))) <= c["max_angle_deg"]
@@ -134,7 +138,7 @@ def _approach(raw, what: str) -> Dict[str, Dict[str, object]]:
     return out
 
 
-def _rule(category: str, name: str, raw, parts: Sequence[str], what: str) -> TaskRule:
+def _rule(category: str, name: str, raw, parts: Sequence[str], what: str, table: bool = True) -> TaskRule:
     if not isinstance(raw, dict) or set(raw) - _TASK_KEYS or "contacts" not in raw or "approach" not in raw:
         raise ValueError(f"{what}: needs 'approach' and 'contacts' (and optionally 'description', 'targets'); "
                          f"keys must be among {sorted(_TASK_KEYS)}")
@@ -156,7 +160,7 @@ def _rule(category: str, name: str, raw, parts: Sequence[str], what: str) -> Tas
     if not isinstance(n, int) or n < 0 or any(not isinstance(v, int) or v < 0 for v in per_part.values()):
         raise ValueError(f"{what}.contacts: contact counts must be non-negative integers")
     return TaskRule(category, name, str(raw.get("description", "")), _approach(raw["approach"], f"{what}.approach"),
-                    allowed, n, per_part, known(raw.get("targets", ()), "targets"))
+                    allowed, n, per_part, known(raw.get("targets", ()), "targets"), table)
 
 
 def load_task_file(path) -> Dict[str, TaskRule]:
@@ -168,10 +172,15 @@ def load_task_file(path) -> Dict[str, TaskRule]:
         raise ValueError(f"task file {p}: cannot read ({e})") from None
     if not isinstance(doc, dict) or not {"category", "parts", "tasks"} <= set(doc):
         raise ValueError(f"task file {p}: needs 'category', 'parts' and 'tasks'")
+    if set(doc) - {"category", "parts", "tasks", "table"}:
+        raise ValueError(f"task file {p}: unknown keys {sorted(set(doc) - {'category', 'parts', 'tasks', 'table'})}")
+    table = doc.get("table", True)
+    if not isinstance(table, bool):
+        raise ValueError(f"task file {p}: 'table' must be true or false, got {table!r}")
     cat, parts = str(doc["category"]), [str(x) for x in doc["parts"]]
     if not isinstance(doc["tasks"], dict) or not doc["tasks"]:
         raise ValueError(f"task file {p}: 'tasks' must name at least one task")
-    return {name: _rule(cat, name, raw, parts, f"{p.name}: task {name!r}") for name, raw in doc["tasks"].items()}
+    return {name: _rule(cat, name, raw, parts, f"{p.name}: task {name!r}", table) for name, raw in doc["tasks"].items()}
 
 
 def task_categories() -> List[str]:

@@ -74,6 +74,7 @@ class CategorySettings:
     clearance_margin: float = 0.002
     clearance_scale: float = 0.001
     clearance_voxel: float = 0.005  # the cloud is reduced to one point per voxel of this size for the check (m)
+    table: bool = True              # the table plane z = 0 is an obstacle (False: the object is held off it)
     min_weight: float = 1e-3        # models whose normalised weight is below this are not search starts
     threads: int = 1
 
@@ -203,6 +204,7 @@ class CategoryPlanner:
         """Deepest intrusion (m) of the table or the cloud into the open hand at each pose (N, 4, 4)."""
         opts = _task.ClearanceOptions()
         opts.margin = self.settings.clearance_margin
+        opts.table = self.settings.table
         q = self.hand.open_joints(spread)
         c = _task.hand_clearance(self.hand.core, q, np.asarray(poses, float), self.cloud, opts, self.settings.threads)
         return np.maximum(np.asarray(c.table), np.asarray(c.cloud))
