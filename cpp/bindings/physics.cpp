@@ -1,5 +1,6 @@
 // Bindings for cpp/bayesgrasp/physics: the Bullet lift test.
 #include <string>
+#include <pybind11/stl.h>
 
 #include "bayesgrasp/physics/lift_test.hpp"
 #include "validate.hpp"
@@ -79,7 +80,7 @@ void bind_options(py::module_& m) {
       .def_readwrite("density", &LiftOptions::density, "density : float\n    Object density, kg/m^3 (mass from the mesh).")
       .def_readwrite("time_step", &LiftOptions::time_step, "time_step : float\n    Fixed time step, s (default 1/480).")
       .def_readwrite("solver_iterations", &LiftOptions::solver_iterations,
-                     "solver_iterations : int\n    Bullet's constraint solver iterations per step (>= 1).")
+                     "solver_iterations : int\n    Bullet's constraint solver iterations per step (>= 1, default 20).")
       .def_readwrite("squeeze_time", &LiftOptions::squeeze_time,
                      "squeeze_time : float\n    s, the palm still while the fingers tighten.")
       .def_readwrite("lift_height", &LiftOptions::lift_height, "lift_height : float\n    m the palm rises.")
@@ -89,11 +90,10 @@ void bind_options(py::module_& m) {
       .def_readwrite("shake_time", &LiftOptions::shake_time, "shake_time : float\n    s of shaking.")
       .def_readwrite("hold_time", &LiftOptions::hold_time, "hold_time : float\n    s held still at the end.")
       .def_readwrite("finger_torque", &LiftOptions::finger_torque,
-                     "finger_torque : float\n    N m, torque limit of each phalanx joint motor.")
+                     "finger_torque : float\n    N m, torque limit of each finger's one motor at the joint it drives "
+                     "(the proximal, the distal after breakaway; coupled phalanges load the same motor).")
       .def_readwrite("closing_speed", &LiftOptions::closing_speed,
-                     "closing_speed : float\n    rad/s, target velocity of the joint motors (closing).")
-      .def_readwrite("squeeze_travel", &LiftOptions::squeeze_travel,
-                     "squeeze_travel : float\n    rad a joint may close beyond its given angle.")
+                     "closing_speed : float\n    rad/s, the finger motors' target velocity (closing).")
       .def_readwrite("link_mass", &LiftOptions::link_mass, "link_mass : float\n    kg per phalanx.")
       .def_readwrite("success_distance", &LiftOptions::success_distance,
                      "success_distance : float\n    m; lifted = the object moved less than this relative to the palm.")
@@ -108,6 +108,60 @@ void bind_options(py::module_& m) {
       .def_readwrite("skip_separated_pairs", &LiftOptions::skip_separated_pairs,
                      "skip_separated_pairs : bool\n    Skip Bullet's narrowphase for shape pairs proven apart "
                      "(same results, faster).");
+}
+
+void bind_trace(py::module_& m) {
+  using T = LiftTrace;
+  auto ints = [](const std::vector<LiftContact>& cs, int LiftContact::*f) {
+    Eigen::VectorXi v(static_cast<Eigen::Index>(cs.size()));
+    for (size_t i = 0; i < cs.size(); ++i) v[static_cast<Eigen::Index>(i)] = cs[i].*f;
+    return v;
+  };
+  auto vecs = [](const std::vector<LiftContact>& cs, Vec3 LiftContact::*f) {
+    RowMatrixXd v(static_cast<Eigen::Index>(cs.size()), 3);
+    for (size_t i = 0; i < cs.size(); ++i) v.row(static_cast<Eigen::Index>(i)) = (cs[i].*f).transpose();
+    return to_numpy(v);
+  };
+  auto rows = [](const auto& vs, Eigen::Index cols) {
+    Eigen::Matrix<typename std::decay_t<decltype(vs[0])>::Scalar, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor> M(
+        static_cast<Eigen::Index>(vs.size()), cols);
+    for (size_t i = 0; i < vs.size(); ++i) M.row(static_cast<Eigen::Index>(i)) = vs[i].transpose();
+    return M;
+  };
+  py::class_<T, std::shared_ptr<T>>(m, "LiftTrace", R"doc(Per-step trace of one lift test (S samples: every
+``every`` steps and the last step simulated; C contacts in all). Arrays are copies.)doc")
+      .def_readonly("every", &T::every, "every : int\n    Steps between samples.")
+      .def_readonly("link_names", &T::link_names, "link_names : list of str\n    The hand's link names.")
+      .def_property_readonly("phase_ends", [](const T& t) { return Eigen::Vector3d(t.phase_ends); },
+                             "phase_ends : numpy.ndarray (3,)\n    s, end of the squeeze, the lift and the shake.")
+      .def_property_readonly("reference_pose", [](const T& t) { return to_numpy(t.reference_pose); },
+                             "reference_pose : numpy.ndarray (4, 4)\n    The object (centre of mass, principal axes) in "
+                             "the palm frame after the squeeze: the displacement's reference.")
+      .def_property_readonly("time", [](const T& t) { return Eigen::VectorXd(Eigen::Map<const Eigen::VectorXd>(t.time.data(), static_cast<Eigen::Index>(t.time.size()))); },
+                             "time : numpy.ndarray (S,)\n    s.")
+      .def_property_readonly("object_pose", [](const T& t) { return to_numpy(t.object_pose); },
+                             "object_pose : numpy.ndarray (S, 4, 4)\n    The object in the palm frame.")
+      .def_property_readonly("joints", [rows](const T& t) {
+                               return RowMatrixXd(rows(t.joints, t.joints.empty() ? 0 : t.joints[0].size())); },
+                             "joints : numpy.ndarray (S, J)\n    Joint angles, rad (HandModel layout).")
+      .def_property_readonly("driven", [rows](const T& t) {
+                               return rows(t.driven, t.driven.empty() ? 0 : t.driven[0].size()); },
+                             "driven : numpy.ndarray (S, F) int\n    The phalanx each finger's motor drives.")
+      .def_property_readonly("contact_sample", [ints](const T& t) { return ints(t.contacts, &LiftContact::sample); },
+                             "contact_sample : numpy.ndarray (C,) int\n    Sample index of each contact.")
+      .def_property_readonly("contact_link", [ints](const T& t) { return ints(t.contacts, &LiftContact::link); },
+                             "contact_link : numpy.ndarray (C,) int\n    Hand link index (0: palm and knuckles).")
+      .def_property_readonly("contact_point", [vecs](const T& t) { return vecs(t.contacts, &LiftContact::point); },
+                             "contact_point : numpy.ndarray (C, 3)\n    m, world frame, on the hand link.")
+      .def_property_readonly("contact_normal", [vecs](const T& t) { return vecs(t.contacts, &LiftContact::normal); },
+                             "contact_normal : numpy.ndarray (C, 3)\n    Unit, out of the object.")
+      .def_property_readonly("contact_force",
+                             [](const T& t) {
+                               Eigen::VectorXd v(static_cast<Eigen::Index>(t.contacts.size()));
+                               for (size_t i = 0; i < t.contacts.size(); ++i) v[static_cast<Eigen::Index>(i)] = t.contacts[i].force;
+                               return v;
+                             },
+                             "contact_force : numpy.ndarray (C,)\n    N, normal force.");
 }
 
 void bind_results(py::module_& m) {
@@ -133,6 +187,13 @@ void bind_results(py::module_& m) {
       .def_readonly("steps", &R::steps, "steps : int\n    Time steps simulated (fewer when the object was lost early).")
       .def_readonly("skipped_queries", &R::skipped_queries,
                     "skipped_queries : int\n    Narrowphase queries skipped (skip_separated_pairs).")
+      .def_property_readonly(
+          "breakaway", [](const R& r) { return Eigen::VectorXi(r.breakaway); },
+          "breakaway : numpy.ndarray (F,) int\n    Per finger, the phalanx its motor drives at the end (0: no "
+          "breakaway; 1: the proximal locked, the distal driven).")
+      .def_property_readonly(
+          "trace", [](const R& r) -> py::object { return r.trace ? py::cast(r.trace) : py::none(); },
+          "trace : LiftTrace or None\n    The per-step trace (run with trace_every > 0), else None.")
       .def("__repr__", [](const R& r) {
         return std::string("<LiftResult: ") + (r.lifted ? "lifted" : "dropped") + ", displacement " +
                std::to_string(r.displacement) + " m>";
@@ -186,6 +247,7 @@ std::unique_ptr<LiftTester> make_tester(const py::handle& hand, const DArray& ve
 
 void bind_physics(py::module_& m) {
   bind_options(m);
+  bind_trace(m);
   bind_results(m);
   py::class_<LiftTester>(m, "LiftTester", R"doc(Lift tests of one object with one hand (see ``lift_test``).
 
@@ -214,15 +276,17 @@ Args:
       .def_property_readonly("num_pieces", &LiftTester::num_pieces, "convex pieces kept (0 without a decomposition)")
       .def(
           "run",
-          [](const LiftTester& t, const DArray& hand_pose, const DArray& joints) {
+          [](const LiftTester& t, const DArray& hand_pose, const DArray& joints, int trace_every) {
             const Iso3 T = pose(hand_pose, "hand_pose");
             const Eigen::VectorXd q = vector(joints, "joints");
+            if (trace_every < 0) throw py::value_error("trace_every: must be >= 0, got " + std::to_string(trace_every));
             py::gil_scoped_release release;
-            return t.run(T, q);
+            return t.run(T, q, trace_every);
           },
-          py::arg("hand_pose"), py::arg("joints"),
+          py::arg("hand_pose"), py::arg("joints"), py::arg("trace_every") = 0,
           R"doc(One lift test. hand_pose: (4, 4) world pose of the hand; joints: (J,) closed joint
-angles (HandModel layout). A LiftResult.)doc")
+angles (HandModel layout); trace_every: record a LiftTrace every that many steps (0: none).
+A LiftResult (its ``trace`` the LiftTrace or None).)doc")
       .def(
           "run_batch",
           [](const LiftTester& t, const DArray& hand_poses, const DArray& joints, int threads) {

@@ -1,8 +1,11 @@
 """Physical lift test (Bullet): does the closed grasp hold the object when the hand lifts it?
 
 The object becomes a dynamic body (mass from its mesh at ``density``), the palm a kinematic
-body, the phalanges motor-driven hinged bodies that keep squeezing (bounded torque, not
-backdrivable). Script: squeeze 0.15 s, lift 10 cm in 0.4 s, gentle 3-axis shake (1 cm,
+body, the phalanges hinged bodies squeezed as the Barrett hand does: one torque-limited motor per
+finger on its proximal joint, the distal coupled to it, breakaway when the proximal is stopped by
+the object (the distal closes on alone), worm drives that do not open under load, no travel
+limit (see cpp/bayesgrasp/physics/lift_test.hpp). ``run(..., trace_every=k)`` records a per-step
+trace (:mod:`bayesgrasp.lift_trace`). Script: squeeze 0.15 s, lift 10 cm in 0.4 s, gentle 3-axis shake (1 cm,
 3 Hz, 0.5 s), hold 0.1 s, at a fixed 1/480 s step (deterministic). Success when the object's
 centre of mass moved less than 2 cm relative to the palm (after the squeeze)::
 
@@ -176,10 +179,11 @@ class LiftTester:
         still uses the hull for grasps that stay outside it; see the results' ``shape``)."""
         return self._t.shape
 
-    def run(self, hand_pose, joints) -> LiftResult:
+    def run(self, hand_pose, joints, trace_every: int = 0) -> LiftResult:
         """One lift test (lifted, displacement, rotation, squeeze_displacement, height_gain,
-        finite, steps, tetrahedra, shape)."""
-        return self._t.run(np.asarray(hand_pose, dtype=float), np.asarray(joints, dtype=float))
+        finite, steps, tetrahedra, shape, breakaway). ``trace_every`` > 0: ``result.trace`` records
+        every that many steps (see :class:`bayesgrasp.lift_trace.LiftTrace`); 0: None."""
+        return self._t.run(np.asarray(hand_pose, dtype=float), np.asarray(joints, dtype=float), int(trace_every))
 
     def run_batch(self, hand_poses, joints, threads=1) -> LiftBatch:
         """N lift tests ((N, 4, 4) poses, (N, J) joints) in C++ threads (0 = all cores): the

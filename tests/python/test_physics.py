@@ -183,6 +183,7 @@ def test_decomposed_mug_gives_the_tetrahedra_verdicts_when_the_hand_reaches_into
     off = physics.LiftTester(None, w.vertices, w.faces, convex_pieces=pieces, mu=w.mu, density=w.object.density,
                              skip_separated_pairs=False)
     ro = off.run_batch(b.hand_pose, b.joint_angles)
+    assert rd.skipped_queries.sum() > 0 and ro.skipped_queries.sum() == 0
     assert ro.displacement.tolist() == rd.displacement.tolist()
     assert ro.rotation.tolist() == rd.rotation.tolist()
 
@@ -226,3 +227,48 @@ def test_side_contacts_hold_a_cylinder_with_friction_in_both_tangent_directions(
     assert r.lifted[0], r.displacement[0]
     assert r.displacement[0] < 0.01
     assert r.height_gain[0] > 0.09
+
+
+# ---- the squeeze model's trace and the options' bounds ------------------------------------------
+
+def test_trace_ends_at_the_results_displacement_and_the_held_box_touches_two_fingers_throughout(tmp_path):
+    from bayesgrasp.lift_trace import LiftTrace, plot_lift_trace
+    t = physics.LiftTester(None, V, F, density=400.0)
+    assert t.run(POSE, GOOD).trace is None  # off by default
+    r = t.run(POSE, GOOD, trace_every=6)
+    assert r.lifted
+    tr = LiftTrace.from_core(r.trace)
+    n = r.steps
+    assert len(tr.time) == -(-n // 6)  # every 6th step and the last one
+    assert tr.time[-1] == pytest.approx(n / 480.0)
+    # The displacement is measured between the reference (after the squeeze) and the last pose.
+    assert np.linalg.norm(tr.object_pose[-1, :3, 3] - tr.reference_pose[:3, 3]) == pytest.approx(r.displacement, abs=1e-12)
+    assert tr.displacement[-1] == pytest.approx(r.displacement, abs=1e-12)
+    assert tr.joints.shape == (len(tr.time), 7) and tr.driven.shape == (len(tr.time), 3)
+    # Contacts on at least two fingers at every sample (links per finger from the hand).
+    from bayesgrasp.hand import Hand
+    h = Hand.load("barrett_bh8")
+    assert list(tr.link_names) == h.links
+    fingers = [list(l) for l in h.phalanx_links]
+    assert np.all(tr.fingers_in_contact(fingers) >= 2)
+    assert np.all(tr.contact_force >= 0) and tr.contact_force.max() > 0.1
+    assert np.allclose(np.linalg.norm(tr.contact_normal, axis=1), 1.0, atol=1e-6)
+    np.testing.assert_allclose(tr.phase_ends, [0.15, 0.55, 1.05])
+    plot_lift_trace(tr, tmp_path / "trace.png")
+    assert (tmp_path / "trace.png").stat().st_size > 1000
+    with pytest.raises(ValueError, match="trace_every"):
+        t.run(POSE, GOOD, trace_every=-1)
+
+
+def test_breakaway_state_is_reported():
+    r = physics.lift_test(None, POSE, GOOD, V, F, density=400.0)
+    assert r.breakaway.shape == (3,) and set(r.breakaway.tolist()) <= {0, 1}
+
+
+@pytest.mark.parametrize("opts, match", [
+    (dict(squeeze_time=5e6), "squeeze_time"),  # used to overflow the step count: lifted with 0 steps
+    (dict(time_step=1e-9), "time_step"),        # used to run for minutes
+])
+def test_step_count_is_bounded(opts, match):
+    with pytest.raises(ValueError, match=match):
+        physics.LiftTester(None, V, F, **opts)

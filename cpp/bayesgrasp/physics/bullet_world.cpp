@@ -5,7 +5,7 @@ namespace bayesgrasp::physics {
 BulletWorld::BulletWorld(const LiftOptions& o)
     : config_(separated_pair_skip_config()),
       skip_funcs_(o.skip_separated_pairs ? make_skip_funcs() : SkipFuncs{}) {
-  world_.setGravity(btVector3(0, 0, btScalar(-9.81)));
+  world_.setGravity(btVector3(0, 0, btScalar(-9.81 * kUnit)));
   world_.getSolverInfo().m_numIterations = o.solver_iterations;
   world_.getSolverInfo().m_solverMode |= SOLVER_USE_2_FRICTION_DIRECTIONS;
 }
@@ -34,10 +34,10 @@ btCollisionShape* BulletWorld::keep(btCollisionShape* s) {
   return s;
 }
 
-btRigidBody* BulletWorld::add_body(btCollisionShape* shape, double mass, const btVector3& inertia, const btTransform& T,
+btRigidBody* BulletWorld::add_body(btCollisionShape* shape, double mass, const Vec3& inertia, const btTransform& T,
                                    int group, int mask, double friction) {
   states_.emplace_back(new btDefaultMotionState(T));
-  btRigidBody::btRigidBodyConstructionInfo info(btScalar(mass), states_.back().get(), shape, inertia);
+  btRigidBody::btRigidBodyConstructionInfo info(btScalar(mass), states_.back().get(), shape, bt(kUnit * kUnit * inertia));
   info.m_friction = btScalar(friction);
   info.m_restitution = 0;
   bodies_.emplace_back(new btRigidBody(info));

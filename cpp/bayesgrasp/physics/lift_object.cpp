@@ -77,6 +77,20 @@ ConvexHull convex_hull(const std::vector<btVector3>& pts) {
   return h;
 }
 
+// A convex hull for Bullet: the points (m) in Bullet units, the hull shrunk by the collision
+// margin (each face moved inwards by `margin`, btConvexHullComputer's shrink; at most half the
+// hull's inner radius), so that hull + margin is the true surface.
+std::vector<btVector3> shrunk_hull(const std::vector<btVector3>& pts, double margin) {
+  std::vector<btVector3> scaled(pts.size());
+  for (size_t i = 0; i < pts.size(); ++i) scaled[i] = pts[i] * btScalar(kUnit);
+  btConvexHullComputer chc;
+  chc.compute(&scaled[0].x(), sizeof(btVector3), static_cast<int>(scaled.size()), btScalar(kUnit * margin),
+              btScalar(0.5));
+  std::vector<btVector3> out;
+  for (int i = 0; i < chc.vertices.size(); ++i) out.push_back(chc.vertices[i]);
+  return out;
+}
+
 // Principal axes (right-handed) at the centre of mass.
 void set_body_frame(LiftObject& o) {
   Eigen::SelfAdjointEigenSolver<Mat3> es(o.mass.inertia);
@@ -89,7 +103,7 @@ void set_body_frame(LiftObject& o) {
 }
 
 // Each piece's hull in the body frame; a piece must span a volume (> 1e-12 m^3).
-void add_pieces(LiftObject& o, const std::vector<Eigen::MatrixX3d>& convex_pieces) {
+void add_pieces(LiftObject& o, const std::vector<Eigen::MatrixX3d>& convex_pieces, double margin) {
   if (convex_pieces.empty())
     throw std::invalid_argument("convex_pieces: the decomposition shape needs at least one convex piece");
   const Iso3 inv = o.body0.inverse();
@@ -102,7 +116,7 @@ void add_pieces(LiftObject& o, const std::vector<Eigen::MatrixX3d>& convex_piece
     for (Eigen::Index k = 0; k < P.rows(); ++k) pts[k] = bt(Vec3(inv * Vec3(P.row(k).transpose())));
     ConvexHull h = convex_hull(pts);
     if (!(h.volume > 1e-12)) throw std::invalid_argument(name + ": spans no volume (flat or degenerate)");
-    o.pieces.push_back(std::move(h.vertices));
+    o.pieces.push_back(shrunk_hull(h.vertices, margin));
   }
 }
 
@@ -126,7 +140,8 @@ void add_tetrahedra(LiftObject& o, const TriMesh& object, const std::vector<btVe
     NearestHit hit(from, to, static_cast<int>(f));
     bvh.performRaycast(&hit, from, to);
     const btScalar depth = std::max(btScalar(1e-4), hit.fraction * btScalar(tet_depth));
-    o.tets.push_back({a, b, c, centroid - n * depth});
+    const btScalar u = btScalar(kUnit);
+    o.tets.push_back({a * u, b * u, c * u, (centroid - n * depth) * u});
   }
   if (o.tets.empty()) throw std::invalid_argument("mesh has only degenerate triangles");
 }
@@ -143,7 +158,7 @@ LiftObject prepare_object(const TriMesh& object, const LiftOptions& options,
   std::vector<btVector3> local(static_cast<size_t>(nv));
   for (Eigen::Index i = 0; i < nv; ++i) local[i] = bt(Vec3(inv * Vec3(object.V.row(i).transpose())));
   ConvexHull hull = convex_hull(local);  // also decides Auto
-  o.hull = std::move(hull.vertices);
+  o.hull = shrunk_hull(hull.vertices, options.margin);
   o.planes = std::move(hull.planes);
   o.concave = hull.volume > 1.05 * std::abs(o.mass.volume);
   o.shape = options.shape;
@@ -155,7 +170,7 @@ LiftObject prepare_object(const TriMesh& object, const LiftOptions& options,
               : convex_pieces.empty() ? LiftOptions::Shape::Tetrahedra
                                       : LiftOptions::Shape::Decomposition;
   }
-  if (o.shape == LiftOptions::Shape::Decomposition) add_pieces(o, convex_pieces);
+  if (o.shape == LiftOptions::Shape::Decomposition) add_pieces(o, convex_pieces, options.margin);
   if (o.shape == LiftOptions::Shape::Tetrahedra) add_tetrahedra(o, object, local, options.tet_depth);
   return o;
 }
@@ -187,7 +202,7 @@ LiftOptions::Shape shape_for_grasp(const LiftObject& o, const HandModel& hand, c
 }
 
 btRigidBody* add_object(BulletWorld& w, const LiftObject& o, LiftOptions::Shape shape, const LiftOptions& opt) {
-  const btScalar margin = btScalar(opt.margin);
+  const btScalar margin = btScalar(kUnit * opt.margin);
   btTransform I;
   I.setIdentity();
   btCollisionShape* object_shape = nullptr;
@@ -212,11 +227,12 @@ btRigidBody* add_object(BulletWorld& w, const LiftObject& o, LiftOptions::Shape 
     hull->setMargin(margin);
     object_shape = w.keep(hull);
   }
-  btRigidBody* body = w.add_body(object_shape, o.mass.mass, bt(o.principal), bt(o.body0), kObject, kHand | kTable, 1.0);
+  btRigidBody* body = w.add_body(object_shape, o.mass.mass, o.principal, to_bt(o.body0), kObject, kHand | kTable, 1.0);
   if (opt.table) {
     btCollisionShape* plane = w.keep(new btStaticPlaneShape(btVector3(0, 0, 1), 0));
-    w.add_body(plane, 0.0, btVector3(0, 0, 0), I, kTable, kObject, opt.table_mu);
+    w.add_body(plane, 0.0, Vec3::Zero(), I, kTable, kObject, opt.table_mu)->setUserIndex(-2);
   }
+  body->setUserIndex(-1);
   return body;
 }
 

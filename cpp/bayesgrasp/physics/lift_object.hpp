@@ -21,10 +21,10 @@ struct LiftObject {
   LiftOptions::Shape shape = LiftOptions::Shape::ConvexHull;  // prepared shape (never Auto)
   bool concave = false;           // hull volume > 1.05 x mesh volume
   bool per_grasp = false;         // Auto on a concave object: choose per grasp (shape_for_grasp)
-  std::vector<btVector3> hull;                 // hull vertices (body frame)
+  std::vector<btVector3> hull;                 // hull vertices (body frame, Bullet units, shrunk by the margin)
   std::vector<Eigen::Vector4d> planes;         // hull faces n.x <= d (body frame, unit n)
-  std::vector<std::array<btVector3, 4>> tets;  // Tetrahedra (body frame)
-  std::vector<std::vector<btVector3>> pieces;  // Decomposition: hull vertices of each piece (body frame)
+  std::vector<std::array<btVector3, 4>> tets;  // Tetrahedra (body frame, Bullet units)
+  std::vector<std::vector<btVector3>> pieces;  // Decomposition: each piece's hull (body frame, Bullet units, shrunk)
 };
 
 /// Prepares the object (mesh and options already validated); throws std::invalid_argument for

@@ -45,11 +45,18 @@ void check_options(const LiftOptions& o) {
   nonneg(o.hold_time, "hold_time");
   nonneg(o.finger_torque, "finger_torque");
   nonneg(o.closing_speed, "closing_speed");
-  nonneg(o.squeeze_travel, "squeeze_travel");
   pos(o.link_mass, "link_mass");
   pos(o.success_distance, "success_distance");
   pos(o.tet_depth, "tet_depth");
   nonneg(o.margin, "margin");
+  // The script's steps, ceil(total / time_step), must be countable and bounded.
+  const double total = o.squeeze_time + o.lift_time + o.shake_time + o.hold_time;
+  const double steps = total / o.time_step;
+  if (!(steps <= static_cast<double>(kMaxLiftSteps)))
+    throw std::invalid_argument("squeeze_time + lift_time + shake_time + hold_time (" + std::to_string(total) +
+                                " s) over time_step (" + std::to_string(o.time_step) + " s) gives " +
+                                std::to_string(steps) + " steps, more than " + std::to_string(kMaxLiftSteps));
+  if (!(physics::script_steps(o) >= 1)) throw std::invalid_argument("time_step: the script has no step");
 }
 
 void check_pose(const Iso3& hand_pose, const std::string& name) {
@@ -78,13 +85,19 @@ LiftOptions::Shape LiftTester::shape() const { return impl_->object.shape; }
 bool LiftTester::concave() const { return impl_->object.concave; }
 int LiftTester::num_pieces() const { return static_cast<int>(impl_->object.pieces.size()); }
 
-LiftResult LiftTester::run(const Iso3& hand_pose, const Eigen::VectorXd& joints) const {
+LiftResult LiftTester::run(const Iso3& hand_pose, const Eigen::VectorXd& joints, int trace_every) const {
   check_pose(hand_pose, "hand_pose");
   impl_->hand.check_joints(joints, 1e-6);
-  return simulate(hand_pose, joints);
+  if (trace_every < 0) throw std::invalid_argument("trace_every must be >= 0, got " + std::to_string(trace_every));
+  if (trace_every == 0) return simulate(hand_pose, joints, nullptr);
+  auto trace = std::make_shared<LiftTrace>();
+  trace->every = trace_every;
+  LiftResult r = simulate(hand_pose, joints, trace.get());
+  r.trace = std::move(trace);
+  return r;
 }
 
-LiftResult LiftTester::simulate(const Iso3& hand_pose, const Eigen::VectorXd& joints) const {
+LiftResult LiftTester::simulate(const Iso3& hand_pose, const Eigen::VectorXd& joints, LiftTrace* trace) const {
   const Impl& im = *impl_;
   const std::vector<Iso3> poses = im.hand.link_poses(hand_pose, joints);
   LiftResult res;
@@ -92,8 +105,9 @@ LiftResult LiftTester::simulate(const Iso3& hand_pose, const Eigen::VectorXd& jo
   res.tetrahedra = res.shape == LiftOptions::Shape::Tetrahedra;
   physics::BulletWorld w(im.opt);
   btRigidBody* object = physics::add_object(w, im.object, res.shape, im.opt);
-  btRigidBody* palm = physics::add_hand(w, im.hand, hand_pose, joints, poses, im.opt);
-  physics::run_script(w, object, palm, hand_pose, im.object.mass.com.z(), im.opt, res);
+  physics::HandBodies hand = physics::add_hand(w, im.hand, hand_pose, joints, poses, im.opt);
+  physics::SqueezeModel squeeze(im.hand, joints, im.opt.closing_speed, im.opt.finger_torque, im.opt.time_step);
+  physics::run_script(w, object, hand, im.hand, squeeze, hand_pose, im.object.mass.com.z(), im.opt, res, trace);
   return res;
 }
 
@@ -109,7 +123,7 @@ std::vector<LiftResult> LiftTester::run_batch(
     check_pose(poses[i], "hand pose " + std::to_string(i));
     impl_->hand.check_joints(joints.row(i).transpose(), 1e-6, ("joints[" + std::to_string(i) + "]").c_str());
   }
-  return parallel_map<LiftResult>(n, threads, 1, [&](long i) { return simulate(poses[i], joints.row(i).transpose()); });
+  return parallel_map<LiftResult>(n, threads, 1, [&](long i) { return simulate(poses[i], joints.row(i).transpose(), nullptr); });
 }
 
 LiftResult lift_test(const HandModel& hand, const Iso3& hand_pose, const Eigen::VectorXd& joints,

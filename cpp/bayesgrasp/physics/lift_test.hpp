@@ -7,12 +7,17 @@
 //  * the palm (with the knuckles, i.e. the spread is frozen) is a kinematic body that
 //    follows a scripted trajectory;
 //  * every phalanx is a dynamic body (mass `link_mass`, centre of mass on its joint axis)
-//    hinged to its parent at its joint, starting at the given closed joint angles, with a
-//    joint motor that keeps closing at `closing_speed` with at most `finger_torque` (N m):
-//    the fingers keep squeezing with a bounded force, like the real hand's motors. A joint
-//    cannot open past its given angle (the Barrett hand's worm drives are not
-//    backdrivable) and closes at most `squeeze_travel` further (or to its upper limit), so
-//    a finger that touches nothing moves only a little;
+//    hinged to its parent at its joint, starting at the given closed joint angles;
+//  * the fingers squeeze as the Barrett BH8 drives them (physics/squeeze_model.hpp): one motor
+//    per finger, a velocity servo at `closing_speed` with at most `finger_torque` (N m) on the
+//    joint it drives - the proximal, its distal coupled by the hand file's ratio (a rigid
+//    transmission: the distal's load is the same motor's) - and the TorqueSwitch breakaway:
+//    once the proximal touches the object and stalls (or reaches its limit) it is locked and
+//    the motor closes the distal alone. Worm drive: a driven joint never opens (its lower
+//    limit ratchets up to the largest angle reached), a coupled one is held by the
+//    transmission; the upper limits are the hand file's. There is no travel limit: a finger
+//    keeps closing after the object as it moves, as far as its joint limits allow. The palm
+//    only translates in the script, which the coupling's two-body form relies on;
 //  * the hand collides only with the object; the object also with the table (z = 0, if
 //    `table`); gravity is -9.81 m/s^2 along z.
 // Friction: two friction directions per contact (Bullet's SOLVER_USE_2_FRICTION_DIRECTIONS).
@@ -56,8 +61,16 @@
 //    concavity: a mug's opening or handle): Decomposition if pieces were given, else
 //    Tetrahedra. See bench/bench_physics.cpp and BENCHMARKS.md for the costs (hull and
 //    decomposition are far cheaper than tetrahedra).
+// Units: Bullet runs in decimetres (bullet_world.hpp kUnit: lengths and gravity x10, inertia
+// and torques x100, masses unchanged - the same motion, and the ~1-2 cm phalanges' contacts far
+// steadier than at Bullet's metre-scale absolute tolerances). Inputs and results stay in metres.
 // Collision margins are `margin` (0.5 mm) on every shape (Bullet's default 4 cm is meant for
-// metre-sized bodies).
+// metre-sized bodies); convex hulls and decomposition pieces are shrunk inwards by the margin
+// (btConvexHullComputer's shrink, at most half a piece's inner radius) and boxes keep their
+// margin inside, so shape + margin is the true surface (capsules are exact; the tetrahedra are
+// not shrunk). Solver: `solver_iterations` (20) per step.
+// The script's step count ceil(total time / time_step) must be at most kMaxLiftSteps (10
+// million): the options are rejected otherwise.
 // Speed. Bullet runs a GJK query at every step for every pair of child shapes (a hand link's
 // capsule or box, one convex piece of the object) whose bounding boxes overlap; with a finger
 // inside a mug that is most of the pairs, nearly all of them apart. With
@@ -67,15 +80,21 @@
 // add no point) is skipped (physics/separated_pair_skip.hpp). Same results, faster on concave
 // objects (see BENCHMARKS.md).
 //
+// Trace: run(..., trace_every = k > 0) records every k steps and at the last step the time,
+// the object's pose in the palm frame, the joint angles, each finger's driven phalanx and every
+// hand-object contact (link, point, normal, normal force): LiftResult::trace.
+//
 // Files: lift_object (object preparation, per-grasp shape, the object's body), hand_bodies
-// (palm, phalanges, hinges and motors), lift_script (trajectory and outcome), bullet_world
-// (the world and its ownership), separated_pair_skip (the narrowphase skip).
+// (palm, phalanges, hinges, motor, limit and coupling rows), squeeze_model (the per-step
+// motor law), lift_script (trajectory, the model's steps, outcome and trace), bullet_world
+// (the world, its units and ownership), separated_pair_skip (the narrowphase skip).
 //
 // Thread safety: LiftTester is immutable after construction; each run builds its own Bullet
 // world, so run() may be called from many threads at once.
 #pragma once
 
 #include <memory>
+#include <string>
 #include <vector>
 
 #include <Eigen/Core>
@@ -85,13 +104,16 @@
 
 namespace bayesgrasp {
 
+/// Most steps a lift test may take (LiftOptions are rejected beyond it).
+constexpr long kMaxLiftSteps = 10'000'000;
+
 struct LiftOptions {
   enum class Shape { Auto, ConvexHull, Tetrahedra, Decomposition };
   double mu = 0.5;              // friction between the hand and the object
   double table_mu = 0.5;        // friction between the object and the table
   double density = 1000.0;      // kg/m^3 (mass from the mesh)
   double time_step = 1.0 / 480.0;  // s; see the note on time steps above
-  int solver_iterations = 10;
+  int solver_iterations = 20;
   double squeeze_time = 0.15;   // s
   double lift_height = 0.10;    // m
   double lift_time = 0.40;      // s
@@ -99,9 +121,8 @@ struct LiftOptions {
   double shake_frequency = 3.0;   // Hz
   double shake_time = 0.5;        // s
   double hold_time = 0.1;         // s
-  double finger_torque = 0.5;     // N m, per phalanx joint motor (~5 N at the fingertip)
-  double closing_speed = 1.0;     // rad/s, motor target velocity (closing)
-  double squeeze_travel = 0.15;   // rad a joint may close beyond its given angle
+  double finger_torque = 0.5;     // N m, torque limit of each finger's motor at the joint it drives
+  double closing_speed = 1.0;     // rad/s, the motor's target velocity (closing)
   double link_mass = 0.08;        // kg per phalanx
   double success_distance = 0.02; // m
   bool table = true;
@@ -112,6 +133,28 @@ struct LiftOptions {
   // conservative bound proves apart (see the note on speed above); the simulation is the
   // same with or without (tests/cpp/test_physics.cpp checks equal results), only faster.
   bool skip_separated_pairs = true;
+};
+
+/// One contact between a hand link and the object in a traced step (world frame).
+struct LiftContact {
+  int sample = 0;            // index of the traced step
+  int link = 0;              // HandModel link index (0: palm and knuckles)
+  Vec3 point = Vec3::Zero(); // m, on the hand link's surface
+  Vec3 normal = Vec3::Zero();// unit, out of the object (towards the hand)
+  double force = 0.0;        // N, normal force in that step
+};
+
+/// Per-step trace of one lift test, every `every` steps and at the last step simulated.
+struct LiftTrace {
+  int every = 0;
+  std::vector<std::string> link_names;  // HandModel link names
+  Eigen::Vector3d phase_ends = Eigen::Vector3d::Zero();  // s: end of the squeeze, the lift, the shake
+  Iso3 reference_pose = Iso3::Identity();  // the object (centre of mass, principal axes) in the palm frame after the squeeze
+  std::vector<double> time;         // s, per sample
+  std::vector<Iso3> object_pose;    // per sample: the object in the palm frame
+  std::vector<Eigen::VectorXd> joints;     // per sample: joint angles (HandModel layout)
+  std::vector<Eigen::VectorXi> driven;     // per sample: the phalanx each finger's motor drives
+  std::vector<LiftContact> contacts;
 };
 
 struct LiftResult {
@@ -125,7 +168,10 @@ struct LiftResult {
   LiftOptions::Shape shape = LiftOptions::Shape::ConvexHull;  // the shape used (never Auto)
   int steps = 0;
   long skipped_queries = 0;  // narrowphase queries skipped (LiftOptions::skip_separated_pairs)
+  Eigen::VectorXi breakaway;  // per finger: the phalanx its motor drives at the end (0: no breakaway)
+  std::shared_ptr<LiftTrace> trace;  // the per-step trace when asked for (run's trace_every > 0)
 };
+
 
 class LiftTester {
  public:
@@ -155,7 +201,8 @@ class LiftTester {
   /// One lift test from the closed grasp (hand pose in the world, joints in HandModel
   /// layout). Throws std::invalid_argument for a non-finite pose or joints of the wrong
   /// size / outside the limits.
-  LiftResult run(const Iso3& hand_pose, const Eigen::VectorXd& joints) const;
+  /// `trace_every` > 0: the result carries a trace of every trace_every-th step (0: none).
+  LiftResult run(const Iso3& hand_pose, const Eigen::VectorXd& joints, int trace_every = 0) const;
 
   /// N lift tests (row i of `joints` with poses[i]) in `threads` threads (0 = all cores,
   /// common/parallel.hpp thread_count; negative is an error), each with its own Bullet
@@ -167,7 +214,7 @@ class LiftTester {
   struct Impl;
 
  private:
-  LiftResult simulate(const Iso3& hand_pose, const Eigen::VectorXd& joints) const;  // validated input
+  LiftResult simulate(const Iso3& hand_pose, const Eigen::VectorXd& joints, LiftTrace* trace) const;  // validated input
   std::unique_ptr<Impl> impl_;
 };
 
