@@ -25,13 +25,14 @@ from __future__ import annotations
 
 import hashlib
 import os
+import zipfile
 from pathlib import Path
 from typing import List, Optional, Sequence, Union
 
 import numpy as np
 
 from bayesgrasp import _core
-from bayesgrasp.cache import cache_root
+from bayesgrasp.cache import atomic_write, cache_root, checked, rebuild_warning
 from bayesgrasp.sim import set_fields
 
 __all__ = ["BARRETT_HAND", "LiftBatch", "LiftOptions", "LiftResult", "LiftTester", "convex_decomposition",
@@ -99,9 +100,12 @@ def convex_decomposition(vertices, faces, threshold: float = 0.05, seed: int = 0
         h.update(F.astype(np.int32).tobytes())
         h.update(f"coacd-{_coacd_version()}-t{threshold!r}-s{int(seed)}-{sorted(_COACD_SEARCH.items())}".encode())
         path = Path(decomposition_cache_dir() if cache_dir is None else cache_dir) / f"{h.hexdigest()[:32]}.npz"
-        if path.exists():
-            with np.load(path, allow_pickle=False) as z:
-                return [np.array(z[f"piece_{i}"], dtype=np.float64) for i in range(int(z["count"]))]
+        if path.exists() and checked(path, "convex decomposition cache file"):
+            try:
+                with np.load(path, allow_pickle=False) as z:
+                    return [np.array(z[f"piece_{i}"], dtype=np.float64) for i in range(int(z["count"]))]
+            except (OSError, ValueError, KeyError, EOFError, zipfile.BadZipFile) as e:
+                rebuild_warning(path, "convex decomposition cache file", e)
     coacd.set_log_level("error")
     parts = coacd.run_coacd(coacd.Mesh(V, F.astype(np.int32)), threshold=float(threshold), seed=int(seed),
                             **_COACD_SEARCH)
@@ -109,10 +113,8 @@ def convex_decomposition(vertices, faces, threshold: float = 0.05, seed: int = 0
     if not pieces:
         raise ValueError("vertices, faces: CoACD found no convex piece (does the mesh enclose a volume?)")
     if path is not None:
-        path.parent.mkdir(parents=True, exist_ok=True)
-        tmp = path.with_name(path.stem + f".{os.getpid()}.tmp.npz")
-        np.savez(tmp, count=len(pieces), **{f"piece_{i}": p for i, p in enumerate(pieces)})
-        os.replace(tmp, path)  # atomic: concurrent runs never read a half-written file
+        # atomic and checksummed: concurrent runs never read a half-written file (bayesgrasp.cache)
+        atomic_write(path, lambda tmp: np.savez(tmp, count=len(pieces), **{f"piece_{i}": p for i, p in enumerate(pieces)}))
     return pieces
 
 

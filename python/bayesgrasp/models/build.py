@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import hashlib
 import json
+import zipfile
 from dataclasses import asdict
 from pathlib import Path
 from typing import Callable, Optional, Union
@@ -15,7 +16,7 @@ from typing import Callable, Optional, Union
 import numpy as np
 
 from .. import gp as _gp
-from ..cache import cache_root
+from ..cache import atomic_write, atomic_write_text, cache_root, checked, rebuild_warning
 from ..objects import ObjectModel, load_object
 from ..world import World
 from .grasp_models import DEFAULT_CALIBRATION, GraspModels, features
@@ -50,20 +51,29 @@ class _CacheFiles:
                                                        d / f"{key}.json")
 
     def complete(self) -> bool:
-        return self.measurement.exists() and self.stability.exists() and self.info.exists()
+        """Whether all three files exist and match their checksums (a damaged one warns)."""
+        files = (self.measurement, self.stability, self.info)
+        if not all(f.exists() for f in files):
+            return False
+        return all([checked(f, "model cache file") for f in files])
 
-    def load(self, settings: ModelSettings) -> GraspModels:
-        info = json.loads(self.info.read_text())
-        models = GraspModels(_gp.load(self.measurement), _gp.load(self.stability), settings, info["joint_index"], info)
+    def load(self, settings: ModelSettings) -> Optional[GraspModels]:
+        """The cached models, or None (with a warning) if a file cannot be read."""
+        try:
+            info = json.loads(self.info.read_text())
+            models = GraspModels(_gp.load(self.measurement), _gp.load(self.stability), settings, info["joint_index"],
+                                 info)
+        except (OSError, ValueError, KeyError, EOFError, zipfile.BadZipFile) as e:
+            rebuild_warning(self.info, "model cache entry", e)
+            return None
         models.loaded_from_cache = True
         return models
 
     def save(self, models: GraspModels) -> None:
         try:
-            self.measurement.parent.mkdir(parents=True, exist_ok=True)
-            models.measurement.save(self.measurement)
-            models.stability.save(self.stability)
-            self.info.write_text(json.dumps(models.info, indent=1))
+            atomic_write(self.measurement, models.measurement.save)
+            atomic_write(self.stability, models.stability.save)
+            atomic_write_text(self.info, json.dumps(models.info, indent=1))
         except OSError as e:
             raise ValueError(f"cache_dir: cannot write models to {self.info.parent}: {e}") from e
 
@@ -141,8 +151,10 @@ def build_models(obj: Union[str, ObjectModel], hand="barrett_bh8", settings: Opt
     say = progress or (lambda msg: None)
     files = None if cache_dir is None else _CacheFiles(cache_dir, key)
     if files is not None and files.complete():
-        say(f"models for {obj.name}: loaded from cache ({key})")
-        return files.load(settings)
+        models = files.load(settings)
+        if models is not None:
+            say(f"models for {obj.name}: loaded from cache ({key})")
+            return models
     models = _train(world, settings, key, say)
     if files is not None:
         files.save(models)

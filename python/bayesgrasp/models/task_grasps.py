@@ -23,6 +23,7 @@ from typing import Callable, List, Optional, Sequence, Union
 
 import numpy as np
 
+from ..cache import atomic_write_text, checked, rebuild_warning
 from ..objects import ObjectModel, load_object
 from ..world import World
 from .settings import CACHE_VERSION
@@ -207,13 +208,15 @@ def task_grasps(models: Sequence[Union[str, ObjectModel]], rule: TaskRule, hand:
     for m in models:
         o = load_object(m)
         f = None if cache_dir is None else Path(cache_dir) / f"task_{_key(o, hand_text, rule, s)}.json"
-        if f is not None and f.is_file():
-            out += load_task_grasp_file(f)
-            continue
+        if f is not None and f.is_file() and checked(f, "task grasp cache file"):
+            try:
+                out += load_task_grasp_file(f)
+                continue
+            except ValueError as e:
+                rebuild_warning(f, "task grasp cache file", e)
         grasps = generate_task_grasps(o, rule, hand, s, say)
         if f is not None:
-            f.parent.mkdir(parents=True, exist_ok=True)
-            f.write_text(json.dumps({"model": o.name, "task": rule.name, "grasps": [grasp_to_json(g) for g in grasps]},
-                                    indent=1))
+            atomic_write_text(f, json.dumps({"model": o.name, "task": rule.name,
+                                             "grasps": [grasp_to_json(g) for g in grasps]}, indent=1))
         out += grasps
     return out
