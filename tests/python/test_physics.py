@@ -272,3 +272,20 @@ def test_breakaway_state_is_reported():
 def test_step_count_is_bounded(opts, match):
     with pytest.raises(ValueError, match=match):
         physics.LiftTester(None, V, F, **opts)
+
+
+def test_centred_top_grasps_hold_the_cube_with_three_fingers_in_contact_throughout():
+    # The 6 cm cube grasped from above at its centre (yaw 0 and 45 deg, force closure): held,
+    # every finger touching it at every traced step of the squeeze, lift, shake and hold.
+    from bayesgrasp.lift_trace import LiftTrace
+    from bayesgrasp.world import World
+    w = World.single("cube")
+    fingers = [list(l) for l in w.hand.phalanx_links]
+    for yaw in (0.0, np.pi / 4):
+        g = w.grasp(0.0, 0.0, yaw)
+        assert g.epsilon > 0
+        r = w.lift_tester().run(g.hand_pose, g.joint_angles, trace_every=4)
+        assert r.lifted and r.displacement < 0.005
+        tr = LiftTrace.from_core(r.trace)
+        assert np.all(tr.fingers_in_contact(fingers) >= 2)
+        assert tr.displacement[-1] == pytest.approx(r.displacement, abs=1e-12)

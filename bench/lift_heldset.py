@@ -1,0 +1,147 @@
+"""Exports closed grasps with our lift test's verdicts for an independent replay (bench/lift_mujoco.py).
+
+Grasps (all closed by our contact simulator, kept when force closure: epsilon > 0, no collision
+at the start):
+  * top grasps on a grid (x, y over the object's footprint, 8 yaws) on the five Pub. II objects
+    (cube, cylinder, mug, mug2, pitcher), ``--per-object`` drawn at random from the force-closure ones;
+  * random approaches on category objects (mug/0..6, bottle/0..10): directions from the side and
+    above, aimed near the object's centre with random roll, ``--per-category-object`` each.
+Per object one ``.npz`` (no pickle) in ``--out``: the mesh, convex pieces (concave objects), mass
+properties, friction and density, the hand's link shapes and joints, and per grasp the hand pose,
+closed joints, link poses, our verdict, displacement, shape used and breakaway state. With
+``--held-share N`` it also prints the held share of N force-closure top grasps per Pub. II object.
+
+    BAYESGRASP_CORE_DIR=build/dev/bayesgrasp_core PYTHONPATH=python python bench/lift_heldset.py --out bench/results/heldset
+"""
+import argparse
+import json
+import os
+import sys
+import time
+
+import numpy as np
+
+from bayesgrasp import physics
+from bayesgrasp.world import World
+
+PUB2 = ["cube", "cylinder", "mug", "mug2", "pitcher"]
+CATEGORY = [f"mug/{i}" for i in range(7)] + [f"bottle/{i}" for i in range(11)]
+
+
+def top_grid(w, n_xy=9):
+    lo, hi = w.object.vertices.min(0), w.object.vertices.max(0)
+    xs, ys = np.linspace(lo[0], hi[0], n_xy), np.linspace(lo[1], hi[1], n_xy)
+    yaws = np.radians(np.arange(0, 180, 22.5))
+    return np.array([[x, y, t] for x in xs for y in ys for t in yaws])
+
+
+def approaches(w, n, rng):
+    """n random approaches (object frame): directions with z <= 0.3 (side to top-down)."""
+    lo, hi = w.object.vertices.min(0), w.object.vertices.max(0)
+    centre = 0.5 * (lo + hi)
+    d = rng.normal(size=(4 * n, 3))
+    d /= np.linalg.norm(d, axis=1, keepdims=True)
+    d = d[d[:, 2] <= 0.3][:n]
+    if len(d) < n:
+        d = np.vstack([d, np.tile([0.0, 0.0, -1.0], (n - len(d), 1))])
+    targets = centre + rng.uniform(-0.3, 0.3, size=(n, 3)) * (hi - lo)
+    rolls = rng.uniform(0, np.pi, size=n)
+    return d, targets, rolls
+
+
+def force_closure(b):
+    return np.flatnonzero((np.asarray(b.epsilon) > 0) & ~np.asarray(b.collision_at_start, bool))
+
+
+def export(w, name, b, idx, source, out):
+    tester = w.lift_tester()
+    P, J = b.hand_pose[idx], b.joint_angles[idx]
+    r = tester.run_batch(P, J, threads=1)
+    br = np.array([tester.run(P[i], J[i]).breakaway for i in range(len(idx))]) if len(idx) else np.zeros((0, 3))
+    hand = w.hand
+    L = hand.num_links
+    links = np.array([hand.link_poses(J[i], P[i]) for i in range(len(idx))]).reshape(len(idx), L, 4, 4)
+    obj, T = w.object, w.scene.object_pose(w.object_index)
+    pieces = []
+    if tester.num_pieces > 0:
+        pieces = [p @ T[:3, :3].T + T[:3, 3] for p in physics.convex_decomposition(obj.vertices, obj.faces)]
+    shapes = []  # per link: type (0 box, 1 capsule), center, half_extents, p0, p1, radius
+    for li, ss in enumerate(hand.link_shapes()):
+        for s in ss:
+            shapes.append([li, 1 if s.type == "capsule" else 0, *np.asarray(s.center), *np.asarray(s.half_extents),
+                           *np.asarray(s.p0), *np.asarray(s.p1), float(s.radius)])
+    core = hand.core
+    fingers = []
+    for f, links_f in enumerate(core.phalanx_links):
+        fingers.append(list(links_f))
+    m = tester._t
+    data = dict(
+        name=np.array(name), source=np.array([source] * len(idx)),
+        V=w.vertices, F=np.asarray(w.faces), num_pieces=np.array(len(pieces)),
+        mass=np.array(m.mass), com=np.asarray(m.com), mu=np.array(w.mu), density=np.array(obj.density),
+        hand_pose=P, joints=J, link_poses=links, lifted=np.asarray(r.lifted), displacement=np.asarray(r.displacement),
+        shape=np.array(r.shape), breakaway=br, epsilon=np.asarray(b.epsilon)[idx],
+        link_shapes=np.array(shapes, float), joint_limits=np.asarray(hand.joint_limits),
+        finger_links=np.array(fingers, int), link_names=np.array(hand.links),
+        hand_json=np.array(open(hand.path).read()),
+    )
+    for i, p in enumerate(pieces):
+        data[f"piece_{i}"] = p
+    safe = name.replace("/", "_")
+    path = os.path.join(out, f"{safe}_{source}.npz")
+    np.savez(path, **data)
+    return r
+
+
+def main():
+    ap = argparse.ArgumentParser()
+    ap.add_argument("--out", default="bench/results/heldset")
+    ap.add_argument("--per-object", type=int, default=40)
+    ap.add_argument("--per-category-object", type=int, default=10)
+    ap.add_argument("--held-share", type=int, default=0,
+                    help="also print the held share of N force-closure top grasps per Pub. II object (a finer grid)")
+    ap.add_argument("--held-share-only", action="store_true", help="only the held shares, no export")
+    ap.add_argument("--seed", type=int, default=0)
+    a = ap.parse_args()
+    os.makedirs(a.out, exist_ok=True)
+    rng = np.random.default_rng(a.seed)
+    total, summary = 0, {}
+    for name in PUB2:
+        t0 = time.time()
+        w = World.single(name)
+        b = w.grasp_batch(top_grid(w), threads=0)
+        fc = force_closure(b)
+        if a.held_share:
+            hb = w.grasp_batch(top_grid(w, 15), threads=0)
+            hfc = force_closure(hb)
+            sel = np.random.default_rng(a.seed).choice(hfc, size=min(a.held_share, len(hfc)), replace=False)
+            r = w.lift_tester().run_batch(hb.hand_pose[sel], hb.joint_angles[sel], threads=0)
+            summary[name] = dict(force_closure=int(len(sel)), held=int(np.sum(r.lifted)))
+            print(f"held share {name}: {int(np.sum(r.lifted))}/{len(sel)} = {np.mean(r.lifted):.3f}", flush=True)
+        if a.held_share_only:
+            continue
+        idx = rng.choice(fc, size=min(a.per_object, len(fc)), replace=False)
+        r = export(w, name, b, idx, "top", a.out)
+        total += len(idx)
+        print(f"{name}: {len(fc)} force-closure top grasps, exported {len(idx)}, lifted {int(np.sum(r.lifted))} "
+              f"({time.time() - t0:.1f} s)", file=sys.stderr, flush=True)
+    for name in [] if a.held_share_only else CATEGORY:
+        w = World.single(name)
+        d, tg, rolls = approaches(w, 12 * a.per_category_object, rng)
+        b = w.approach_batch(d, tg, rolls, threads=0)
+        fc = force_closure(b)
+        idx = fc[: a.per_category_object]
+        if len(idx) == 0:
+            continue
+        r = export(w, name, b, idx, "approach", a.out)
+        total += len(idx)
+        print(f"{name}: {len(fc)} force-closure approaches, exported {len(idx)}, lifted {int(np.sum(r.lifted))}",
+              file=sys.stderr, flush=True)
+    print(f"exported {total} grasps to {a.out}", file=sys.stderr)
+    if summary:
+        with open(os.path.join(a.out, "held_share.json"), "w") as f:
+            json.dump(summary, f, indent=1)
+
+
+if __name__ == "__main__":
+    main()

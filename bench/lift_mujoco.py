@@ -1,0 +1,381 @@
+"""Replays exported grasps (bench/lift_heldset.py) in MuJoCo: an independent check of our lift test.
+
+The same scene in MuJoCo (PyPI ``mujoco``, needs only numpy besides): the palm and knuckles a
+mocap body at the hand pose (the spread frozen), every phalanx a body on a hinge at its joint
+(capsules and boxes as the hand file gives them, 80 g, the same inertia), the object a free
+body with our mesh's mass, centre of mass and inertia, its collision shape the convex hull or
+the convex pieces our lift test used for that grasp, the table a plane; friction mu on the
+hand and table_mu on the table (geom priority), condim 3, elliptic cones.
+The squeeze model as in cpp/bayesgrasp/physics/squeeze_model.hpp: one velocity-servo motor
+per finger (target closing_speed, at most finger_torque) on its driven phalanx, the later
+phalanges coupled by joint equalities (q_j = c + ratio_j / ratio_a q_a), breakaway when the
+driven phalanx touches the object and has stalled for 10 ms or reaches its limit (equality
+off, the phalanx locked by its range), the worm lock as a ratchet on every joint's lower limit.
+Script: squeeze 0.15 s, lift 10 cm in 0.4 s (cosine), 3-axis shake 1 cm 3 Hz 0.5 s, hold 0.1 s;
+verdict: the object's centre of mass moved < 2 cm in the palm frame after the squeeze.
+Prints the verdict agreement with ours and writes per-grasp rows (JSON) for the report.
+
+    .venv-mj/bin/python bench/lift_mujoco.py bench/results/heldset --out bench/results/lift_mujoco.json
+"""
+import argparse
+import glob
+import json
+import os
+import sys
+import time
+
+import numpy as np
+import mujoco
+
+SQUEEZE, LIFT, SHAKE, HOLD = 0.15, 0.40, 0.5, 0.1
+LIFT_H, SHAKE_A, SHAKE_F = 0.10, 0.01, 3.0
+SUCCESS, LOST = 0.02, 0.05
+TORQUE, SPEED, LINK_MASS = 0.5, 1.0, 0.08
+STALL_FRACTION, STALL_TIME = 0.1, 0.01
+
+
+def palm_offset(t):
+    d = np.zeros(3)
+    t -= SQUEEZE
+    if t <= 0:
+        return d
+    d[2] = LIFT_H * 0.5 * (1 - np.cos(np.pi * min(1.0, t / LIFT)))
+    t -= LIFT
+    if 0 < t < SHAKE:
+        env = np.sin(np.pi * t / SHAKE) ** 2
+        w = 2 * np.pi * SHAKE_F * t
+        d += SHAKE_A * env * np.sin(w + 2 * np.pi * np.arange(3) / 3)
+    return d
+
+
+def mass_properties(V, F):
+    """Mass-free volume, centre and second moments of a closed mesh (signed tetrahedra)."""
+    a, b, c = V[F[:, 0]], V[F[:, 1]], V[F[:, 2]]
+    vol6 = np.einsum("ij,ij->i", a, np.cross(b, c))
+    vol = vol6.sum() / 6
+    com = ((a + b + c) * vol6[:, None]).sum(0) / (24 * vol)
+    # Covariance of each tetrahedron (0, a, b, c) about the origin: vol6/120 (sum x x^T + (sum x)(sum x)^T).
+    s = a + b + c
+    C = (np.einsum("i,ij,ik->jk", vol6, a, a) + np.einsum("i,ij,ik->jk", vol6, b, b) +
+         np.einsum("i,ij,ik->jk", vol6, c, c) + np.einsum("i,ij,ik->jk", vol6, s, s)) / 120
+    C -= vol * np.outer(com, com)
+    return vol, com, np.trace(C) * np.eye(3) - C  # inertia per unit density about the centre
+
+
+def quat(R):
+    q = np.zeros(4)
+    mujoco.mju_mat2Quat(q, np.ascontiguousarray(R).reshape(-1))
+    return q
+
+
+def fmt(v):
+    return " ".join(f"{x:.9g}" for x in np.ravel(v))
+
+
+def shape_geoms(rows, T, cls):
+    """MJCF geoms for one link's shapes (rows of link_shapes), placed by T (link -> body frame)."""
+    out = []
+    for r in rows:
+        kind, center, half, p0, p1, rad = int(r[1]), r[2:5], r[5:8], r[8:11], r[11:14], r[14]
+        if kind == 1:
+            a, b = T[:3, :3] @ p0 + T[:3, 3], T[:3, :3] @ p1 + T[:3, 3]
+            out.append(f'<geom class="{cls}" type="capsule" fromto="{fmt(a)} {fmt(b)}" size="{rad:.9g}"/>')
+        else:
+            c = T[:3, :3] @ center + T[:3, 3]
+            out.append(f'<geom class="{cls}" type="box" pos="{fmt(c)}" quat="{fmt(quat(T[:3, :3]))}" size="{fmt(half)}"/>')
+    return out
+
+
+def build(z, g, hand, timestep):
+    """The MJCF of grasp g of the exported object z; returns (xml, meta)."""
+    V, F = z["V"], z["F"]
+    link_poses, q0 = z["link_poses"][g], z["joints"][g]
+    shapes, fingers = z["link_shapes"], z["finger_links"]
+    mu, table_mu = float(z["mu"]), 0.5
+    mass = float(z["mass"])
+    vol, com, I1 = mass_properties(V, F)
+    inertia = I1 * mass / vol
+    use_pieces = str(z["shape"][g]) == "decomposition"
+    meshes = [z[f"piece_{i}"] for i in range(int(z["num_pieces"]))] if use_pieces else [V]
+    assets = "\n".join(f'<mesh name="m{i}" vertex="{fmt(m)}"/>' for i, m in enumerate(meshes))
+    obj_geoms = "\n".join(f'<geom class="obj" type="mesh" mesh="m{i}"/>' for i in range(len(meshes)))
+    P = z["hand_pose"][g]
+    Pinv = np.linalg.inv(P)
+    by_link = {}
+    for r in shapes:
+        by_link.setdefault(int(r[0]), []).append(r)
+    phal = {int(l) for f in fingers for l in f}
+    palm_geoms = []
+    for li in range(len(link_poses)):
+        if li in phal:
+            continue
+        palm_geoms += shape_geoms(by_link.get(li, []), Pinv @ link_poses[li], "hand")
+    joint_of = {}
+    jf = hand["fingers"]
+    k = 1
+    for f, links in enumerate(fingers):
+        for j, l in enumerate(links):
+            joint_of[int(l)] = k
+            k += 1
+
+    def chain(f, j, parent_T):
+        l = int(fingers[f][j])
+        T = link_poses[l]
+        rel = np.linalg.inv(parent_T) @ T
+        kq = joint_of[l]
+        ph = jf[f]["phalanges"][j]
+        lo, hi = np.radians(ph["lower_deg"]) - q0[kq], np.radians(ph["upper_deg"]) - q0[kq]
+        L = max(ph["length"], 0.01)
+        inner = chain(f, j + 1, T) if j + 1 < len(fingers[f]) else ""
+        return (f'<body name="l{l}" pos="{fmt(rel[:3, 3])}" quat="{fmt(quat(rel[:3, :3]))}">'
+                f'<inertial pos="0 0 0" mass="{LINK_MASS}" diaginertia="{fmt([LINK_MASS * 1e-4, LINK_MASS * L * L / 3, LINK_MASS * L * L / 3])}"/>'
+                f'<joint name="j{kq}" type="hinge" axis="0 1 0" limited="true" range="{min(lo, 0):.9g} {max(hi, 1e-6):.9g}" damping="0"/>'
+                + "".join(shape_geoms(by_link.get(l, []), np.eye(4), "hand")) + inner + "</body>")
+
+    fingers_xml = "".join(chain(f, 0, P) for f in range(len(fingers)))
+    acts = "".join(f'<velocity name="a{kq}" joint="j{kq}" kv="1" forcelimited="true" forcerange="{-TORQUE} {TORQUE}"/>'
+                   for kq in range(1, k))
+    eqs = []
+    for f, links in enumerate(fingers):
+        for j in range(1, len(links)):
+            for a in range(j):
+                eqs.append(f'<joint name="e{f}_{j}_{a}" joint1="j{joint_of[int(links[j])]}" '
+                           f'joint2="j{joint_of[int(links[a])]}" polycoef="0 1 0 0 0" active="false"/>')
+    xml = f"""<mujoco>
+<compiler angle="radian"/>
+<option timestep="{timestep}" gravity="0 0 -9.81" cone="elliptic" impratio="10" integrator="implicitfast"/>
+<default>
+  <joint solreflimit="{2 * timestep} 1" solimplimit="0.99 0.999 0.0001"/>
+  <equality solref="{2 * timestep} 1" solimp="0.99 0.999 0.0001"/>
+  <default class="obj"><geom contype="1" conaffinity="6" condim="3" friction="{mu} 0.005 0.0001" priority="0"/></default>
+  <default class="hand"><geom contype="2" conaffinity="0" condim="3" friction="{mu} 0.005 0.0001" priority="1"/></default>
+</default>
+<asset>{assets}</asset>
+<worldbody>
+  <geom name="table" type="plane" size="2 2 0.1" contype="4" conaffinity="0" condim="3" friction="{table_mu} 0.005 0.0001" priority="1"/>
+  <body name="object" pos="0 0 0">
+    <freejoint/>
+    <inertial pos="{fmt(com)}" mass="{mass:.9g}" fullinertia="{fmt(inertia[[0, 1, 2, 0, 0, 1], [0, 1, 2, 1, 2, 2]])}"/>
+    {obj_geoms}
+  </body>
+  <body name="palm" pos="{fmt(P[:3, 3])}" quat="{fmt(quat(P[:3, :3]))}" gravcomp="1">
+    <inertial pos="0 0 0" mass="1000" diaginertia="100 100 100"/>
+    <joint name="px" type="slide" axis="{fmt(P[0, :3])}"/><joint name="py" type="slide" axis="{fmt(P[1, :3])}"/><joint name="pz" type="slide" axis="{fmt(P[2, :3])}"/>
+    {"".join(palm_geoms)}
+    {fingers_xml}
+  </body>
+</worldbody>
+<actuator>{acts}</actuator>
+<equality>{"".join(eqs)}</equality>
+</mujoco>"""
+    return xml, dict(joint_of=joint_of, njoints=k)
+
+
+def replay(z, g, hand, timestep, verbose=False):
+    xml, meta = build(z, g, hand, timestep)
+    m = mujoco.MjModel.from_xml_string(xml)
+    d = mujoco.MjData(m)
+    fingers = z["finger_links"]
+    q0 = z["joints"][g]
+    jf = hand["fingers"]
+    nf = len(fingers)
+    jid = {kq: m.joint(f"j{kq}").id for kq in range(1, meta["njoints"])}
+    qadr = {kq: m.jnt_qposadr[jid[kq]] for kq in jid}
+    vadr = {kq: m.jnt_dofadr[jid[kq]] for kq in jid}
+    aid = {kq: m.actuator(f"a{kq}").id for kq in jid}
+    body_link = {m.body(f"l{int(l)}").id: int(l) for f in fingers for l in f}
+    geom_link = np.array([body_link.get(int(b), -1) for b in m.geom_bodyid])
+    obj_body = m.body("object").id
+    obj_geom = m.geom_bodyid == obj_body
+    kj = [[meta["joint_of"][int(l)] for l in fingers[f]] for f in range(nf)]
+    ratio = [[jf[f]["phalanges"][j]["ratio"] for j in range(len(kj[f]))] for f in range(nf)]
+    offset = [[np.radians(jf[f]["phalanges"][j]["offset_deg"]) for j in range(len(kj[f]))] for f in range(nf)]
+    lower = [[np.radians(jf[f]["phalanges"][j]["lower_deg"]) for j in range(len(kj[f]))] for f in range(nf)]
+    upper = [[np.radians(jf[f]["phalanges"][j]["upper_deg"]) for j in range(len(kj[f]))] for f in range(nf)]
+    # The closed grasp's breakaway state (squeeze_model.cpp).
+    driven = []
+    for f in range(nf):
+        a = 0
+        while a + 1 < len(kj[f]):
+            t = (q0[kj[f][a]] - offset[f][a]) / ratio[f][a]
+            beyond = q0[kj[f][a]] >= upper[f][a] - 1e-4
+            for j in range(a + 1, len(kj[f])):
+                law = np.clip(offset[f][j] + ratio[f][j] * t, lower[f][j], upper[f][j])
+                beyond = beyond or q0[kj[f][j]] > law + 1e-3
+            if not beyond:
+                break
+            a += 1
+        driven.append(a)
+    reached = {kq: 0.0 for kq in jid}  # the worm lock (relative to the closed angles)
+    locked = set()
+    stall = [0] * nf
+    stall_steps = max(1, int(np.ceil(STALL_TIME / timestep - 1e-9)))
+
+    def set_drive(f):
+        a = driven[f]
+        for j, kq in enumerate(kj[f]):
+            on = j == a
+            m.actuator_gainprm[aid[kq], 0] = 1e3 if on else 0.0
+            m.actuator_biasprm[aid[kq], 2] = -1e3 if on else 0.0
+            d.ctrl[aid[kq]] = SPEED if on else 0.0
+            if j < a:
+                locked.add(kq)
+        for j in range(1, len(kj[f])):
+            for b in range(j):
+                e = m.equality(f"e{f}_{j}_{b}").id
+                on = b == a and j > a
+                if on:  # q_j = c + (ratio_j / ratio_a) q_a from here
+                    gr = ratio[f][j] / ratio[f][a]
+                    m.eq_data[e, :5] = [d.qpos[qadr[kj[f][j]]] - gr * d.qpos[qadr[kj[f][a]]], gr, 0, 0, 0]
+                d.eq_active[e] = on
+
+    for f in range(nf):
+        set_drive(f)
+    steps = int(np.ceil((SQUEEZE + LIFT + SHAKE + HOLD) / timestep - 1e-9))
+    sq_steps = int(np.ceil(SQUEEZE / timestep - 1e-9))
+    P = z["hand_pose"][g]
+    R, p0 = P[:3, :3], P[:3, 3].copy()
+    rel = lambda pp: R.T @ (d.xipos[obj_body] - pp)
+    palm_q = [m.jnt_qposadr[m.joint(n).id] for n in ("px", "py", "pz")]
+    palm_v = [m.jnt_dofadr[m.joint(n).id] for n in ("px", "py", "pz")]
+    mujoco.mj_forward(m, d)
+    ref = rel(p0)
+    disp = 0.0
+    pp = p0
+    for s in range(steps):
+        t = (s + 1) * timestep
+        # The palm follows the script kinematically: position and velocity set every step
+        # (a 1000 kg body on three slides, gravity compensated), so its motion has a velocity
+        # the contacts' friction sees.
+        prev = palm_offset(s * timestep)
+        nxt = palm_offset(t)
+        d.qpos[palm_q] = prev
+        d.qvel[palm_v] = (nxt - prev) / timestep
+        pp = p0 + nxt
+        # Worm lock: lower limit = the largest angle reached; locked phalanges held.
+        for kq in jid:
+            q = d.qpos[qadr[kq]]
+            reached[kq] = max(reached[kq], q)
+            hi = np.radians(0) + m.jnt_range[jid[kq], 1]
+            if kq in locked:
+                m.jnt_range[jid[kq]] = [reached[kq], reached[kq] + 1e-6]
+            else:
+                m.jnt_range[jid[kq], 0] = min(reached[kq], hi - 1e-6)
+        mujoco.mj_step(m, d)
+        # Breakaway: the driven phalanx touches the object and has stalled, or is at its limit.
+        n = d.ncon
+        touch = set()
+        if n:
+            g1, g2 = d.contact.geom1[:n], d.contact.geom2[:n]
+            for a_, b_ in zip(g1, g2):
+                if obj_geom[a_] and geom_link[b_] >= 0:
+                    touch.add(int(geom_link[b_]))
+                elif obj_geom[b_] and geom_link[a_] >= 0:
+                    touch.add(int(geom_link[a_]))
+        for f in range(nf):
+            a = driven[f]
+            if a + 1 >= len(kj[f]):
+                continue
+            kq = kj[f][a]
+            slow = d.qvel[vadr[kq]] < STALL_FRACTION * SPEED
+            stall[f] = stall[f] + 1 if slow and int(fingers[f][a]) in touch else 0
+            at_lim = q0[kq] + d.qpos[qadr[kq]] >= upper[f][a] - 1e-4
+            if stall[f] >= stall_steps or at_lim:
+                driven[f] = a + 1
+                stall[f] = 0
+                set_drive(f)
+        if verbose and s % 50 == 0:
+            print(f"t={t:.3f} d={np.linalg.norm(rel(pp) - ref):.4f} q={np.round([d.qpos[qadr[k]] for k in jid], 3)} "
+                  f"touch={sorted(touch)} driven={driven} ncon={d.ncon}", file=sys.stderr)
+            f6 = np.zeros(6)
+            for i in range(d.ncon):
+                mujoco.mj_contactForce(m, d, i, f6)
+                c = d.contact[i]
+                print(f"   contact {m.geom_bodyid[c.geom1]}-{m.geom_bodyid[c.geom2]} dist {c.dist:.5f} f {np.round(f6[:3], 3)} mu {c.friction[:2]}",
+                      file=sys.stderr)
+        if s + 1 == sq_steps:
+            ref = rel(pp)
+        if (s + 1) % 24 == 0:
+            disp = float(np.linalg.norm(rel(pp) - ref))
+            if not np.isfinite(disp) or disp > LOST:
+                break
+    disp = float(np.linalg.norm(rel(pp) - ref))
+    return dict(lifted=bool(np.isfinite(disp) and disp < SUCCESS), displacement=disp, breakaway=driven)
+
+
+def cause(r):
+    """A disagreement's likely cause, from the two displacements and breakaway states."""
+    near = min(abs(r["ours_displacement"] - SUCCESS), abs(r["mujoco_displacement"] - SUCCESS))
+    if near < 0.005:
+        return "marginal (a displacement within 5 mm of 2 cm)"
+    if r["ours_breakaway"] != r["mujoco_breakaway"]:
+        return "breakaway differs (squeeze: which phalanx the motor drove)"
+    if r["shape"] == "decomposition":
+        return "concave shape (convex pieces; contact with a piece's faces)"
+    return "contact model (soft MuJoCo vs hard Bullet contacts: squeeze force, slip)"
+
+
+def summarize(rows):
+    agree = sum(r["ours_lifted"] == r["mujoco_lifted"] for r in rows)
+    print(f"verdict agreement: {agree}/{len(rows)} = {agree / max(1, len(rows)):.3f}")
+    print(f"held: ours {sum(r['ours_lifted'] for r in rows)}, mujoco {sum(r['mujoco_lifted'] for r in rows)}")
+    by_obj = {}
+    for r in rows:
+        k = r["object"].split("/")[0] + ("" if "/" not in r["object"] else "/*")
+        a = by_obj.setdefault(k, [0, 0, 0, 0])
+        a[0] += 1
+        a[1] += r["ours_lifted"] == r["mujoco_lifted"]
+        a[2] += r["ours_lifted"]
+        a[3] += r["mujoco_lifted"]
+    for k, (n, ag, o, mj) in sorted(by_obj.items()):
+        print(f"  {k:10s} {n:4d} grasps, agree {ag:4d} ({ag / n:.3f}); held ours {o}, mujoco {mj}")
+    dis = [r for r in rows if r["ours_lifted"] != r["mujoco_lifted"]]
+    causes = {}
+    for r in dis:
+        causes.setdefault(cause(r), []).append(r)
+    print(f"disagreements: {len(dis)} (ours lifted, MuJoCo not: {sum(r['ours_lifted'] for r in dis)}; "
+          f"MuJoCo lifted, ours not: {sum(not r['ours_lifted'] for r in dis)})")
+    for c, rs in sorted(causes.items(), key=lambda kv: -len(kv[1])):
+        print(f"  {len(rs):3d}  {c}")
+        for r in rs:
+            print(f"         {r['object']:10s} {r['source']:8s} #{r['grasp']:<3d} {r['shape']:13s} ours {r['ours_displacement'] * 100:6.2f} cm "
+                  f"(break {r['ours_breakaway']}), mujoco {r['mujoco_displacement'] * 100:6.2f} cm (break {r['mujoco_breakaway']})")
+
+
+def main():
+    ap = argparse.ArgumentParser()
+    ap.add_argument("heldset", help="directory of bench/lift_heldset.py's .npz files")
+    ap.add_argument("--out", default="bench/results/lift_mujoco.json")
+    ap.add_argument("--timestep", type=float, default=0.001)
+    ap.add_argument("--max-grasps", type=int, default=0, help="per file (0: all)")
+    ap.add_argument("--summary-only", action="store_true", help="summarize an existing --out file")
+    a = ap.parse_args()
+    if a.summary_only:
+        with open(a.out) as f:
+            summarize(json.load(f))
+        return
+    rows = []
+    t0 = time.time()
+    for path in sorted(glob.glob(os.path.join(a.heldset, "*.npz"))):
+        with np.load(path, allow_pickle=False) as zf:
+            z = {k: zf[k] for k in zf.files}
+        hand = json.loads(str(z["hand_json"]))
+        n = len(z["lifted"]) if a.max_grasps <= 0 else min(a.max_grasps, len(z["lifted"]))
+        for g in range(n):
+            r = replay(z, g, hand, a.timestep)
+            rows.append(dict(object=str(z["name"]), source=str(z["source"][g]), grasp=g, shape=str(z["shape"][g]),
+                             ours_lifted=bool(z["lifted"][g]), ours_displacement=float(z["displacement"][g]),
+                             ours_breakaway=[int(x) for x in z["breakaway"][g]],
+                             mujoco_lifted=r["lifted"], mujoco_displacement=r["displacement"],
+                             mujoco_breakaway=[int(x) for x in r["breakaway"]]))
+        agree = sum(r["ours_lifted"] == r["mujoco_lifted"] for r in rows)
+        print(f"{os.path.basename(path)}: {n} grasps; total {len(rows)}, agree {agree} ({time.time() - t0:.0f} s)",
+              file=sys.stderr, flush=True)
+    summarize(rows)
+    os.makedirs(os.path.dirname(a.out) or ".", exist_ok=True)
+    with open(a.out, "w") as f:
+        json.dump(rows, f, indent=1)
+
+
+if __name__ == "__main__":
+    main()
