@@ -17,7 +17,9 @@ fi
 OUT=bench/results/heldset
 rm -rf "$OUT"
 echo ">> our lift test: export the grasps and verdicts ($OUT)"
-BAYESGRASP_CORE_DIR="$BUILD_DIR/bayesgrasp_core" PYTHONPATH=python "$BAYESGRASP_PY" bench/lift_heldset.py --out "$OUT" \
+# A development build's module if there is one (BUILD_DIR/bayesgrasp_core), else the installed package.
+if [ -d "$BUILD_DIR/bayesgrasp_core" ]; then export BAYESGRASP_CORE_DIR="$BUILD_DIR/bayesgrasp_core" PYTHONPATH=python; fi
+"$BAYESGRASP_PY" bench/lift_heldset.py --out "$OUT" \
   --per-object 40 --per-category-object 10 --held-share 200 | tee bench/results/lift_held_share.txt
 echo ">> MuJoCo: the same grasps"
 "$MJ_PY" bench/lift_mujoco.py "$OUT" --out bench/results/lift_mujoco.json | tee bench/results/lift_mujoco.txt
