@@ -17,9 +17,14 @@ import os
 import uuid
 import warnings
 from pathlib import Path
-from typing import Callable, Union
+import zipfile
+from typing import Callable, Optional, TypeVar, Union
 
 PathLike = Union[str, os.PathLike]
+T = TypeVar("T")
+
+#: What reading a damaged file may raise (numpy's .npz reader, json, our own format checks).
+READ_ERRORS = (OSError, ValueError, KeyError, EOFError, zipfile.BadZipFile)
 
 
 def cache_root() -> Path:
@@ -91,7 +96,15 @@ def checked(path: PathLike, what: str = "cache file") -> bool:
     return ok
 
 
-def rebuild_warning(path: PathLike, what: str, error: Exception) -> None:
-    """The warning for a file that passed its check but could not be read (``error``)."""
-    warnings.warn(f"{what} {path}: unreadable ({type(error).__name__}: {error}); rebuilding it",
-                  CacheWarning, stacklevel=3)
+def load_checked(path: PathLike, what: str, read: Callable[[Path], T]) -> Optional[T]:
+    """``read(path)`` if the file exists, passes :func:`checked` and reads without one of
+    READ_ERRORS; else None (with a :class:`CacheWarning` unless the file is simply absent): the
+    caller rebuilds the entry."""
+    path = Path(path)
+    if not checked(path, what):
+        return None
+    try:
+        return read(path)
+    except READ_ERRORS as e:
+        warnings.warn(f"{what} {path}: unreadable ({type(e).__name__}: {e}); rebuilding it", CacheWarning, stacklevel=2)
+        return None

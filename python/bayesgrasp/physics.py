@@ -25,14 +25,13 @@ from __future__ import annotations
 
 import hashlib
 import os
-import zipfile
 from pathlib import Path
 from typing import List, Optional, Sequence, Union
 
 import numpy as np
 
 from bayesgrasp import _core
-from bayesgrasp.cache import atomic_write, cache_root, checked, rebuild_warning
+from bayesgrasp.cache import atomic_write, cache_root, load_checked
 from bayesgrasp.sim import set_fields
 
 __all__ = ["BARRETT_HAND", "LiftBatch", "LiftOptions", "LiftResult", "LiftTester", "convex_decomposition",
@@ -60,6 +59,11 @@ def decomposition_cache_dir() -> Path:
     ``~/.cache/bayesgrasp``) / ``convex_decomposition``."""
     return cache_root() / "convex_decomposition"
 
+
+
+def _read_pieces(path: Path) -> List[np.ndarray]:
+    with np.load(path, allow_pickle=False) as z:
+        return [np.array(z[f"piece_{i}"], dtype=np.float64) for i in range(int(z["count"]))]
 
 
 def convex_decomposition(vertices, faces, threshold: float = 0.05, seed: int = 0,
@@ -100,12 +104,9 @@ def convex_decomposition(vertices, faces, threshold: float = 0.05, seed: int = 0
         h.update(F.astype(np.int32).tobytes())
         h.update(f"coacd-{_coacd_version()}-t{threshold!r}-s{int(seed)}-{sorted(_COACD_SEARCH.items())}".encode())
         path = Path(decomposition_cache_dir() if cache_dir is None else cache_dir) / f"{h.hexdigest()[:32]}.npz"
-        if path.exists() and checked(path, "convex decomposition cache file"):
-            try:
-                with np.load(path, allow_pickle=False) as z:
-                    return [np.array(z[f"piece_{i}"], dtype=np.float64) for i in range(int(z["count"]))]
-            except (OSError, ValueError, KeyError, EOFError, zipfile.BadZipFile) as e:
-                rebuild_warning(path, "convex decomposition cache file", e)
+        cached = load_checked(path, "convex decomposition cache file", _read_pieces)
+        if cached is not None:
+            return cached
     coacd.set_log_level("error")
     parts = coacd.run_coacd(coacd.Mesh(V, F.astype(np.int32)), threshold=float(threshold), seed=int(seed),
                             **_COACD_SEARCH)

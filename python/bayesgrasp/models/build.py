@@ -8,7 +8,6 @@ from __future__ import annotations
 
 import hashlib
 import json
-import zipfile
 from dataclasses import asdict
 from pathlib import Path
 from typing import Callable, Optional, Union
@@ -16,7 +15,7 @@ from typing import Callable, Optional, Union
 import numpy as np
 
 from .. import gp as _gp
-from ..cache import atomic_write, atomic_write_text, cache_root, checked, rebuild_warning
+from ..cache import atomic_write, atomic_write_text, cache_root, load_checked
 from ..objects import ObjectModel, load_object
 from ..world import World
 from .grasp_models import DEFAULT_CALIBRATION, GraspModels, features
@@ -50,22 +49,13 @@ class _CacheFiles:
         self.measurement, self.stability, self.info = (d / f"{key}_measurement.npz", d / f"{key}_stability.npz",
                                                        d / f"{key}.json")
 
-    def complete(self) -> bool:
-        """Whether all three files exist and match their checksums (a damaged one warns)."""
-        files = (self.measurement, self.stability, self.info)
-        if not all(f.exists() for f in files):
-            return False
-        return all([checked(f, "model cache file") for f in files])
-
     def load(self, settings: ModelSettings) -> Optional[GraspModels]:
-        """The cached models, or None (with a warning) if a file cannot be read."""
-        try:
-            info = json.loads(self.info.read_text())
-            models = GraspModels(_gp.load(self.measurement), _gp.load(self.stability), settings, info["joint_index"],
-                                 info)
-        except (OSError, ValueError, KeyError, EOFError, zipfile.BadZipFile) as e:
-            rebuild_warning(self.info, "model cache entry", e)
+        """The cached models, or None (a damaged or unreadable file warns) to rebuild them."""
+        info = load_checked(self.info, "model cache file", lambda p: json.loads(p.read_text()))
+        gps = [load_checked(f, "model cache file", _gp.load) for f in (self.measurement, self.stability)]
+        if info is None or None in gps:
             return None
+        models = GraspModels(gps[0], gps[1], settings, info["joint_index"], info)
         models.loaded_from_cache = True
         return models
 
@@ -150,11 +140,10 @@ def build_models(obj: Union[str, ObjectModel], hand="barrett_bh8", settings: Opt
     key = cache_key(world.object, hand_text, settings)
     say = progress or (lambda msg: None)
     files = None if cache_dir is None else _CacheFiles(cache_dir, key)
-    if files is not None and files.complete():
-        models = files.load(settings)
-        if models is not None:
-            say(f"models for {obj.name}: loaded from cache ({key})")
-            return models
+    models = None if files is None else files.load(settings)
+    if models is not None:
+        say(f"models for {obj.name}: loaded from cache ({key})")
+        return models
     models = _train(world, settings, key, say)
     if files is not None:
         files.save(models)

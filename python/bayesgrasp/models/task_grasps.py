@@ -23,7 +23,7 @@ from typing import Callable, List, Optional, Sequence, Union
 
 import numpy as np
 
-from ..cache import atomic_write_text, checked, rebuild_warning
+from ..cache import atomic_write_text, load_checked
 from ..objects import ObjectModel, load_object
 from ..world import World
 from .settings import CACHE_VERSION
@@ -208,12 +208,10 @@ def task_grasps(models: Sequence[Union[str, ObjectModel]], rule: TaskRule, hand:
     for m in models:
         o = load_object(m)
         f = None if cache_dir is None else Path(cache_dir) / f"task_{_key(o, hand_text, rule, s)}.json"
-        if f is not None and f.is_file() and checked(f, "task grasp cache file"):
-            try:
-                out += load_task_grasp_file(f)
-                continue
-            except ValueError as e:
-                rebuild_warning(f, "task grasp cache file", e)
+        cached = None if f is None else load_checked(f, "task grasp cache file", load_task_grasp_file)
+        if cached is not None:
+            out += cached
+            continue
         grasps = generate_task_grasps(o, rule, hand, s, say)
         if f is not None:
             atomic_write_text(f, json.dumps({"model": o.name, "task": rule.name,
