@@ -98,7 +98,9 @@ def test_approach_rules_by_hand():
     # tools are held off the table: from below (moving up, +z) is allowed too, along the handle never
     assert not tool.table and task_rule("mug", "top").table
     assert tool.approach_ok([[0, 0, -1], [0, 1, 0], [-1, 0, 0], [0, 0, 1]]).tolist() == [True, True, False, True]
-    assert not side.approach_ok([[0.6, 0, 0.8]]).any()            # a mug on the table: never from under it
+    from dataclasses import replace
+    on_table = replace(tool, table=True)                           # the same rule for a tool on a table
+    assert on_table.approach_ok([[0, 0, -1], [0, 1, 0], [0, 0, 1], [0, 0.6, 0.8]]).tolist() == [True, True, False, False]
 
 
 def test_a_tool_held_off_the_table_can_be_grasped_around_its_handle():
