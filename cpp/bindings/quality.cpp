@@ -1,6 +1,7 @@
 // Bindings for cpp/bayesgrasp/quality: grasp wrench space, Ferrari-Canny epsilon, volume. Thin:
 // convert arrays to contacts, release the GIL for the hulls; the core validates the parameters
 // and contacts (its std::invalid_argument becomes ValueError).
+#include <cstdint>
 #include <string>
 
 #include "bayesgrasp/quality/wrench_space.hpp"
@@ -109,16 +110,19 @@ Returns:
 }
 
 // Contacts of N grasps from (M, 3) points and normals and (N,) counts (sum M).
-std::vector<Contacts> grasps_from(const RowMatrixXd& P, const RowMatrixXd& N, const IArray& counts) {
+// Counts are read as int64 (a forced int32 cast would truncate 2^32 + 3 to 3) and checked.
+using CountArray = py::array_t<std::int64_t, py::array::c_style | py::array::forcecast>;
+std::vector<Contacts> grasps_from(const RowMatrixXd& P, const RowMatrixXd& N, const CountArray& counts) {
   if (counts.ndim() != 1) throw py::value_error("counts: expected shape (N,), got " + shape_str(counts));
   const py::ssize_t n = counts.shape(0);
   std::vector<Contacts> grasps(static_cast<size_t>(n));
   Eigen::Index row = 0;
   for (py::ssize_t i = 0; i < n; ++i) {
-    const int k = counts.data()[i];
+    const std::int64_t k = counts.data()[i];
     if (k < 0) throw py::value_error("counts: entry " + std::to_string(i) + " is negative");
     if (row + k > P.rows())
-      throw py::value_error("counts: sum exceeds the number of points (" + std::to_string(P.rows()) + ")");
+      throw py::value_error("counts: sum exceeds the number of points (" + std::to_string(P.rows()) + ") at entry " +
+                            std::to_string(i));
     grasps[static_cast<size_t>(i)] = contacts_from(P, N, row, row + k);
     row += k;
   }
@@ -130,7 +134,7 @@ std::vector<Contacts> grasps_from(const RowMatrixXd& P, const RowMatrixXd& N, co
 void bind_epsilon_volume_batch(py::module_& m) {
   m.def(
       "epsilon_volume_batch",
-      [](const DArray& points, const DArray& normals, const IArray& counts, const DArray& com, double torque_scale,
+      [](const DArray& points, const DArray& normals, const CountArray& counts, const DArray& com, double torque_scale,
          double mu, int n_edges, bool volume, int threads) {
         auto [P, N] = points_normals(points, normals);
         const std::vector<Contacts> grasps = grasps_from(P, N, counts);

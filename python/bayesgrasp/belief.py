@@ -19,6 +19,7 @@ from __future__ import annotations
 import warnings
 from typing import Callable, Optional, Sequence, Tuple
 
+from bayesgrasp._args import c_int, c_seed
 import numpy as np
 
 from bayesgrasp import _core
@@ -68,7 +69,7 @@ class ParticleBelief:
         self._b = _c.ParticleBelief(np.asarray(particles, dtype=float), np.asarray(low, dtype=float),
                                     np.asarray(high, dtype=float), _flags(wraps),
                                     None if log_weights is None else np.asarray(log_weights, dtype=float),
-                                    int(seed))
+                                    c_seed(seed, "seed"))
 
     @classmethod
     def _wrap(cls, core):
@@ -79,15 +80,15 @@ class ParticleBelief:
     @classmethod
     def uniform(cls, low, high, n: int, wraps=None, seed: int = 0) -> "ParticleBelief":
         """n particles uniform in the box."""
-        return cls._wrap(_c.ParticleBelief.uniform(np.asarray(low, float), np.asarray(high, float), int(n),
-                                                   _flags(wraps), int(seed)))
+        return cls._wrap(_c.ParticleBelief.uniform(np.asarray(low, float), np.asarray(high, float), c_int(n, "n"),
+                                                   _flags(wraps), c_seed(seed, "seed")))
 
     @classmethod
     def gaussian(cls, low, high, mean, std, n: int, wraps=None, seed: int = 0) -> "ParticleBelief":
         """n particles from N(mean, diag(std^2)) truncated to the box (wrapping dims wrapped)."""
         return cls._wrap(_c.ParticleBelief.gaussian(np.asarray(low, float), np.asarray(high, float),
-                                                    np.asarray(mean, float), np.asarray(std, float), int(n),
-                                                    _flags(wraps), int(seed)))
+                                                    np.asarray(mean, float), np.asarray(std, float), c_int(n, "n"),
+                                                    _flags(wraps), c_seed(seed, "seed")))
 
     # ---- state (read from the C++ belief) ---------------------------------------------------------
     particles = _core_property("particles", "(N, D) particle states (a copy).")
@@ -136,7 +137,7 @@ class ParticleBelief:
 
     def resample(self, scheme: str = "systematic", n: int = 0) -> None:
         """Resamples N (or n > 0) particles; weights become uniform."""
-        self._b.resample(scheme, int(n))
+        self._b.resample(scheme, c_int(n, "n"))
 
     def resample_if_needed(self, threshold: float = 0.5, scheme: str = "systematic") -> bool:
         """Resamples when ess < threshold * N; returns whether it did."""
@@ -147,7 +148,7 @@ class ParticleBelief:
         plus once at the start); proposal std ``step`` per dimension. Returns a
         :class:`bayesgrasp._core.belief.MetropolisStats` (``acceptance_rate``, ``evaluations``)."""
         return self._b.metropolis(log_target, np.broadcast_to(np.asarray(step, float), (self.dim,)).copy(),
-                                  int(n_steps))
+                                  c_int(n_steps, "n_steps"))
 
     def roughen(self, k: float = 0.2) -> None:
         """Gordon et al. roughening: jitter std k * spread * N^(-1/D) per dimension."""
@@ -194,8 +195,8 @@ def expected_posterior_entropy(log_weights, mean, var, n_samples: int = 100, see
     var = np.asarray(var, dtype=float)
     if mean.ndim == 1:
         mean, var = mean[:, None], var.reshape(-1, 1)
-    h, se = _c.expected_posterior_entropy(np.asarray(log_weights, float), mean, var, int(n_samples), int(seed),
-                                          int(n_threads))
+    h, se = _c.expected_posterior_entropy(np.asarray(log_weights, float), mean, var, c_int(n_samples, "n_samples"), c_seed(seed, "seed"),
+                                          c_int(n_threads, "n_threads"))
     if mean.ndim == 2:
         return float(h[0]), float(se[0])
     return h, se
@@ -210,7 +211,7 @@ def expected_posterior_entropy_gp(gp, belief: ParticleBelief, actions, n_samples
     core = _single_core_model(gp)
     if core is not None:
         return _c.expected_posterior_entropy_gp(core, belief.particles, belief.log_weights, actions,
-                                                int(n_samples), int(seed), int(n_threads))
+                                                c_int(n_samples, "n_samples"), c_seed(seed, "seed"), c_int(n_threads, "n_threads"))
     X = relative_planar_pose(actions, belief.particles)
     mv = [m.predict(X, True) for m in gp.models_]
     mean = np.concatenate([a for a, _ in mv], axis=1).reshape(len(actions), len(belief), -1)
@@ -242,7 +243,7 @@ def absolute_planar_pose_paired(relative, poses) -> np.ndarray:
 
 def resample_indices(weights, n: int, scheme: str = "systematic", seed: int = 0) -> np.ndarray:
     """Indices of n draws with probabilities proportional to weights (>= 0)."""
-    return np.asarray(_c.resample_indices(np.asarray(weights, float), int(n), scheme, int(seed)), dtype=np.int64)
+    return np.asarray(_c.resample_indices(np.asarray(weights, float), c_int(n, "n"), scheme, c_seed(seed, "seed")), dtype=np.int64)
 
 
 def gp_log_likelihood(gp, action, measurement) -> Callable[[np.ndarray], np.ndarray]:

@@ -19,6 +19,7 @@ from __future__ import annotations
 import inspect
 import os
 
+from bayesgrasp._args import c_int, c_seed
 import numpy as np
 
 from bayesgrasp import _core
@@ -93,9 +94,9 @@ class _GPBase:
     def _core_kwargs(self, D):
         ls = None if self.lengthscale is None else np.atleast_1d(np.asarray(self.lengthscale, dtype=float))
         return dict(kernel=self.kernel, lengthscale=ls, variance=float(self.variance), noise=float(self.noise),
-                    mean=self.mean, optimize=bool(self.optimize), max_iter=int(self.max_iter),
+                    mean=self.mean, optimize=bool(self.optimize), max_iter=c_int(self.max_iter, "max_iter"),
                     normalize_x=bool(self.normalize_x), normalize_y=bool(self.normalize_y),
-                    jitter=float(self.jitter), threads=int(self.threads))
+                    jitter=float(self.jitter), threads=c_int(self.threads, "threads"))
 
     def _check_fitted(self):
         if not hasattr(self, "models_"):
@@ -183,10 +184,10 @@ class _GPBase:
         (the planners' measurement draws, Eq. 3.2); include_noise adds the observation noise."""
         self._check_fitted()
         X = _as_2d(X, "X", self.n_features_in_)
-        if int(n_samples) < 1:
+        if c_int(n_samples, "n_samples") < 1:
             raise ValueError(f"n_samples: must be >= 1, got {n_samples}")
-        seed = int(seed) if seed is not None else 0
-        parts = [m.sample(X, int(n_samples), seed + 7919 * p, bool(include_noise), bool(joint))
+        seed = c_seed(seed, "seed") if seed is not None else 0
+        parts = [m.sample(X, c_int(n_samples, "n_samples"), (seed + 7919 * p) % 2**64, bool(include_noise), bool(joint))
                  for p, m in enumerate(self.models_)]
         s = np.concatenate(parts, axis=2)  # (S, N, P)
         s = np.transpose(s, (1, 2, 0))  # (N, P, S)
@@ -306,13 +307,12 @@ class SparseGP(_GPBase):
 
     def _check_params(self):
         super()._check_params()
-        if int(self.seed) < 0:  # the C++ seed is unsigned
-            raise ValueError(f"seed: must be >= 0, got {self.seed!r}")
+        c_seed(self.seed, "seed")  # the C++ seed is unsigned 64-bit
 
     def _core_kwargs(self, D):
         kw = super()._core_kwargs(D)
-        kw.update(n_inducing=int(self.n_inducing), optimize_inducing=bool(self.optimize_inducing),
-                  seed=int(self.seed), kmeans_iter=int(self.kmeans_iter))
+        kw.update(n_inducing=c_int(self.n_inducing, "n_inducing"), optimize_inducing=bool(self.optimize_inducing),
+                  seed=c_seed(self.seed, "seed"), kmeans_iter=c_int(self.kmeans_iter, "kmeans_iter"))
         if self.inducing is not None:
             kw["inducing"] = _as_2d(self.inducing, "inducing", D)
         return kw

@@ -20,6 +20,7 @@ from __future__ import annotations
 
 from typing import Callable, Optional, Sequence, Tuple, Union
 
+from bayesgrasp._args import c_int, c_seed
 import numpy as np
 
 from bayesgrasp import _core
@@ -50,7 +51,7 @@ def _options(cls, settings: dict):
         if isinstance(default, bool):
             value = bool(value)
         elif isinstance(default, int):
-            value = int(value)
+            value = c_seed(value, name) if name == "seed" else c_int(value, name)
         elif isinstance(default, float):
             value = float(value)
         setattr(o, name, value)

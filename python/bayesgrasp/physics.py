@@ -28,6 +28,7 @@ import os
 from pathlib import Path
 from typing import List, Optional, Sequence, Union
 
+from bayesgrasp._args import c_int, c_seed
 import numpy as np
 
 from bayesgrasp import _core
@@ -108,7 +109,7 @@ def convex_decomposition(vertices, faces, threshold: float = 0.05, seed: int = 0
         if cached is not None:
             return cached
     coacd.set_log_level("error")
-    parts = coacd.run_coacd(coacd.Mesh(V, F.astype(np.int32)), threshold=float(threshold), seed=int(seed),
+    parts = coacd.run_coacd(coacd.Mesh(V, F.astype(np.int32)), threshold=float(threshold), seed=c_seed(seed, "seed"),
                             **_COACD_SEARCH)
     pieces = [np.ascontiguousarray(p[0], dtype=np.float64) for p in parts if len(p[0]) >= 4]
     if not pieces:
@@ -186,13 +187,13 @@ class LiftTester:
         """One lift test (lifted, displacement, rotation, squeeze_displacement, height_gain,
         finite, steps, tetrahedra, shape, breakaway). ``trace_every`` > 0: ``result.trace`` records
         every that many steps (see :class:`bayesgrasp.lift_trace.LiftTrace`); 0: None."""
-        return self._t.run(np.asarray(hand_pose, dtype=float), np.asarray(joints, dtype=float), int(trace_every))
+        return self._t.run(np.asarray(hand_pose, dtype=float), np.asarray(joints, dtype=float), c_int(trace_every, "trace_every"))
 
     def run_batch(self, hand_poses, joints, threads=1) -> LiftBatch:
         """N lift tests ((N, 4, 4) poses, (N, J) joints) in C++ threads (0 = all cores): the
         LiftResult fields as (N,) arrays, ``shape`` the list of shapes used."""
         return self._t.run_batch(np.asarray(hand_poses, dtype=float), np.asarray(joints, dtype=float),
-                                 int(threads))
+                                 c_int(threads, "threads"))
 
 
 def lift_test(hand, hand_pose, joints, vertices, faces, **options) -> LiftResult:

@@ -12,6 +12,7 @@ wrenches do not span 6-D). Degenerate grasps are never an error::
 """
 from __future__ import annotations
 
+from bayesgrasp._args import c_int, c_seed
 import numpy as np
 
 from bayesgrasp import _core
@@ -37,7 +38,7 @@ def contact_wrenches(points, normals, com, torque_scale, mu=DEFAULT_FRICTION, n_
     """The primitive contact wrenches, (K * n_edges, 6) (K rows when ``mu == 0``)."""
     return _core.quality.contact_wrenches(_points(points, "points"), _points(normals, "normals"),
                                           np.asarray(com, dtype=float), float(torque_scale),
-                                          float(mu), int(n_edges))
+                                          float(mu), c_int(n_edges, "n_edges"))
 
 
 def epsilon_volume(points, normals, com, torque_scale, mu=DEFAULT_FRICTION, n_edges=DEFAULT_CONE_EDGES,
@@ -58,7 +59,7 @@ def epsilon_volume(points, normals, com, torque_scale, mu=DEFAULT_FRICTION, n_ed
     """
     return _core.quality.epsilon_volume(_points(points, "points"), _points(normals, "normals"),
                                         np.asarray(com, dtype=float), float(torque_scale),
-                                        float(mu), int(n_edges), bool(volume))
+                                        float(mu), c_int(n_edges, "n_edges"), bool(volume))
 
 
 def epsilon_volume_batch(points, normals, com, torque_scale, mu=DEFAULT_FRICTION, n_edges=DEFAULT_CONE_EDGES,
@@ -84,7 +85,7 @@ def epsilon_volume_batch(points, normals, com, torque_scale, mu=DEFAULT_FRICTION
                 raise ValueError(f"points[{i}]: expected shape (K, 3), got {p.shape}")
             if n.shape != p.shape:
                 raise ValueError(f"normals[{i}]: expected shape {p.shape}, got {n.shape}")
-        counts = np.array([len(p) for p in P], dtype=np.int32)
+        counts = np.array([len(p) for p in P], dtype=np.int64)
         points = np.concatenate(P) if P else np.zeros((0, 3))
         normals = np.concatenate(N) if N else np.zeros((0, 3))
     else:
@@ -92,7 +93,7 @@ def epsilon_volume_batch(points, normals, com, torque_scale, mu=DEFAULT_FRICTION
         counts = np.asarray(counts)
         if counts.size and not np.issubdtype(counts.dtype, np.integer):
             raise ValueError(f"counts: expected integers, got dtype {counts.dtype}")
-        counts = counts.astype(np.int32)
+        counts = counts.astype(np.int64)  # int32 would truncate 2**32 + 3 to 3
     return _core.quality.epsilon_volume_batch(points, normals, counts, np.asarray(com, dtype=float),
-                                              float(torque_scale), float(mu), int(n_edges), bool(volume),
-                                              int(threads))
+                                              float(torque_scale), float(mu), c_int(n_edges, "n_edges"), bool(volume),
+                                              c_int(threads, "threads"))

@@ -26,6 +26,7 @@ table): what :mod:`bayesgrasp.quality` consumes. Options are a :class:`SimOption
 """
 from __future__ import annotations
 
+from bayesgrasp._args import c_int, c_seed
 import numpy as np
 
 from bayesgrasp import _core
@@ -43,6 +44,9 @@ def set_fields(options, fields: dict, what: str):
     for k, v in fields.items():
         if k.startswith("_") or not hasattr(options, k):
             raise ValueError(f"{k}: not a {what} option")
+        default = getattr(options, k)
+        if isinstance(default, int) and not isinstance(default, bool):
+            v = c_seed(v, k) if k == "seed" else c_int(v, k)
         setattr(options, k, v)
     return options
 
@@ -121,13 +125,13 @@ class GraspSimulator:
         """N hand poses (N, 4, 4); spreads a number or (N,); threads 0 = all cores."""
         spreads = self._spread(None) if spreads is None else spreads
         spreads = float(spreads) if np.isscalar(spreads) else np.asarray(spreads, dtype=float)
-        return self.core.close_batch(np.asarray(hand_poses, dtype=float), spreads, int(threads))
+        return self.core.close_batch(np.asarray(hand_poses, dtype=float), spreads, c_int(threads, "threads"))
 
     def top_grasp_batch(self, xyyaw, spread: float | None = None, standoff: float = 0.0,
                         threads: int = 1) -> GraspBatch:
         """Top grasps at the rows (x, y, yaw) of an (N, 3) array."""
         return self.core.top_grasp_batch(np.asarray(xyyaw, dtype=float), self._spread(spread), float(standoff),
-                                         int(threads))
+                                         c_int(threads, "threads"))
 
     def approach(self, direction, target, roll: float = 0.0, spread: float | None = None,
                  standoff: float = 0.0) -> GraspResult:
@@ -142,7 +146,7 @@ class GraspSimulator:
         """N approaches: directions and targets (N, 3), rolls a number or (N,)."""
         rolls = float(rolls) if np.isscalar(rolls) else np.asarray(rolls, dtype=float)
         return self.core.approach_batch(np.asarray(directions, dtype=float), np.asarray(targets, dtype=float), rolls,
-                                        self._spread(spread), float(standoff), int(threads))
+                                        self._spread(spread), float(standoff), c_int(threads, "threads"))
 
     def link_object_distance(self, hand_pose, q, link: int) -> float:
         """Exact distance from one link to the object (m), <= 0 when penetrating."""

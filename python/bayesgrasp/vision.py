@@ -47,6 +47,7 @@ import math
 from dataclasses import dataclass, field
 from typing import Any, Callable, Dict, List, Optional, Sequence, Tuple, Union
 
+from bayesgrasp._args import c_int, c_seed
 import numpy as np
 
 from bayesgrasp import _core as _bgcore
@@ -159,8 +160,8 @@ class Camera:
         kw = dict(table=bool(table), table_z=float(tb.get("z", 0.0)),
                   table_center=np.asarray(tb.get("center", (0.0, 0.0)), float),
                   table_half_extents=np.asarray(tb.get("half_extents", (0.5, 0.5)), float))
-        depth, label = _v.render(ms, self.pose, width=int(self.width), height=int(self.height), **self._intr(),
-                                      noise=bool(noise), seed=int(seed), **kw, **noise_params)
+        depth, label = _v.render(ms, self.pose, width=c_int(self.width, "width"), height=c_int(self.height, "height"), **self._intr(),
+                                      noise=bool(noise), seed=c_seed(seed, "seed"), **kw, **noise_params)
         return np.asarray(depth), np.asarray(label)
 
     def points(self, depth: np.ndarray, world: bool = True, organised: bool = False) -> np.ndarray:
@@ -309,7 +310,7 @@ def _results(raw: Sequence, names: Sequence) -> List[RegistrationResult]:
 
 
 def _mesh_samples(V: np.ndarray, F: np.ndarray, options: RegistrationOptions, seed: int) -> Tuple[np.ndarray, np.ndarray]:
-    s = _v.model_from_mesh(V, F, options, seed=int(seed))
+    s = _v.model_from_mesh(V, F, options, seed=c_seed(seed, "seed"))
     return np.asarray(s.points), np.asarray(s.normals)
 
 
@@ -344,7 +345,7 @@ def model_samples(model, voxel: float = 0.005, seed: int = 0, samples: int = 0) 
     if given is not None:
         return given
     V, F = as_mesh(model, "model")
-    return _mesh_samples(V, F, RegistrationOptions(voxel=float(voxel), model_samples=int(samples)), seed)
+    return _mesh_samples(V, F, RegistrationOptions(voxel=float(voxel), model_samples=c_int(samples, "samples")), seed)
 
 
 def _model_clouds(models: Sequence, options: RegistrationOptions, model_seed: int) -> List[Tuple[np.ndarray, np.ndarray]]:
@@ -428,7 +429,7 @@ class Registrar:
 
     def preparation_time(self, i: int) -> float:
         """Seconds spent preparing model ``i`` (radius grid, downsampling, normals, FPFH)."""
-        return float(self._core.model_info(int(i)).time)
+        return float(self._core.model_info(c_int(i, "i")).time)
 
     def _indices(self, models) -> Optional[List[int]]:
         if models is None:
@@ -454,7 +455,7 @@ class Registrar:
         normalised over those; ``time_features`` is the cloud's feature time only."""
         P = as_cloud(cloud)
         idx = self._indices(models)
-        raw = self._core.register(P, seed=int(seed), viewpoint=_viewpoint(viewpoint), models=idx)
+        raw = self._core.register(P, seed=c_seed(seed, "seed"), viewpoint=_viewpoint(viewpoint), models=idx)
         return _results(raw, self.names if idx is None else [self.names[i] for i in idx])
 
 
@@ -487,7 +488,7 @@ def register(cloud, models: Sequence, options: Optional[RegistrationOptions] = N
     models = list(models)
     names = _model_names(names, len(models))
     P = as_cloud(cloud)
-    raw = _v.register_models(P, _model_clouds(models, options, model_seed), options, seed=int(seed),
+    raw = _v.register_models(P, _model_clouds(models, options, model_seed), options, seed=c_seed(seed, "seed"),
                              viewpoint=_viewpoint(viewpoint))
     return _results(raw, names)
 

@@ -68,7 +68,7 @@ def test_spread_chosen_by_the_pilot_is_recorded_and_fixed_spreads_are_kept(tmp_p
     pilot = auto.info["spread_pilot"]
     assert len(pilot) == len(AUTO_SPREADS)
     # the chosen spread has the best stable x lifted score of the pilot
-    score = {d: f * (l / t if t else 0.0) for d, (f, l, t) in pilot.items()}
+    score = {int(d): f * (l / t if t else 0.0) for d, (f, l, t) in pilot.items()}  # JSON keys are str
     assert score[round(np.degrees(auto.spread))] == max(score.values())
     fixed = build_models("cube", settings=ModelSettings(**{**SMALL.__dict__, "spread": 0.5}), cache_dir=tmp_path)
     assert fixed.spread == 0.5 and fixed.info["spread_pilot"] is None

@@ -17,8 +17,8 @@ constexpr double kLog2Pi = 1.8378770664093453;
 constexpr double kLogMinLikelihood = -708.3964185322641;
 
 void check_channels(const RelativePoseGrid& grid, const MeasurementChannels& ch) {
-  if (ch.k < 1 || ch.mean_c0 < 0 || ch.var_c0 < 0 || ch.mean_c0 + ch.k > grid.channels() ||
-      ch.var_c0 + ch.k > grid.channels())
+  const long long k = ch.k, end_mean = ch.mean_c0 + k, end_var = ch.var_c0 + k;  // 64-bit: no overflow
+  if (k < 1 || ch.mean_c0 < 0 || ch.var_c0 < 0 || end_mean > grid.channels() || end_var > grid.channels())
     throw std::invalid_argument("channels: mean and variance channels must lie inside the grid's " +
                                 std::to_string(grid.channels()) + " channels");
 }

@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <stdexcept>
+#include <string>
 
 #include "bayesgrasp/common/interval.hpp"
 
@@ -236,8 +238,12 @@ bool ParticleBelief::update(const BatchLogLikelihood& f) {
   return reweight(ll);
 }
 
+constexpr int kMaxParticles = 100000000;  // 10^8 particles: GBs of poses
+
 void ParticleBelief::resample(Rng& rng, Resampling scheme, int n) {
-  if (n <= 0) n = size();
+  if (n < 0) throw std::invalid_argument("n: must be >= 0 (0 = keep the particle count), got " + std::to_string(n));
+  if (n > kMaxParticles) throw std::invalid_argument("n: at most " + std::to_string(kMaxParticles) + " particles");
+  if (n == 0) n = size();
   const std::vector<int> idx = resample_indices(weights(), n, scheme, rng);
   RowMatrixXd Y(n, dim());
   for (int m = 0; m < n; ++m) Y.row(m) = X_.row(idx[m]);

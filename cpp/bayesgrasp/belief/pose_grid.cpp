@@ -84,7 +84,10 @@ RowMatrixXd RelativePoseGrid::interpolate_pairs(const RowMatrixXd& A, const RowM
                                                 int n_threads) const {
   check_planar_poses(A, "actions");
   check_planar_poses(P, "poses");
-  if (c0 < 0 || nc < 1 || c0 + nc > channels()) throw std::invalid_argument("channels: out of range");
+  // In 64 bits: c0 + nc overflows int for c0 near 2^31.
+  if (c0 < 0 || nc < 1 || static_cast<long long>(c0) + nc > channels())
+    throw std::invalid_argument("channels [" + std::to_string(c0) + ", " + std::to_string(static_cast<long long>(c0) + nc) +
+                                "): out of range for a grid of " + std::to_string(channels()) + " channels");
   const Eigen::Index na = A.rows(), n = P.rows();
   RowMatrixXd out(na * n, nc);
   const std::vector<PlanarFrame> frames = planar_frames(P);

@@ -54,6 +54,15 @@ void GaussianProcess::check_inputs(const Eigen::MatrixXd& X, const char* name) c
     throw std::invalid_argument(std::string(name) + ": expected " + std::to_string(dim_) + " columns, got " +
                                 std::to_string(X.cols()));
   if (!X.allFinite()) throw std::invalid_argument(std::string(name) + ": contains NaN or infinity");
+  check_magnitude(X, name);
+}
+
+// Squared distances of inputs beyond 1e150 overflow to infinity (and standardising them loses
+// every digit of their spread), so such inputs are refused instead of predicting NaN.
+void GaussianProcess::check_magnitude(const Eigen::MatrixXd& X, const char* name) {
+  constexpr double kMaxInput = 1e100;
+  if (X.size() > 0 && X.cwiseAbs().maxCoeff() > kMaxInput)
+    throw std::invalid_argument(std::string(name) + ": values beyond 1e100 in magnitude; rescale the inputs");
 }
 
 void GaussianProcess::set_training_data(const Eigen::MatrixXd& X, const Eigen::MatrixXd& Y) {
@@ -63,6 +72,9 @@ void GaussianProcess::set_training_data(const Eigen::MatrixXd& X, const Eigen::M
   if (Y.cols() == 0) throw std::invalid_argument("y: has no outputs");
   if (!X.allFinite()) throw std::invalid_argument("X: contains NaN or infinity");
   if (!Y.allFinite()) throw std::invalid_argument("y: contains NaN or infinity");
+  check_magnitude(X, "X");
+  if (Y.cwiseAbs().maxCoeff() > 1e100)
+    throw std::invalid_argument("y: values beyond 1e100 in magnitude; rescale the outputs");
   const Eigen::Index N = X.rows(), D = X.cols(), P = Y.cols();
   if (opt_.lengthscale.size() != 0 && opt_.lengthscale.size() != 1 && opt_.lengthscale.size() != D)
     throw std::invalid_argument("lengthscale: expected 1 or " + std::to_string(D) + " values, got " +
@@ -231,6 +243,7 @@ std::vector<Eigen::MatrixXd> GaussianProcess::sample_joint(const Eigen::MatrixXd
   const Eigen::MatrixXd m = predict_mean(X);
   const Eigen::Index N = X.rows();
   std::vector<Eigen::MatrixXd> out(n_samples, m);
+  if (N == 0) return out;  // (n_samples, 0, P): no covariance to factor
   std::normal_distribution<double> nd(0.0, 1.0);
   for (Eigen::Index p = 0; p < outputs_; ++p) {
     const Eigen::MatrixXd C = predict_cov(X, static_cast<int>(p), what);

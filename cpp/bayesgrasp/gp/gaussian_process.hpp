@@ -108,7 +108,10 @@ class GaussianProcess {
                                       Predictive what = Predictive::Latent) const;
 
   // ---- hyper-parameters and objective (standardised space) ----
-  virtual double log_marginal_likelihood() const { return lml_; }
+  virtual double log_marginal_likelihood() const {
+    check_fitted("log_marginal_likelihood");
+    return lml_;
+  }
   const Kernel& kernel() const { return kernel_; }
   double noise() const { return noise_; }
   const Eigen::VectorXd& mean_constant() const { return mean_c_; }  ///< (P,), zeros for MeanType::Zero
@@ -147,6 +150,7 @@ class GaussianProcess {
   void check_fitted(const char* what) const;
   void check_training_data(const char* what) const;
   void check_inputs(const Eigen::MatrixXd& X, const char* name) const;
+  static void check_magnitude(const Eigen::MatrixXd& X, const char* name);
   /// Standardises X, Y into Xn_, Yn_ and sets the normalisation; validates.
   void set_training_data(const Eigen::MatrixXd& X, const Eigen::MatrixXd& Y);
   /// Runs the hyper-parameter fit (hyperparameter_fit.hpp) from parameters(); n_inducing_params

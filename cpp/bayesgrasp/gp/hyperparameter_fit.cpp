@@ -25,8 +25,11 @@ Box data_box(const Eigen::MatrixXd& Xn, const Eigen::MatrixXd& Yn, Eigen::Index 
   double yv = 0.0;
   for (Eigen::Index p = 0; p < P; ++p) yv += (Yn.col(p).array() - Yn.col(p).mean()).square().mean();
   yv = yv / P;
-  if (!(yv > 1e-300)) yv = std::max(1e-300, Yn.array().square().mean());
-  if (!(yv > 1e-300)) yv = 1.0;
+  // Outputs constant to round-off (standardised residues ~1e-17, or one point) have no scale of
+  // their own: bounds relative to their ~1e-34 "variance" would let the signal variance reach
+  // 1e-34. Such data, and data without variance, take the unit scale.
+  if (!(yv > 1e-20)) yv = std::max(1e-300, Yn.array().square().mean());
+  if (!(yv > 1e-20)) yv = 1.0;
   for (Eigen::Index d = 0; d < D; ++d) {
     const Eigen::ArrayXd c = Xn.col(d).array();
     double range = c.maxCoeff() - c.minCoeff();
@@ -106,6 +109,9 @@ HyperparameterFit fit_hyperparameters(const GaussianProcess& model, const Eigen:
   const Eigen::Index D = Xn.cols();
   Box box = data_box(Xn, Yn, theta0.size());
   Eigen::VectorXd x = theta0.cwiseMax(box.lb).cwiseMin(box.ub);
+  // A start at the noise bound (an initial noise of 0) sits where the gradient in log noise
+  // vanishes, and L-BFGS-B stops there; start such a fit from 1e-2 of the output variance.
+  if (theta0[D + 1] <= box.lb[D + 1]) x[D + 1] = std::min(box.ub[D + 1], box.lb[D + 1] + std::log(1e7));
   if (objective == FitObjective::ProfiledScale) {
     const Box full = box;
     x = drop_variance(x, D, x[D + 1] - x[D]);
@@ -131,7 +137,12 @@ HyperparameterFit fit_hyperparameters(const GaussianProcess& model, const Eigen:
   if (objective == FitObjective::ProfiledScale) {  // back to [log lengthscales, log variance, log noise, ...]
     const Eigen::VectorXd& t = fn.best_x;
     fit.theta.resize(t.size() + 1);
-    fit.theta << t.head(D), fn.best_log_scale, t[D] + fn.best_log_scale, t.tail(t.size() - D - 1);
+    // The profiled scale s* = quad / (N P) is not bounded by the solver: for constant outputs
+    // (or one point) it runs to ~1e-300. Keep it, and the noise it implies, inside the box.
+    const Box full = data_box(Xn, Yn, theta0.size());
+    const double log_scale = std::clamp(fn.best_log_scale, full.lb[D], full.ub[D]);
+    const double log_noise = std::clamp(t[D] + log_scale, full.lb[D + 1], full.ub[D + 1]);
+    fit.theta << t.head(D), log_scale, log_noise, t.tail(t.size() - D - 1);
   }
   return fit;
 }

@@ -60,7 +60,10 @@ std::vector<Eigen::MatrixXd> IndependentOutputsGP::sample_joint(const Eigen::Mat
   return out;
 }
 
-double IndependentOutputsGP::log_marginal_likelihood() const { return lml_; }
+double IndependentOutputsGP::log_marginal_likelihood() const {
+  check_fitted("log_marginal_likelihood");
+  return lml_;
+}
 
 Eigen::VectorXd IndependentOutputsGP::parameters() const {
   check_fitted("parameters");

@@ -10,6 +10,7 @@ namespace bayesgrasp::optim {
 Result simulated_annealing(const BatchObjective& fun, const Bounds& b, const AnnealingOptions& o) {
   validate_bounds(b);
   if (o.n_chains < 1) throw std::invalid_argument("n_chains: must be at least 1");
+  if (std::isnan(o.t0) || std::isinf(o.t0)) throw std::invalid_argument("t0: must be finite (<= 0: from the initial points)");
   if (o.max_iter < 0) throw std::invalid_argument("max_iter: must be >= 0");
   if (!(o.cooling > 0.0 && o.cooling <= 1.0)) throw std::invalid_argument("cooling: must be in (0, 1]");
   if (!(o.step > 0.0)) throw std::invalid_argument("step: must be positive");

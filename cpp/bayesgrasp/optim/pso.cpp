@@ -1,6 +1,8 @@
 #include "bayesgrasp/optim/pso.hpp"
 
 #include <cmath>
+#include <stdexcept>
+#include <string>
 
 #include "bayesgrasp/common/random.hpp"
 
@@ -15,6 +17,9 @@ Result pso(const BatchObjective& fun, const Bounds& b, const PSOOptions& o) {
   if (!std::isfinite(o.inertia)) throw std::invalid_argument("inertia: must be finite");
   if (!std::isfinite(o.c1)) throw std::invalid_argument("c1: must be finite");
   if (!std::isfinite(o.c2)) throw std::invalid_argument("c2: must be finite");
+  if (o.stall_iter < 0) throw std::invalid_argument("stall_iter: must be >= 0 (0: off), got " + std::to_string(o.stall_iter));
+  if (!(o.ftol >= 0.0)) throw std::invalid_argument("ftol: must be >= 0");
+  if (std::isnan(o.target)) throw std::invalid_argument("target: is NaN");
   const int n = o.n_particles, d = b.dim();
   validate_population(o, n, d, "n_particles");
 

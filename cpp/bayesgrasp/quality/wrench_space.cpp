@@ -48,7 +48,11 @@ Vec3 tangent_hint(const Vec3& n, const Vec3& p, const Vec3& com, const Vec3& cen
 void validate_quality_params(const QualityParams& params, const Vec3& com, double torque_scale) {
   if (!std::isfinite(params.mu) || params.mu < 0.0)
     throw std::invalid_argument("mu: must be finite and >= 0, got " + std::to_string(params.mu));
-  if (params.n_edges < 3) throw std::invalid_argument("n_edges: must be >= 3, got " + std::to_string(params.n_edges));
+  // The hull of n_edges x contacts 6-D points grows fast: more than 256 edges per cone would
+  // take minutes per grasp (the default is 8).
+  if (params.n_edges < 3 || params.n_edges > kMaxConeEdges)
+    throw std::invalid_argument("n_edges: must be in [3, " + std::to_string(kMaxConeEdges) + "], got " +
+                                std::to_string(params.n_edges));
   if (!std::isfinite(torque_scale) || !(torque_scale > 0.0))
     throw std::invalid_argument("torque_scale: must be positive and finite, got " + std::to_string(torque_scale));
   if (!com.allFinite()) throw std::invalid_argument("com: contains NaN or infinity");

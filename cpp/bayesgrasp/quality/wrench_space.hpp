@@ -49,6 +49,7 @@ namespace bayesgrasp {
 constexpr double kDefaultFriction = 0.5;
 /// Default number of edges of the linearised friction cone.
 constexpr int kDefaultConeEdges = 8;
+constexpr int kMaxConeEdges = 256;  // upper bound on n_edges (validate_quality_params)
 
 /// One row per wrench: (fx, fy, fz, tx, ty, tz), torques already divided by torque_scale.
 using Wrenches = Eigen::Matrix<double, Eigen::Dynamic, 6, Eigen::RowMajor>;

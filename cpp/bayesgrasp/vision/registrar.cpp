@@ -159,6 +159,14 @@ ModelCloud model_from_mesh(const TriMesh& mesh, const RegistrationOptions& optio
 }
 
 double rotation_error(const Mat3& Ra, const Mat3& Rb, const Vec3& axis) {
+  // Both must be rotations: R^T R = I and det R = +1 (to 1e-6).
+  auto check = [](const Mat3& R, const char* name) {
+    if (!R.allFinite() || !(R.transpose() * R).isApprox(Mat3::Identity(), 1e-6) || !(std::abs(R.determinant() - 1.0) < 1e-6))
+      throw std::invalid_argument(std::string(name) + ": is not a rotation matrix (R^T R = I, det R = 1)");
+  };
+  check(Ra, "Ra");
+  check(Rb, "Rb");
+  if (!axis.allFinite()) throw std::invalid_argument("axis: contains NaN or infinity");
   if (axis.norm() > 0) {
     const Vec3 a = axis.normalized();
     return std::acos(std::clamp((Ra * a).dot(Rb * a), -1.0, 1.0));

@@ -64,12 +64,18 @@ void validate_steps(const RegistrationOptions& o) {
 }
 }  // namespace
 
+constexpr int kMaxModelSamples = 10000000;
+
 void validate(const RegistrationOptions& o) {
   positive(o.voxel, "voxel");
   positive(o.inlier_distance, "inlier_distance");
   positive(o.weight_sigma, "weight_sigma");
   at_least(o.min_scene_points, 1, "min_scene_points");
   at_least(o.model_samples, 0, "model_samples");
+  // 10^7 points and normals are 480 MB; more would only exhaust memory (the default is <= 200000).
+  if (o.model_samples > kMaxModelSamples)
+    throw std::invalid_argument("model_samples: at most " + std::to_string(kMaxModelSamples) + ", got " +
+                                std::to_string(o.model_samples));
   thread_count(o.threads, "threads");
   validate_steps(o);
 }

@@ -34,6 +34,27 @@ def join_negative_values(argv: Sequence[str]) -> List[str]:
     return out
 
 
+SEED_MAX = 2**63 - 1
+
+
+def bounded_int(lo: int, hi: int):
+    """An argparse type: an integer in [lo, hi]; argparse names the option in the error
+    (``argument --seed: expected an integer in [0, 2^63 - 1], got '-1'``), before any work."""
+    hi_text = "2^63 - 1" if hi == SEED_MAX else str(hi)
+
+    def parse(text: str) -> int:
+        try:
+            v = int(text)
+        except ValueError:
+            v = None
+        if v is None or not lo <= v <= hi:
+            raise argparse.ArgumentTypeError(f"expected an integer in [{lo}, {hi_text}], got {text!r}")
+        return v
+
+    parse.__name__ = "integer"
+    return parse
+
+
 def floats(text: str, n: int, what: str) -> List[float]:
     """``n`` finite comma-separated numbers from ``text`` (``what`` names the option in errors)."""
     try:
@@ -77,7 +98,7 @@ def add_context_options(p: argparse.ArgumentParser, lift: bool = False, seed: bo
     p.add_argument("--cache", default=None, help="model cache directory (default: $BAYESGRASP_CACHE/models, "
                                                  "$BAYESGRASP_CACHE defaulting to ~/.cache/bayesgrasp)")
     if seed:
-        p.add_argument("--seed", type=int, default=0, help="seed")
+        p.add_argument("--seed", type=bounded_int(0, SEED_MAX), default=0, help="seed")
     p.add_argument("--set", action="append", default=[], metavar="models.FIELD=VALUE",
                    help="override a grasp-model setting (bayesgrasp.models.ModelSettings), e.g. models.n_samples=500; "
                         "repeatable")
@@ -110,6 +131,8 @@ def context(args: argparse.Namespace, progress: bool = True):
     """The :class:`~bayesgrasp.experiments.context.RunContext` of a command, built once from its options."""
     from ..experiments.context import RunContext, stderr_progress
 
+    if getattr(args, "cache", None):
+        out_dir(args.cache, "--cache")  # before minutes of model building
     success, lift = getattr(args, "success", "lift"), not getattr(args, "no_lift", False)
     if success == "lift" and not lift:
         raise CliError("--no-lift: needs --success epsilon (success 'lift' is decided by the lift test)")

@@ -3,14 +3,14 @@ from __future__ import annotations
 
 import time
 
-from .args import CliError, add_context_options, context, out_dir
+from .args import CliError, add_context_options, bounded_int, context, out_dir
 
 
 def add(sub) -> None:
     e = sub.add_parser("experiment", help="run (or resume) one of the thesis's experiments")
     e.add_argument("name", help="the experiment's name; `bayesgrasp experiment list` lists them")
-    e.add_argument("--runs", type=int, default=None, help="runs per object (default: the experiment's)")
-    e.add_argument("--workers", type=int, default=1, help="worker processes")
+    e.add_argument("--runs", type=bounded_int(1, 10**7), default=None, help="runs per object (default: the experiment's)")
+    e.add_argument("--workers", type=bounded_int(1, 1024), default=1, help="worker processes")
     e.add_argument("--out", default=None, help="output directory (default: out/experiments/NAME)")
     e.add_argument("--objects", nargs="+", default=None, help="objects (default: the experiment's)")
     add_context_options(e, lift=True)

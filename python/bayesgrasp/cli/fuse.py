@@ -7,7 +7,8 @@ import json
 
 import numpy as np
 
-from .args import CliError, add_category_options, add_context_options, context, floats, output_file, task_grasps_arg
+from .args import (CliError, add_category_options, add_context_options, bounded_int, context, floats, output_file,
+                   task_grasps_arg)
 
 
 def add(sub) -> None:
@@ -17,7 +18,7 @@ def add(sub) -> None:
     f.add_argument("--task", default="top", help="the task whose demonstrated top grasps define P(T)")
     f.add_argument("--scene-object", required=True, help="the new object (built-in name or mesh file)")
     f.add_argument("--pose", default="0,0,0", metavar="X,Y,YAW", help="its pose on the table")
-    f.add_argument("--rounds", type=int, default=3, help="tactile rounds after the first grasp")
+    f.add_argument("--rounds", type=bounded_int(0, 1000), default=3, help="tactile rounds after the first grasp")
     f.add_argument("--start", choices=["vision", "random"], default="vision",
                    help="G(0): planned from the view (Eq. 4.6's task term) or at random above the object")
     f.add_argument("--belief", choices=["map", "particles"], default="map",

@@ -7,7 +7,7 @@ from pathlib import Path
 
 import numpy as np
 
-from .args import CliError, add_context_options, context, floats, out_dir, output_file
+from .args import CliError, add_context_options, bounded_int, context, floats, out_dir, output_file
 
 METHODS = ["stability", "explore", "ml_pose", "open_loop"]
 
@@ -26,7 +26,7 @@ def add(sub) -> None:
     p.add_argument("--method", default="explore", choices=METHODS)
     p.add_argument("--estimate", default=None, metavar="X,Y,YAW",
                    help="the initial pose estimate (default: true pose + uniform noise within the belief)")
-    p.add_argument("--attempts", type=int, default=4)
+    p.add_argument("--attempts", type=bounded_int(1, 1000), default=4)
     p.add_argument("--noise", type=float, default=0.0, help="joint-angle measurement noise std (rad)")
     p.add_argument("--png", default=None, help="write a PNG of the belief's evolution")
     p.add_argument("--json", action="store_true", help="print one JSON object")

@@ -6,7 +6,7 @@ import json
 
 import numpy as np
 
-from .args import CliError, floats, output_file
+from .args import SEED_MAX, CliError, bounded_int, floats, output_file
 
 
 def add(sub) -> None:
@@ -15,7 +15,7 @@ def add(sub) -> None:
     r.add_argument("--pose", default="0,0,0", metavar="X,Y,YAW", help="its pose on the table")
     r.add_argument("--models", required=True, nargs="+", metavar="NAME_OR_PATH", help="models to register against")
     r.add_argument("--voxel", type=float, default=0.005, help="voxel size (m); all radii scale from it")
-    r.add_argument("--seed", type=int, default=0)
+    r.add_argument("--seed", type=bounded_int(0, SEED_MAX), default=0)
     r.add_argument("--png", default=None, help="write a PNG of the cloud over each registered model")
     r.add_argument("--json", action="store_true", help="print one JSON object")
     r.set_defaults(run=run)

@@ -11,7 +11,7 @@ import json
 
 import numpy as np
 
-from .args import CliError, floats, output_file
+from .args import SEED_MAX, CliError, bounded_int, floats, output_file
 
 
 def add(sub) -> None:
@@ -23,11 +23,11 @@ def add(sub) -> None:
     t.add_argument("--optimizer", default="pso", choices=["pso", "sa", "firefly", "descent", "trust_region"])
     t.add_argument("--size", action="store_true", help="estimate the scale too (4 DoF; the guess is scale 1)")
     t.add_argument("--orientation-only", action="store_true", help="estimate the yaw alone, the position given")
-    t.add_argument("--budget", type=int, default=2000, help="fitness evaluations (re-simulated closings)")
+    t.add_argument("--budget", type=bounded_int(1, 10**7), default=2000, help="fitness evaluations (re-simulated closings)")
     t.add_argument("--contact-term", default="flags", choices=["flags", "surface"],
                    help="0/1 contact flags, or the continuous distance of the touching links to the surface")
     t.add_argument("--spread", type=float, default=None, help="finger spread of the touch (rad); default: the hand's")
-    t.add_argument("--seed", type=int, default=0, help="the optimiser's seed")
+    t.add_argument("--seed", type=bounded_int(0, SEED_MAX), default=0, help="the optimiser's seed")
     t.add_argument("--hand", default="barrett_bh8", help="hand file name or path")
     t.add_argument("--json", action="store_true", help="print one JSON object")
     t.add_argument("--png", default=None, metavar="PATH", help="write the fitness landscape to this PNG")

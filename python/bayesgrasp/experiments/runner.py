@@ -11,6 +11,7 @@ from __future__ import annotations
 import hashlib
 import json
 import multiprocessing
+import os
 import sqlite3
 import sys
 from concurrent.futures import FIRST_COMPLETED, ProcessPoolExecutor, wait
@@ -70,6 +71,23 @@ class ResultStore:
         self._db.close()
 
 
+def _die_with_parent(parent_pid: int, interval: float = 0.5) -> None:
+    """Worker initializer: a daemon thread ends this worker once its parent is gone (a parent
+    killed by SIGKILL cannot tell its pool to stop, and the workers would run on indefinitely;
+    when the last of them ends, multiprocessing's resource tracker sees its pipe close and ends
+    too)."""
+    import threading
+    import time
+
+    def watch():
+        while True:
+            if os.getppid() != parent_pid:
+                os._exit(1)
+            time.sleep(interval)
+
+    threading.Thread(target=watch, name="bayesgrasp-parent-watchdog", daemon=True).start()
+
+
 def _call(fn, key: RunKey):
     return key, fn(key.experiment, key.object, key.run_index, key.seed)
 
@@ -99,7 +117,8 @@ def run_experiment(experiment: str, objects: Iterable[str], runs: int, fn: Calla
         else:
             # spawn, not fork: a forked child inherits OpenMP's thread pool in a broken state
             # (the parent has run parallel C++ batches) and hangs in its first parallel region
-            with ProcessPoolExecutor(max_workers=workers, mp_context=multiprocessing.get_context("spawn")) as pool:
+            with ProcessPoolExecutor(max_workers=workers, mp_context=multiprocessing.get_context("spawn"),
+                                     initializer=_die_with_parent, initargs=(os.getpid(),)) as pool:
                 pending = {pool.submit(_call, fn, k) for k in todo}
                 try:
                     while pending:

@@ -144,10 +144,24 @@ def build_models(obj: Union[str, ObjectModel], hand="barrett_bh8", settings: Opt
     if models is not None:
         say(f"models for {obj.name}: loaded from cache ({key})")
         return models
-    models = _train(world, settings, key, say)
-    if files is not None:
-        files.save(models)
-    return models
+    return _as_reloaded(_train(world, settings, key, say), files, settings, key)
+
+
+def _as_reloaded(models: GraspModels, files: Optional[_CacheFiles], settings: ModelSettings, key: str) -> GraspModels:
+    """The freshly fitted models as a later run will load them: saved (to the cache, or to a
+    temporary directory without one) and read back. A reloaded GP re-factors from its stored
+    hyper-parameters and predicts ~1e-14 away from the fitted one, so returning the fitted one
+    would make a cold-cache run differ in its last digits from a warm one."""
+    import tempfile
+
+    with tempfile.TemporaryDirectory(prefix="bayesgrasp-models-") as tmp:
+        target = files if files is not None else _CacheFiles(tmp, key)
+        target.save(models)
+        reloaded = target.load(settings)
+    if reloaded is None:  # the cache could not be read back: keep what was fitted
+        return models
+    reloaded.loaded_from_cache = False
+    return reloaded
 
 
 _MODELS: dict = {}

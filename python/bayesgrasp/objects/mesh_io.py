@@ -140,6 +140,18 @@ def orient_outward(V: np.ndarray, F: np.ndarray) -> np.ndarray:
     return F
 
 
+def _check_solid(V: np.ndarray, F: np.ndarray, name: str) -> None:
+    """ValueError unless the mesh's vertices span three dimensions: a single triangle, a flat
+    square or a line has no volume, mass or convex hull (Qhull fails on it)."""
+    used = V[np.unique(F)]
+    if len(used) < 4:
+        raise ValueError(f"mesh '{name}' is degenerate: {len(used)} vertices cannot enclose a volume")
+    s = np.linalg.svd(used - used.mean(axis=0), compute_uv=False)
+    if not s[2] > 1e-9 * s[0]:
+        raise ValueError(f"mesh '{name}' is flat (all its vertices lie in a plane or on a line): "
+                         "an object needs a volume")
+
+
 @dataclass
 class ObjectModel:
     """A rigid object: a closed triangle mesh (metres) of uniform density (kg/m^3).
@@ -196,6 +208,7 @@ class ObjectModel:
                                                             what=f"parts of '{self.name}'")
         elif self.part_names:
             raise ValueError(f"part_names of '{self.name}' given without parts")
+        _check_solid(self.vertices, self.faces, self.name)
         self._watertight = mesh_is_watertight(self.faces)
         self.mass_from_hull = not self._watertight
         if self._watertight:

@@ -18,6 +18,7 @@ that resampled copies spread out again.
 from __future__ import annotations
 
 import time
+import warnings
 from dataclasses import dataclass, replace
 from typing import List, Optional, Sequence
 
@@ -75,6 +76,15 @@ class PlannerSettings:
             raise ValueError(f"explore_stability_weight: must be >= 0, got {self.explore_stability_weight}")
         if self.metropolis_steps < 0:
             raise ValueError(f"metropolis_steps: must be >= 0, got {self.metropolis_steps}")
+        ms = np.asarray(self.metropolis_step, dtype=float)
+        if ms.shape != (3,) or not np.all(np.isfinite(ms)) or np.any(ms <= 0):
+            raise ValueError(f"metropolis_step: expected three positive numbers (m, m, rad), got {self.metropolis_step}")
+        if not 0.0 <= self.outcome_floor < 0.5:
+            raise ValueError(f"outcome_floor: must be in [0, 0.5), got {self.outcome_floor}")
+        if not (np.isfinite(self.action_margin) and self.action_margin >= 0):
+            raise ValueError(f"action_margin: must be >= 0 (m), got {self.action_margin}")
+        if not isinstance(self.threads, (int, np.integer)) or isinstance(self.threads, bool) or self.threads < 0:
+            raise ValueError(f"threads: must be an int >= 0 (0 = all cores), got {self.threads!r}")
 
     def with_(self, **kw) -> "PlannerSettings":
         return replace(self, **kw)
@@ -101,6 +111,24 @@ class Observation:
     action: np.ndarray
     measurement: np.ndarray
     stable: bool
+
+
+class MeasurementWarning(UserWarning):
+    """A measurement outside what the hand can read (it is still used)."""
+
+
+# No revolute joint of a hand file turns more than half a turn from zero.
+MAX_JOINT_ANGLE = np.pi
+
+
+def _outcome(stable) -> bool:
+    """The grasp outcome as a bool: True/False, numpy bools or the ints 0/1; anything else (a
+    string such as "no" would be truthy) is a TypeError naming the argument."""
+    if isinstance(stable, (bool, np.bool_)):
+        return bool(stable)
+    if isinstance(stable, (int, np.integer)) and stable in (0, 1):
+        return bool(stable)
+    raise TypeError(f"stable: expected a bool (or 0/1), got {stable!r}")
 
 
 def wrap_angle(a):
@@ -182,10 +210,15 @@ class Planner:
             raise ValueError(f"action: expected (x, y, yaw), got {action}")
         if m.shape != (self.models.n_joints,) or not np.all(np.isfinite(m)):
             raise ValueError(f"measurement: expected {self.models.n_joints} finite joint angles, got {m.shape}")
-        obs = Observation(a, m, bool(stable))
+        stable = _outcome(stable)
+        if np.any(np.abs(m) > MAX_JOINT_ANGLE):
+            warnings.warn(f"measurement: joint angles {m.tolist()} lie beyond +-{MAX_JOINT_ANGLE:.2f} rad, outside "
+                          "any joint's range (degrees instead of radians?); the belief will collapse onto the "
+                          "few poses least unlikely under it", MeasurementWarning, stacklevel=2)
+        obs = Observation(a, m, stable)
         self.observations.append(obs)
         self._update(obs)
-        self.history.append({"action": a.tolist(), "measurement": m.tolist(), "stable": bool(stable),
+        self.history.append({"action": a.tolist(), "measurement": m.tolist(), "stable": stable,
                              "mean": self.belief.mean().tolist(), "ess": float(self.belief.ess())})
 
     def _update(self, obs: Observation) -> None:
