@@ -15,7 +15,7 @@ DEB_PACKAGES := build-essential cmake pkg-config python3-dev python3-venv \
 SOURCES := $(shell find cpp python tests/cpp bench -type f \( -name '*.cpp' -o -name '*.hpp' -o -name '*.h' -o -name '*.py' -o -name '*.json' \) 2>/dev/null) \
            CMakeLists.txt pyproject.toml
 
-.PHONY: all demo test bench deps clean distclean ctest pytest
+.PHONY: all demo test bench deps clean distclean ctest pytest fuzz
 all: $(VENV)/.installed
 
 # ---- system packages -------------------------------------------------------------------
@@ -56,6 +56,11 @@ pytest: $(VENV)/.installed
 	$(VENV)/bin/python -m pytest -q tests/python
 
 test: ctest pytest
+
+# The long run of the bindings' property-based fuzzing (make test runs 25 cases per target).
+FUZZ_EXAMPLES ?= 1000
+fuzz: $(VENV)/.installed
+	BAYESGRASP_FUZZ_EXAMPLES=$(FUZZ_EXAMPLES) BAYESGRASP_FUZZ_REPORT=out/fuzz.jsonl $(VENV)/bin/python -m pytest -q tests/python/test_fuzz.py
 
 # ---- benchmarks ----------------------------------------------------------------------------
 # Peers (GPy, pyswarms, pybullet, scikit-learn) live in their own virtual environment.

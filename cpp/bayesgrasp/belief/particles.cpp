@@ -161,9 +161,12 @@ ParticleBelief::ParticleBelief(StateSpace space, RowMatrixXd particles, Eigen::V
   }
 }
 
+constexpr int kMaxParticles = 10000000;  // 10^7 particles: hundreds of MB of poses and weights
+
 ParticleBelief ParticleBelief::uniform(const StateSpace& space, int n, Rng& rng) {
   space.validate();
   if (n < 1) throw std::invalid_argument("n: zero particles");
+  if (n > kMaxParticles) throw std::invalid_argument("n: at most " + std::to_string(kMaxParticles) + " particles");
   RowMatrixXd X(n, space.dim());
   for (int i = 0; i < n; ++i)
     for (int k = 0; k < space.dim(); ++k) {
@@ -177,6 +180,7 @@ ParticleBelief ParticleBelief::gaussian(const StateSpace& space, const Eigen::Ve
                                         const Eigen::VectorXd& std, int n, Rng& rng) {
   space.validate();
   if (n < 1) throw std::invalid_argument("n: zero particles");
+  if (n > kMaxParticles) throw std::invalid_argument("n: at most " + std::to_string(kMaxParticles) + " particles");
   if (mean.size() != space.dim() || !mean.allFinite())
     throw std::invalid_argument("mean: expected a finite vector of the state's dimension");
   if (std.size() != space.dim() || !std.allFinite() || (std.array() < 0.0).any())
@@ -237,8 +241,6 @@ bool ParticleBelief::update(const BatchLogLikelihood& f) {
   f(X_, ll);
   return reweight(ll);
 }
-
-constexpr int kMaxParticles = 100000000;  // 10^8 particles: GBs of poses
 
 void ParticleBelief::resample(Rng& rng, Resampling scheme, int n) {
   if (n < 0) throw std::invalid_argument("n: must be >= 0 (0 = keep the particle count), got " + std::to_string(n));

@@ -57,6 +57,13 @@ void GaussianProcess::check_inputs(const Eigen::MatrixXd& X, const char* name) c
   check_magnitude(X, name);
 }
 
+// n_samples x N x P draws beyond 10^8 values (800 MB) only exhaust memory.
+void GaussianProcess::check_draw_size(long long n_samples, long long rows, long long outputs) {
+  if (n_samples * std::max(rows, 1LL) * std::max(outputs, 1LL) > 100000000LL)
+    throw std::invalid_argument("n_samples: " + std::to_string(n_samples) + " draws of " + std::to_string(rows) +
+                                " inputs exceed 10^8 values");
+}
+
 // Squared distances of inputs beyond 1e150 overflow to infinity (and standardising them loses
 // every digit of their spread), so such inputs are refused instead of predicting NaN.
 void GaussianProcess::check_magnitude(const Eigen::MatrixXd& X, const char* name) {
@@ -226,6 +233,7 @@ Eigen::VectorXd GaussianProcess::log_predictive_density(const Eigen::MatrixXd& X
 std::vector<Eigen::MatrixXd> GaussianProcess::sample(const Eigen::MatrixXd& X, int n_samples, std::mt19937_64& rng,
                                                      Predictive what) const {
   if (n_samples < 1) throw std::invalid_argument("n_samples: must be >= 1");
+  check_draw_size(n_samples, X.rows(), outputs_);
   Eigen::MatrixXd m, v;
   predict(X, m, v, what);
   const Eigen::MatrixXd sd = v.cwiseMax(0.0).cwiseSqrt();
@@ -240,6 +248,7 @@ std::vector<Eigen::MatrixXd> GaussianProcess::sample(const Eigen::MatrixXd& X, i
 std::vector<Eigen::MatrixXd> GaussianProcess::sample_joint(const Eigen::MatrixXd& X, int n_samples,
                                                            std::mt19937_64& rng, Predictive what) const {
   if (n_samples < 1) throw std::invalid_argument("n_samples: must be >= 1");
+  check_draw_size(n_samples, X.rows(), outputs_);
   const Eigen::MatrixXd m = predict_mean(X);
   const Eigen::Index N = X.rows();
   std::vector<Eigen::MatrixXd> out(n_samples, m);

@@ -151,6 +151,7 @@ class GaussianProcess {
   void check_training_data(const char* what) const;
   void check_inputs(const Eigen::MatrixXd& X, const char* name) const;
   static void check_magnitude(const Eigen::MatrixXd& X, const char* name);
+  static void check_draw_size(long long n_samples, long long rows, long long outputs);
   /// Standardises X, Y into Xn_, Yn_ and sets the normalisation; validates.
   void set_training_data(const Eigen::MatrixXd& X, const Eigen::MatrixXd& Y);
   /// Runs the hyper-parameter fit (hyperparameter_fit.hpp) from parameters(); n_inducing_params

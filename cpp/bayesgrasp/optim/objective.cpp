@@ -1,5 +1,6 @@
 #include "bayesgrasp/optim/objective.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 
@@ -17,6 +18,10 @@ void validate_bounds(const Bounds& b) {
 }
 
 void validate_population(const PopulationOptions& o, int n, int d, const char* size_name) {
+  // n x d positions, velocities and bests: 10^8 values are GBs; more only exhausts memory.
+  if (static_cast<long long>(n) * std::max(d, 1) > 100000000LL)
+    throw std::invalid_argument(std::string(size_name) + ": " + std::to_string(n) + " x " + std::to_string(d) +
+                                " dimensions exceed 10^8 values");
   if (o.init.size() == 0) return;
   if (o.init.rows() != n || o.init.cols() != d)
     throw std::invalid_argument(std::string("init: expected shape (") + size_name + ", D) = (" + std::to_string(n) +
