@@ -60,7 +60,7 @@ test: ctest pytest
 # The long run of the bindings' property-based fuzzing (make test runs 25 cases per target).
 FUZZ_EXAMPLES ?= 1000
 fuzz: $(VENV)/.installed
-	BAYESGRASP_FUZZ_EXAMPLES=$(FUZZ_EXAMPLES) BAYESGRASP_FUZZ_REPORT=out/fuzz.jsonl $(VENV)/bin/python -m pytest -q tests/python/test_fuzz.py
+	mkdir -p out && BAYESGRASP_FUZZ_EXAMPLES=$(FUZZ_EXAMPLES) BAYESGRASP_FUZZ_REPORT=out/fuzz.jsonl $(VENV)/bin/python -m pytest -q tests/python/test_fuzz.py
 
 # ---- benchmarks ----------------------------------------------------------------------------
 # Peers (GPy, pyswarms, pybullet, scikit-learn) live in their own virtual environment.
