@@ -30,10 +30,6 @@ def run(args) -> int:
         get_experiment(args.name)
     except ValueError as e:
         raise CliError(str(e)) from None
-    if args.runs is not None and args.runs < 1:
-        raise CliError(f"--runs: must be at least 1, got {args.runs}")
-    if args.workers < 1:
-        raise CliError(f"--workers: must be at least 1, got {args.workers}")
     for o in args.objects or ():
         load_object(o)  # a clear error for an unknown object
     out = out_dir(args.out or f"out/experiments/{args.name}")
