@@ -114,3 +114,55 @@ def test_task_grasp_files_are_validated(tmp_path):
     bad.write_text(json.dumps({"grasps": [{"model": "mug/1", "task": "top", "pose": T.tolist(), "spread": 0}]}))
     with pytest.raises(ValueError, match="rigid"):
         load_task_grasp_file(bad)
+
+
+@pytest.fixture(scope="module")
+def scan(tmp_path_factory):
+    """examples/make_scan.py, run as the README runs it: a mug seen 10 cm off the origin."""
+    import subprocess
+    import sys
+    from pathlib import Path
+
+    out = tmp_path_factory.mktemp("scan")
+    root = Path(__file__).resolve().parents[2]
+    p = subprocess.run([sys.executable, str(root / "examples" / "make_scan.py"), "--object", "mug/3", "--pose",
+                        "0.1,-0.05,-1.0", "--out", str(out)], capture_output=True, text=True)
+    assert p.returncode == 0, p.stderr
+    return out
+
+
+def test_category_cli_plans_on_a_camera_cloud_and_executes_on_the_stand_in(grasp_file, scan, capsys):
+    f, _ = grasp_file
+    base = ["category", "--category", "mug", "--task", "top", "--method", "laplace", "--task-grasps", str(f),
+            "--exclude", "mug/3", "--json", "--cloud", str(scan / "cloud.ply"), "--extrinsic", str(scan / "extrinsic.json")]
+    assert main(base) == 0                                  # plan only: no stand-in
+    doc = json.loads(capsys.readouterr().out)
+    assert doc["executed"] is False and doc["lifted"] is None and doc["success"] is None
+    G = np.asarray(doc["grasp"]["pose"])
+    assert np.hypot(G[0, 3] - 0.1, G[1, 3] + 0.05) < 0.08   # over the scanned mug, not the origin
+    assert main(base + ["--scene-object", "mug/3", "--pose", "0.1,-0.05,-1.0"]) == 0
+    done = json.loads(capsys.readouterr().out)
+    assert done["executed"] is True and isinstance(done["lifted"], bool)
+    np.testing.assert_allclose(done["grasp"]["pose"], G)    # the same plan, now executed
+    assert main(base[:-4] + ["--complete", "--cloud", str(scan / "cloud.ply")]) == 2
+    assert "--complete" in capsys.readouterr().err
+
+
+def test_plan_cli_starts_its_belief_from_registering_the_mesh_to_a_depth_image(scan, tmp_path, capsys):
+    from bayesgrasp.cli import main as cli
+
+    args = ["plan", "--object", "mug/3", "--true-pose", "0.1,-0.05,-1.0", "--attempts", "1", "--json",
+            "--depth", str(scan / "depth.png"), "--intrinsics", str(scan / "intrinsics.json"),
+            "--extrinsic", str(scan / "extrinsic.json"), "--success", "epsilon",
+            "--cache", str(tmp_path / "cache")]
+    for k, v in {"n_samples": 300, "n_inducing": 40, "max_iter": 30, "n_calibration": 100, "n_pilot": 40,
+                 "n_pilot_lifts": 10}.items():
+        args += ["--set", f"models.{k}={v}"]
+    assert cli(args) == 0
+    doc = json.loads(capsys.readouterr().out)
+    est, hw = np.asarray(doc["vision"]["estimate"]), np.asarray(doc["vision"]["half_width"])
+    assert np.hypot(est[0] - 0.1, est[1] + 0.05) < 0.01
+    np.testing.assert_allclose(doc["estimate"], est)
+    assert 0.01 <= hw[0] <= 0.04 and np.radians(10) - 1e-9 <= hw[2] <= np.radians(45) + 1e-9
+    assert cli(args + ["--estimate", "0,0,0"]) == 2
+    assert "--estimate" in capsys.readouterr().err

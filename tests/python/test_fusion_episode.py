@@ -88,3 +88,29 @@ def test_fuse_cli(grasps, cache, tmp_path, capsys):
     assert png.stat().st_size > 1000
     assert main(["fuse", "--scene-object", "mug/3", "--set", "models.n_samples=x"]) == 2
     assert "--set" in capsys.readouterr().err
+
+
+def test_fuse_cli_sees_a_camera_cloud(grasps, cache, tmp_path, capsys):
+    """The vision step from a scan file: the scan shows the mug 5 cm away from the stand-in, and
+    the first round's model poses follow the scan, not the stand-in."""
+    import subprocess
+    import sys
+    from pathlib import Path
+
+    scan = tmp_path / "scan"
+    root = Path(__file__).resolve().parents[2]
+    subprocess.run([sys.executable, str(root / "examples" / "make_scan.py"), "--object", "mug/3", "--pose",
+                    "0.05,-0.03,0.7", "--out", str(scan)], check=True, capture_output=True)
+    args = ["fuse", "--scene-object", "mug/3", "--pose", "0.01,0.02,0.7", "--exclude", *EXCLUDE, "mug/3",
+            "--cache", cache, "--rounds", "1", "--json", "--cloud", str(scan / "cloud.ply"),
+            "--extrinsic", str(scan / "extrinsic.json")]
+    for k, v in {"n_samples": 400, "n_inducing": 60, "max_iter": 40, "n_lift_samples": 200, "n_calibration": 150,
+                 "n_pilot": 60, "n_pilot_lifts": 15}.items():
+        args += ["--set", f"models.{k}={v}"]
+    f = tmp_path / "g.json"
+    f.write_text(json.dumps({"grasps": [grasp_to_json(g) for g in grasps]}))
+    assert main(args + ["--task-grasps", str(f)]) == 0
+    doc = json.loads(capsys.readouterr().out)
+    assert doc["scene"] == str(scan / "cloud.ply")
+    poses = np.array(list(doc["rounds"][0]["poses"].values()))
+    assert np.all(np.hypot(poses[:, 0] - 0.05, poses[:, 1] + 0.03) < 0.02)

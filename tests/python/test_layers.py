@@ -12,7 +12,7 @@ ROOT = Path(__file__).resolve().parents[2] / "python" / "bayesgrasp"
 # Layer of each top-level module or sub-package, lowest first (DESIGN.md's picture, upside down).
 LAYERS = [
     {"_core", "_args", "cache", "data"},
-    {"hand", "sim", "quality", "physics", "gp", "belief", "optim", "vision", "lift_trace"},
+    {"hand", "sim", "quality", "physics", "gp", "belief", "optim", "vision", "lift_trace", "io"},
     {"objects"},
     {"world"},
     {"models"},

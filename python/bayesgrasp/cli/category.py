@@ -1,13 +1,16 @@
 """``bayesgrasp category``: grasp a new object of a known category for a task (thesis §4.2, Eq. 4.1):
-one simulated view of the object, registration against the category's training models (the
-object itself left out when it is one of them), the grasp of Eq. 4.1, executed (approach along the
-planned pose, close, lift test) and checked against the task's rule."""
+one view of the object (a camera's ``--cloud`` or ``--depth``, or a simulated view of
+``--scene-object``), registration against the category's training models (the object itself left
+out when it is one of them), the grasp of Eq. 4.1, executed on ``--scene-object`` (approach along
+the planned pose, close, lift test) and checked against the task's rule; with camera data and no
+``--scene-object`` the planned grasp is the output."""
 from __future__ import annotations
 
 import json
 
 import numpy as np
 
+from . import camera_input
 from .args import CliError, add_category_options, add_context_options, context, floats, output_file, task_grasps_arg
 
 
@@ -16,13 +19,16 @@ def add(sub) -> None:
                        description=__doc__)
     c.add_argument("--category", required=True, help="mug, bottle or knife (knives train on the hammers)")
     c.add_argument("--task", required=True, help="the task (mug: top, side, handle; bottle: side; knife: handle)")
-    c.add_argument("--scene-object", required=True, help="the new object (built-in name or mesh file)")
+    c.add_argument("--scene-object", default=None,
+                   help="the new object (built-in name or mesh file): the simulated view, or with camera data the "
+                        "simulated stand-in the grasp is executed on (at --pose, in the table frame)")
     c.add_argument("--pose", default="0,0,0", metavar="X,Y,YAW", help="its pose on the table")
     c.add_argument("--method", default="laplace", choices=["laplace", "regularised", "gaussian", "baseline"],
                    help="Eq. 4.1's density, or the best-single-grasp baseline")
     c.add_argument("--complete", action="store_true", help="use the object's whole surface as the cloud")
     add_category_options(c, "the cloud, the registered models and the hand")
     add_context_options(c)
+    camera_input.add(c)
     c.set_defaults(run=run)
 
 
@@ -33,15 +39,23 @@ def run(args) -> int:
     pose = floats(args.pose, 3, "--pose")
     png = output_file(args.png, "--png")
     task_rule(args.category, args.task)   # a clear error for an unknown category or task
-    exclude = args.exclude if args.exclude is not None else [args.scene_object]
+    view = camera_input.observe(args)
+    if view is None and not args.scene_object:
+        raise CliError("--scene-object: needed without --cloud or --depth")
+    if view is not None and args.complete:
+        raise CliError("--complete: not with camera data (it replaces the view by the object's whole surface)")
+    exclude = args.exclude if args.exclude is not None else [m for m in [args.scene_object] if m]
     ctx = context(args)
-    ep = see(args.scene_object, pose, args.category, exclude=exclude, seed=args.seed, complete=args.complete)
+    ep = see(args.scene_object, pose, args.category, exclude=exclude, seed=args.seed, complete=args.complete,
+             observation=None if view is None else camera_input.observation(view))
     if not any(r.success for r in ep.registrations):
         raise CliError("no training model registered to the cloud (is the object in view, is it of this category?)")
     grasps = task_grasps_arg(args)
     out = plan_and_execute(ep, args.category, args.task, args.method, ctx, seed=args.seed, grasps=grasps)
     doc = {"grasp": {"pose": out["pose"], "spread": out.get("spread"), "frame": "table"}, "method": args.method,
-           "category": args.category, "task": args.task, "scene_object": args.scene_object, "object_pose": pose,
+           "category": args.category, "task": args.task, "scene_object": args.scene_object,
+           "object_pose": pose if args.scene_object else None, "executed": out["executed"],
+           "scene": (args.cloud or args.depth) if view is not None else "simulated view",
            "models": [{"model": m, "weight": out["weights"][m], "contribution": out["contributions"][m]}
                       for m in ep.models],
            "epsilon": out["epsilon"], "lifted": out["lifted"], "task_ok": out["task_ok"], "success": out["success"],
@@ -57,11 +71,16 @@ def run(args) -> int:
 
 
 def _print(doc: dict) -> None:
-    print(f"{doc['scene_object']} ({doc['category']}, task {doc['task']}), method {doc['method']}")
+    print(f"{doc['scene_object'] or doc['scene']} ({doc['category']}, task {doc['task']}), method {doc['method']}")
     for m in doc["models"]:
         print(f"  {m['model']:<10} weight {m['weight']:.3f}  contribution {m['contribution']:.4f}")
     if doc["reason"]:
         print(f"  no grasp: {doc['reason']}")
+        return
+    if not doc["executed"]:
+        x, y, z = (doc["grasp"]["pose"][i][3] for i in range(3))
+        print(f"  planned grasp at ({100 * x:.1f}, {100 * y:.1f}, {100 * z:.1f}) cm in the table frame, spread "
+              f"{doc['grasp']['spread']:.2f} rad (not executed: no --scene-object)")
         return
     print(f"  epsilon {doc['epsilon']:.4f}, {'lifted' if doc['lifted'] else 'dropped'}, contacts on "
           f"{', '.join(doc['contact_parts']) or 'nothing'}: {'task-compatible' if doc['task_ok'] else 'wrong part'}"

@@ -1,12 +1,15 @@
 """``bayesgrasp fuse``: vision, then touch (thesis §4.3, Pub. VI): one view gives every training
 model a weight and a pose; each executed top grasp's joint angles update them (Eqs. 4.4-4.5); the
-next grasp maximises stability x task (Eq. 4.6); until a grasp is lifted or the rounds run out."""
+next grasp maximises stability x task (Eq. 4.6); until a grasp is lifted or the rounds run out.
+The view is a camera's (``--cloud``, ``--depth``) or a simulated one of ``--scene-object``; the
+grasps are executed on ``--scene-object`` at ``--pose``, the simulated stand-in for the robot."""
 from __future__ import annotations
 
 import json
 
 import numpy as np
 
+from . import camera_input
 from .args import (CliError, add_category_options, add_context_options, bounded_int, context, floats, output_file,
                    task_grasps_arg)
 
@@ -16,7 +19,8 @@ def add(sub) -> None:
                        description=__doc__)
     f.add_argument("--category", default="mug", help="the category (its training models are its members)")
     f.add_argument("--task", default="top", help="the task whose demonstrated top grasps define P(T)")
-    f.add_argument("--scene-object", required=True, help="the new object (built-in name or mesh file)")
+    f.add_argument("--scene-object", required=True,
+                   help="the new object (built-in name or mesh file), seen (without camera data) and grasped")
     f.add_argument("--pose", default="0,0,0", metavar="X,Y,YAW", help="its pose on the table")
     f.add_argument("--rounds", type=bounded_int(0, 1000), default=3, help="tactile rounds after the first grasp")
     f.add_argument("--start", choices=["vision", "random"], default="vision",
@@ -27,6 +31,7 @@ def add(sub) -> None:
     f.add_argument("--noise", type=float, default=0.0, help="joint-angle noise sd (rad) in the likelihood")
     add_category_options(f, "the weights and the models' poses per round")
     add_context_options(f)
+    camera_input.add(f)
     f.set_defaults(run=run)
 
 
@@ -40,12 +45,14 @@ def run(args) -> int:
     if not (np.isfinite(args.noise) and args.noise >= 0):
         raise CliError(f"--noise: must be >= 0, got {args.noise}")
     png = output_file(args.png, "--png")
+    view = camera_input.observe(args)
     ctx = context(args)
     settings = FusionSettings(belief=args.belief, recursive=args.recursive, measurement_noise=args.noise)
     grasps = task_grasps_arg(args)
     trial = FusionTrial(args.scene_object, pose, ctx, task=args.task, settings=settings,
                         exclude=args.exclude if args.exclude is not None else [args.scene_object], seed=args.seed,
-                        category=args.category, grasps=grasps)
+                        category=args.category, grasps=grasps,
+                        observation=None if view is None else camera_input.observation(view))
     rounds = []
     r = trial.run(args.start, rounds=args.rounds, on_round=None if args.json else _print_round(trial.names))
     for rec in r["rounds"]:
@@ -54,7 +61,8 @@ def run(args) -> int:
                        "poses": dict(zip(trial.names, rec["poses"])), "underflow": rec["underflow"]})
     success = any(x["lifted"] for x in rounds)
     doc = {"scene_object": args.scene_object, "object_pose": pose, "category": args.category, "task": args.task,
-           "start": args.start, "belief": args.belief, "rounds": rounds, "success": success}
+           "start": args.start, "belief": args.belief, "rounds": rounds, "success": success,
+           "scene": (args.cloud or args.depth) if view is not None else "simulated view"}
     if args.json:
         print(json.dumps(doc))
     else:

@@ -7,6 +7,7 @@ from pathlib import Path
 
 import numpy as np
 
+from . import camera_input
 from .args import CliError, add_context_options, bounded_int, context, floats, out_dir, output_file
 
 METHODS = ["stability", "explore", "ml_pose", "open_loop"]
@@ -25,12 +26,14 @@ def add(sub) -> None:
     p.add_argument("--true-pose", required=True, metavar="X,Y,YAW", help="the hidden pose: metres, metres, radians")
     p.add_argument("--method", default="explore", choices=METHODS)
     p.add_argument("--estimate", default=None, metavar="X,Y,YAW",
-                   help="the initial pose estimate (default: true pose + uniform noise within the belief)")
+                   help="the initial pose estimate (default: from --cloud / --depth by registering the object's "
+                        "mesh, its spread set by the fit; else the true pose + uniform noise within the belief)")
     p.add_argument("--attempts", type=bounded_int(1, 1000), default=4)
     p.add_argument("--noise", type=float, default=0.0, help="joint-angle measurement noise std (rad)")
     p.add_argument("--png", default=None, help="write a PNG of the belief's evolution")
     p.add_argument("--json", action="store_true", help="print one JSON object")
     add_context_options(p)
+    camera_input.add(p)
     p.set_defaults(run=plan)
 
 
@@ -47,17 +50,27 @@ def _print_attempt(a: dict) -> None:
           f"({1e3 * a['plan_seconds']:.0f} ms to plan)", flush=True)
 
 
-def _loop(args, pose, attempts: int = 4, estimate=None, noise: float = 0.0, quiet: bool = False) -> dict:
+def _loop(args, pose, attempts: int = 4, estimate=None, noise: float = 0.0, quiet: bool = False,
+          half_width=None) -> dict:
+    from dataclasses import replace
+
     from ..experiments.episode import EpisodeSettings, run_episode
+    from ..planners.base import PlannerSettings
     from ..world import World
 
     if attempts < 1:
         raise CliError(f"--attempts: must be at least 1, got {attempts}")
     ctx = context(args)
-    World.single(args.object, pose=pose, hand=ctx.hand)  # a clear error for an unknown object or a pose off the table
-    models = ctx.models(args.object)
-    episode = EpisodeSettings(method=args.method, attempts=attempts, measurement_noise=noise)
-    return run_episode(args.object, pose, episode, ctx, seed=args.seed, estimate=estimate, models=models,
+    obj = args.object
+    if getattr(args, "units", None):                  # a mesh file in another unit: scaled once, here
+        from ..objects import load_object
+
+        obj = load_object(obj, units=args.units)
+    World.single(obj, pose=pose, hand=ctx.hand)  # a clear error for an unknown object or a pose off the table
+    models = ctx.models(obj)
+    planner = PlannerSettings() if half_width is None else replace(PlannerSettings(), half_width=tuple(half_width))
+    episode = EpisodeSettings(method=args.method, attempts=attempts, measurement_noise=noise, planner=planner)
+    return run_episode(obj, pose, episode, ctx, seed=args.seed, estimate=estimate, models=models,
                        keep_planner=True, on_attempt=None if quiet else _print_attempt)
 
 
@@ -112,11 +125,40 @@ def plan(args) -> int:
     if not (np.isfinite(args.noise) and args.noise >= 0):
         raise CliError(f"--noise: must be >= 0, got {args.noise}")
     png = output_file(args.png, "--png")
-    r = _loop(args, pose, args.attempts, est, args.noise, quiet=args.json)
+    start = _vision_start(args, est, quiet=args.json)
+    half_width = None
+    if start is not None:
+        est, half_width = start.estimate.tolist(), start.half_width.tolist()
+    r = _loop(args, pose, args.attempts, est, args.noise, quiet=args.json, half_width=half_width)
     if png:
         _belief_png(r, png)
     if args.json:
-        print(json.dumps(_plan_json(args, pose, r)))
+        doc = _plan_json(args, pose, r)
+        if start is not None:
+            doc["vision"] = {"scene": args.cloud or args.depth, "estimate": start.estimate.tolist(),
+                             "half_width": start.half_width.tolist(), "registration": start.registration.as_dict()}
+        print(json.dumps(doc))
     else:
         print(f"{'success' if r['success'] else 'no successful grasp'} after {len(r['attempts'])} attempt(s)")
     return 0
+
+
+def _vision_start(args, estimate, quiet: bool):
+    """The estimate and belief spread from registering --object's mesh to the camera data, or None."""
+    view = camera_input.observe(args)
+    if view is None:
+        return None
+    if estimate is not None:
+        raise CliError("--estimate: not with --cloud or --depth (the estimate comes from registering to them)")
+    from ..experiments.vision_start import vision_start
+    from ..objects import load_object
+
+    start = vision_start(load_object(args.object, units=args.units), view.object_points, view.viewpoint,
+                         seed=args.seed)
+    if not quiet:
+        x, y, yaw = start.estimate
+        hx, _, hyaw = start.half_width
+        print(f"vision: {args.object} registered to {args.cloud or args.depth} at ({100 * x:.1f} cm, {100 * y:.1f} cm, "
+              f"{np.degrees(yaw):.0f} deg), fit {1000 * start.registration.delta:.1f} mm -> belief "
+              f"+-{100 * hx:.1f} cm, +-{np.degrees(hyaw):.0f} deg")
+    return start

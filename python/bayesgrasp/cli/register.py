@@ -1,56 +1,72 @@
-"""``bayesgrasp register``: a simulated depth view of an object, table segmentation, and the
-registration of the object's cloud against models."""
+"""``bayesgrasp register``: the object's cloud, from a camera's cloud or depth image (``--cloud``,
+``--depth``) or a simulated view of a scene object, registered against models."""
 from __future__ import annotations
 
 import json
 
 import numpy as np
 
+from . import camera_input
 from .args import SEED_MAX, CliError, bounded_int, floats, output_file
 
 
 def add(sub) -> None:
-    r = sub.add_parser("register", help="render a view of an object, segment it and register it against models")
-    r.add_argument("--scene-object", required=True, help="object placed in the scene (built-in name or mesh file)")
+    r = sub.add_parser("register", help="register a camera's cloud (or a simulated view) against models")
+    r.add_argument("--scene-object", default=None,
+                   help="simulated view: object placed in the scene (built-in name or mesh file)")
     r.add_argument("--pose", default="0,0,0", metavar="X,Y,YAW", help="its pose on the table")
     r.add_argument("--models", required=True, nargs="+", metavar="NAME_OR_PATH", help="models to register against")
     r.add_argument("--voxel", type=float, default=0.005, help="voxel size (m); all radii scale from it")
     r.add_argument("--seed", type=bounded_int(0, SEED_MAX), default=0)
     r.add_argument("--png", default=None, help="write a PNG of the cloud over each registered model")
     r.add_argument("--json", action="store_true", help="print one JSON object")
+    camera_input.add(r)
     r.set_defaults(run=run)
 
 
 def run(args) -> int:
     from ..objects import load_object
-    from ..objects.views import capture_view
     from ..vision import register
 
     pose = floats(args.pose, 3, "--pose")
     if not (args.voxel > 0 and np.isfinite(args.voxel)):
         raise CliError(f"--voxel: must be positive, got {args.voxel}")
+    if camera_input.given(args) == bool(args.scene_object):
+        raise CliError("--scene-object, --cloud, --depth: give exactly one (a simulated view or camera data)")
     png = output_file(args.png, "--png")
-    view = capture_view(args.scene_object, pose, seed=args.seed)
-    models = [load_object(m) for m in args.models]
-    res = register(view.object_points, models, voxel=args.voxel, seed=args.seed, viewpoint=view.camera.eye,
+    models = [load_object(m, units=args.units) for m in args.models]
+    points, viewpoint, source = _scene(args, pose)
+    res = register(points, models, voxel=args.voxel, seed=args.seed, viewpoint=viewpoint,
                    names=[str(m) for m in args.models])
-    doc = {"scene_object": str(args.scene_object), "pose": pose, "scene_points": int(len(view.object_points)),
-           "models": [r.as_dict() for r in res]}
+    doc = {"scene": source, "scene_points": int(len(points)), "models": [r.as_dict() for r in res]}
+    if args.scene_object:
+        doc.update(scene_object=str(args.scene_object), pose=pose)
     if args.json:
         print(json.dumps(doc, indent=2))
     else:
-        _print(args.scene_object, pose, len(view.object_points), res)
+        _print(source, len(points), res)
     if png:
         from ..viz import plot_registrations
 
-        plot_registrations(view.object_points, models, res, str(png))
+        plot_registrations(points, models, res, str(png))
         print(f"saved {png}")
     return 0
 
 
-def _print(name, pose, n_points: int, results) -> None:
+def _scene(args, pose):
+    """(object cloud in the table frame, camera centre or None, a description of where it came from)."""
+    view = camera_input.observe(args)
+    if view is not None:
+        return view.object_points, view.viewpoint, args.cloud or args.depth
+    from ..objects.views import capture_view
+
+    v = capture_view(args.scene_object, pose, seed=args.seed)
     x, y, yaw = pose
-    print(f"scene object {name} at x={x:.3f} y={y:.3f} yaw={yaw:.3f}: {n_points} points in the largest cluster")
+    return v.object_points, v.camera.eye, f"{args.scene_object} at x={x:.3f} y={y:.3f} yaw={yaw:.3f}"
+
+
+def _print(source: str, n_points: int, results) -> None:
+    print(f"{source}: {n_points} points of the object in the table frame")
     for r in results:
         if not r.success:
             print(f"  {r.model}: registration failed: {r.reason}")

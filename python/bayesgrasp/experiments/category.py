@@ -131,11 +131,18 @@ def execute(obj, pose, plan: CategoryPlan, rule: TaskRule, ctx: RunContext) -> d
             "joint_angles": np.asarray(g.joint_angles).tolist(), "joint_names": list(g.joint_names)}
 
 
+def not_executed(plan: CategoryPlan) -> dict:
+    """The outcome fields of a plan made on camera data with no stand-in to execute it on."""
+    return {"executed": False, "reason": plan.reason if not plan.ok else "", "lifted": None, "task_ok": None,
+            "success": None, "epsilon": None, "force_closure": None, "failure": None if plan.ok else "no contact",
+            "spread": plan.spread if plan.ok else None}
+
+
 @dataclass
 class CategoryEpisode:
     """A scene and its registrations, reusable for several tasks and methods (the same view)."""
 
-    obj: str
+    obj: Optional[str]
     pose: Tuple[float, float, float]
     models: List[str]
     observation: Observation
@@ -143,11 +150,18 @@ class CategoryEpisode:
     extra: Dict = field(default_factory=dict)
 
 
-def see(obj: str, pose, category_name: str, exclude: Sequence[str] = (), eye_offset=DEFAULT_EYE_OFFSET,
-        seed: int = 0, complete: bool = False) -> CategoryEpisode:
+def see(obj: Optional[str], pose, category_name: str, exclude: Sequence[str] = (), eye_offset=DEFAULT_EYE_OFFSET,
+        seed: int = 0, complete: bool = False, observation: Optional[Observation] = None) -> CategoryEpisode:
+    """The episode's view and registrations: ``observation`` (a camera's cloud in the table frame,
+    see :mod:`bayesgrasp.io`) when given, else a simulated view of ``obj`` at ``pose``. ``obj`` is
+    the simulated stand-in the grasp is executed on; None: plan only."""
     models = training_models(category_name, exclude)
-    o = observe(obj, pose, eye_offset, seed, complete)
-    return CategoryEpisode(str(obj), tuple(float(v) for v in pose), models, o, register_models(o, models, seed))
+    if observation is None:
+        if obj is None:
+            raise ValueError("obj: needed for a simulated view when no observation is given")
+        observation = observe(obj, pose, eye_offset, seed, complete)
+    return CategoryEpisode(None if obj is None else str(obj), tuple(float(v) for v in pose), models, observation,
+                           register_models(observation, models, seed))
 
 
 def plan_and_execute(ep: CategoryEpisode, category_name: str, task: str, method: str, ctx: RunContext,
@@ -161,7 +175,7 @@ def plan_and_execute(ep: CategoryEpisode, category_name: str, task: str, method:
     s = replace(settings or CategorySettings(method=method), table=rule.table)
     planner = CategoryPlanner(ctx.hand, grasps, ep.registrations, cloud=ep.observation.cloud, settings=s, seed=seed)
     plan = planner.plan()
-    out = execute(ep.obj, ep.pose, plan, rule, ctx)
+    out = execute(ep.obj, ep.pose, plan, rule, ctx) if ep.obj is not None else not_executed(plan)
     out.update({"method": method, "task": task, "plan_ok": plan.ok, "objective": plan.objective,
                 "mixture": plan.mixture, "pose": None if not plan.ok else plan.pose.tolist(),
                 "weights": plan.weights, "contributions": plan.contributions, "dominant_model": plan.dominant_model,

@@ -63,11 +63,15 @@ class FusionTrial:
     def __init__(self, obj: str, pose, ctx: RunContext, task: str = "top", settings: Optional[FusionSettings] = None,
                  exclude: Sequence[str] = (), eye_offset=None, seed: int = 0,
                  model_settings: Optional[ModelSettings] = None, grasps: Optional[Sequence] = None,
-                 category: Optional[str] = None):
+                 category: Optional[str] = None, observation=None):
+        """``observation``: the vision step's cloud from a camera (a
+        :class:`~bayesgrasp.experiments.category.Observation` in the table frame) instead of a
+        simulated view of ``obj``; ``obj`` at ``pose`` is then the simulated stand-in the grasps
+        are executed on."""
         cat = category or (obj.split("/")[0] if "/" in str(obj) else "mug")
         self.obj, self.pose, self.ctx, self.seed = obj, np.asarray(pose, float), ctx, seed
         kw = {} if eye_offset is None else {"eye_offset": eye_offset}
-        self.episode = see(obj, pose, cat, exclude=tuple(exclude) or (obj,), seed=seed, **kw)
+        self.episode = see(obj, pose, cat, exclude=tuple(exclude) or (obj,), seed=seed, observation=observation, **kw)
         if not any(r.success for r in self.episode.registrations):
             raise ValueError("no training model registered to the cloud: there is no vision belief to start from")
         self.names = self.episode.models

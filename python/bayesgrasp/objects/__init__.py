@@ -8,13 +8,13 @@
 """
 from .library import (CATEGORY_SIZES, boolean_available, builtin, categories, category, generate,
                       list_objects, load_object, object_params, sample_params)
-from .mesh_io import (DEFAULT_DENSITY, MESH_EXTENSIONS, MeshWarning, ObjectModel, load_mesh,
+from .mesh_io import (DEFAULT_DENSITY, MESH_EXTENSIONS, MeshWarning, ObjectModel, load_mesh, mesh_from_object,
                       mesh_is_watertight)
 from .scene import Scene, TableScene
 
 __all__ = [
     "CATEGORY_SIZES", "DEFAULT_DENSITY", "MESH_EXTENSIONS", "MeshWarning", "ObjectModel", "Scene",
     "TableScene", "boolean_available", "builtin", "categories", "category", "generate",
-    "list_objects", "load_mesh", "load_object", "mesh_is_watertight", "object_params",
+    "list_objects", "load_mesh", "load_object", "mesh_from_object", "mesh_is_watertight", "object_params",
     "sample_params",
 ]

@@ -498,14 +498,17 @@ def builtin(name: str, density: Optional[float] = None,
     return generate(p, name=name, use_boolean=use_boolean, density=density)
 
 
-def load_object(name_or_path, density: Optional[float] = None) -> ObjectModel:
-    """A built-in object by name (``"mug"``, ``"mug/3"``, ``"bottle/7"``) or a mesh file by path.
+def load_object(name_or_path, density: Optional[float] = None, units: Optional[str] = None) -> ObjectModel:
+    """A built-in object by name (``"mug"``, ``"mug/3"``, ``"bottle/7"``), a mesh file by path, or
+    an in-memory ``trimesh.Trimesh`` / Open3D ``TriangleMesh``.
 
     Args:
         name_or_path: a built-in name (see :func:`list_objects`; category members accept any
-            non-negative index) or the path of an OBJ / STL / PLY file in metres.
+            non-negative index), the path of an OBJ / STL / PLY file, or a mesh object.
         density: kg/m^3; default: the built-in's own (ceramic mugs 2300, bottles 1000, ...) or
             :data:`~bayesgrasp.objects.mesh_io.DEFAULT_DENSITY` for files.
+        units: the length unit of a file or mesh object (``"m"`` default, ``"cm"``, ``"mm"``); an
+            extent outside 5 mm .. 2 m is refused with the likely unit named.
 
     Raises:
         ValueError: neither a built-in name nor an existing file (the message lists the names), or
@@ -516,10 +519,13 @@ def load_object(name_or_path, density: Optional[float] = None) -> ObjectModel:
     import os
     from pathlib import Path
 
-    from .mesh_io import MESH_EXTENSIONS, load_mesh
+    from .mesh_io import MESH_EXTENSIONS, load_mesh, mesh_from_object
 
     if isinstance(name_or_path, ObjectModel):
         return name_or_path
+    if hasattr(name_or_path, "vertices") and (hasattr(name_or_path, "faces") or hasattr(name_or_path, "triangles")) \
+            or hasattr(name_or_path, "to_legacy"):
+        return mesh_from_object(name_or_path, density=density, units=units)
     if not isinstance(name_or_path, (str, os.PathLike)):
         raise ValueError(f"name_or_path must be a built-in name or a file path, got "
                          f"{type(name_or_path).__name__}")
@@ -528,7 +534,7 @@ def load_object(name_or_path, density: Optional[float] = None) -> ObjectModel:
         return builtin(s, density=density)
     p = Path(s)
     if p.is_file():
-        return load_mesh(p, density=density)
+        return load_mesh(p, density=density, units=units)
     if p.suffix.lower() in MESH_EXTENSIONS or os.sep in s and not _NAME_RE.match(s):
         raise FileNotFoundError(f"mesh file not found: '{s}' (and it is not a built-in object name)")
     raise ValueError(f"'{s}' is neither a built-in object nor an existing file; built-in objects: "

@@ -312,8 +312,8 @@ class ObjectModel:
 
 
 def load_mesh(path: Union[str, os.PathLike], density: Optional[float] = None,
-              name: Optional[str] = None) -> ObjectModel:
-    """Load an OBJ, STL or PLY triangle mesh (coordinates in metres) as an :class:`ObjectModel`.
+              name: Optional[str] = None, units: Optional[str] = None) -> ObjectModel:
+    """Load an OBJ, STL or PLY triangle mesh as an :class:`ObjectModel` in metres.
 
     Vertices are merged (STL stores each triangle separately), inconsistent face winding is made
     consistent and inward-facing closed components are flipped so that their volume is positive.
@@ -322,10 +322,12 @@ def load_mesh(path: Union[str, os.PathLike], density: Optional[float] = None,
         path: the mesh file.
         density: kg/m^3 (default :data:`DEFAULT_DENSITY`).
         name: object name (default: the file's stem).
+        units: the file's length unit, ``"m"`` (default), ``"cm"`` or ``"mm"``.
 
     Raises:
         FileNotFoundError: the file does not exist.
-        ValueError: unsupported extension, not a mesh, no faces, NaN/infinite coordinates.
+        ValueError: unsupported extension, not a mesh, no faces, NaN/infinite coordinates, an
+            extent outside 5 mm .. 2 m (the message names the likely unit).
 
     Warns:
         MeshWarning: the mesh is not watertight (mass properties then from its convex hull).
@@ -357,13 +359,47 @@ def load_mesh(path: Union[str, os.PathLike], density: Optional[float] = None,
     F = np.asarray(loaded.faces)
     if len(V) == 0 and len(F) == 0:
         raise ValueError(f"'{p}' is not a {ext[1:].upper()} mesh: no vertices or faces could be read")
+    return _object_from_arrays(V, F, f"'{p}'", name or p.stem, density, units, source=str(p), label_path=p)
+
+
+def mesh_from_object(mesh, name: str = "mesh", density: Optional[float] = None,
+                     units: Optional[str] = None) -> ObjectModel:
+    """An :class:`ObjectModel` from an in-memory mesh: a ``trimesh.Trimesh``, an
+    ``open3d.geometry.TriangleMesh`` or an ``open3d.t.geometry.TriangleMesh`` (the input is not
+    modified; the same repairs and checks as :func:`load_mesh`)."""
+    if hasattr(mesh, "to_legacy") and hasattr(mesh, "vertex"):        # Open3D tensor mesh
+        mesh = mesh.to_legacy()
+    if hasattr(mesh, "faces") and hasattr(mesh, "vertices"):           # trimesh.Trimesh
+        V, F = np.asarray(mesh.vertices), np.asarray(mesh.faces)
+    elif hasattr(mesh, "triangles") and hasattr(mesh, "vertices"):     # Open3D legacy mesh
+        V, F = np.asarray(mesh.vertices), np.asarray(mesh.triangles)
+    else:
+        raise ValueError(f"{name}: expected a trimesh.Trimesh or an Open3D TriangleMesh, got {type(mesh).__name__}")
+    return _object_from_arrays(np.array(V, dtype=np.float64), np.array(F), name, name, density, units,
+                               source=f"in memory ({type(mesh).__name__})")
+
+
+def _object_from_arrays(V: np.ndarray, F: np.ndarray, what: str, name: str, density: Optional[float],
+                        units: Optional[str], source: str, label_path: Optional[Path] = None) -> ObjectModel:
+    """The shared checks and repairs of a mesh given as vertex and face arrays, scaled to metres."""
+    import trimesh
+
+    from ..io.units import check_extent, unit_scale
+
+    scale = unit_scale(units)
     if len(F) == 0:
-        raise ValueError(f"'{p}': mesh has no faces ({len(V)} vertices)")
+        raise ValueError(f"{what}: mesh has no faces ({len(V)} vertices)")
     if V.ndim != 2 or V.shape[1] != 3:
-        raise ValueError(f"'{p}': vertices must be 3-D, got shape {V.shape}")
+        raise ValueError(f"{what}: vertices must be 3-D, got shape {V.shape}")
+    if F.ndim != 2 or F.shape[1] != 3 or not np.issubdtype(F.dtype, np.integer):
+        raise ValueError(f"{what}: faces must be integer triangles (M, 3), got {F.shape} {F.dtype}")
+    if F.min() < 0 or F.max() >= len(V):
+        raise ValueError(f"{what}: faces index vertices out of range [0, {len(V)})")
     if not np.all(np.isfinite(V)):
         bad = int(np.count_nonzero(~np.all(np.isfinite(V), axis=1)))
-        raise ValueError(f"'{p}': mesh has {bad} vertices with NaN or infinite coordinates")
+        raise ValueError(f"{what}: mesh has {bad} vertices with NaN or infinite coordinates")
+    V = V * scale
+    check_extent(V[np.unique(F)], what, units)
     mesh = trimesh.Trimesh(vertices=V, faces=F, process=False)
     mesh.merge_vertices(merge_tex=True, merge_norm=True)
     mesh.remove_unreferenced_vertices()
@@ -371,13 +407,13 @@ def load_mesh(path: Union[str, os.PathLike], density: Optional[float] = None,
     F = np.asarray(mesh.faces, dtype=np.int64)
     # drop faces that collapse to a line or point (repeated indices)
     keep = (F[:, 0] != F[:, 1]) & (F[:, 1] != F[:, 2]) & (F[:, 2] != F[:, 0])
-    parts, part_names = _label_file(p, len(F))
+    parts, part_names = _label_file(label_path, len(F)) if label_path is not None else (None, ())
     F = F[keep]
     if len(F) == 0:
-        raise ValueError(f"'{p}': mesh has no non-degenerate faces")
+        raise ValueError(f"{what}: mesh has no non-degenerate faces")
     F = orient_outward(V, F)
     d = DEFAULT_DENSITY if density is None else density
-    return ObjectModel(name or p.stem, V, F.astype(np.int32), d, source=str(p),
+    return ObjectModel(name, V, F.astype(np.int32), d, source=source,
                        parts=None if parts is None else parts[keep], part_names=part_names)
 
 
