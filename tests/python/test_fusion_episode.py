@@ -72,16 +72,22 @@ def test_the_accounting_of_transitions_by_hand():
     assert t["cumulative_success_by_round"] == [1, 2, 3, 4] and t["vision_only_success"] == 1
 
 
-def test_fuse_cli(grasps, cache, tmp_path, capsys):
-    png = tmp_path / "f.png"
-    args = ["fuse", "--scene-object", "mug/3", "--pose", "0.01,0.02,0.7", "--exclude", *EXCLUDE, "mug/3",
-            "--cache", cache, "--rounds", "2", "--json", "--png", str(png)]
+def small_models_and_grasps(grasps, tmp_path) -> list:
+    """The CLI options for SMALL models and the given task grasps (written to a file)."""
+    args = []
     for k, v in {"n_samples": 400, "n_inducing": 60, "max_iter": 40, "n_lift_samples": 200, "n_calibration": 150,
                  "n_pilot": 60, "n_pilot_lifts": 15}.items():
         args += ["--set", f"models.{k}={v}"]
     f = tmp_path / "g.json"
     f.write_text(json.dumps({"grasps": [grasp_to_json(g) for g in grasps]}))
-    assert main(args + ["--task-grasps", str(f)]) == 0
+    return args + ["--task-grasps", str(f)]
+
+
+def test_fuse_cli(grasps, cache, tmp_path, capsys):
+    png = tmp_path / "f.png"
+    args = ["fuse", "--scene-object", "mug/3", "--pose", "0.01,0.02,0.7", "--exclude", *EXCLUDE, "mug/3",
+            "--cache", cache, "--rounds", "2", "--json", "--png", str(png)]
+    assert main(args + small_models_and_grasps(grasps, tmp_path)) == 0
     doc = json.loads(capsys.readouterr().out)
     assert doc["rounds"] and set(doc["rounds"][0]) >= {"grasp", "weights", "poses", "epsilon", "lifted"}
     assert doc["success"] == any(r["lifted"] for r in doc["rounds"])
@@ -104,12 +110,7 @@ def test_fuse_cli_sees_a_camera_cloud(grasps, cache, tmp_path, capsys):
     args = ["fuse", "--scene-object", "mug/3", "--pose", "0.01,0.02,0.7", "--exclude", *EXCLUDE, "mug/3",
             "--cache", cache, "--rounds", "1", "--json", "--cloud", str(scan / "cloud.ply"),
             "--extrinsic", str(scan / "extrinsic.json")]
-    for k, v in {"n_samples": 400, "n_inducing": 60, "max_iter": 40, "n_lift_samples": 200, "n_calibration": 150,
-                 "n_pilot": 60, "n_pilot_lifts": 15}.items():
-        args += ["--set", f"models.{k}={v}"]
-    f = tmp_path / "g.json"
-    f.write_text(json.dumps({"grasps": [grasp_to_json(g) for g in grasps]}))
-    assert main(args + ["--task-grasps", str(f)]) == 0
+    assert main(args + small_models_and_grasps(grasps, tmp_path)) == 0
     doc = json.loads(capsys.readouterr().out)
     assert doc["scene"] == str(scan / "cloud.ply")
     poses = np.array(list(doc["rounds"][0]["poses"].values()))

@@ -162,20 +162,12 @@ def read_extrinsic(source, name: str = "extrinsic") -> np.ndarray:
 def read_depth(path: Union[str, os.PathLike]) -> np.ndarray:
     """A depth image from a 16-bit PNG (uint16, usually millimetres) or a ``.npy`` (float metres,
     or integers), as the array it holds."""
-    p = Path(path)
-    ext = p.suffix.lower()
-    if ext not in DEPTH_EXTENSIONS:
-        raise ValueError(f"{p}: unknown depth image type '{ext}' (known: {', '.join(DEPTH_EXTENSIONS)})")
-    if not p.is_file():
-        raise FileNotFoundError(f"depth image not found: '{p}'")
-    if ext == ".npy":
-        try:
-            return np.load(p, allow_pickle=False)
-        except (ValueError, OSError) as e:
-            raise ValueError(f"{p}: not a readable .npy array: {e}") from None
-    import open3d as o3d
+    from .clouds import _quiet_open3d, checked_file, load_npy
 
-    from .clouds import _quiet_open3d
+    p = checked_file(path, DEPTH_EXTENSIONS, "depth image")
+    if p.suffix.lower() == ".npy":
+        return load_npy(p)
+    import open3d as o3d
 
     with _quiet_open3d(o3d):
         img = o3d.io.read_image(str(p))

@@ -82,22 +82,31 @@ def read_cloud(path: Union[str, os.PathLike], units: Optional[str] = None) -> np
 
     ValueError for an unknown extension, an unreadable or empty file, or a scene whose extent
     says it is not in ``units`` (default metres); FileNotFoundError if it does not exist."""
-    p = Path(path)
-    ext = p.suffix.lower()
-    if ext not in CLOUD_EXTENSIONS:
-        raise ValueError(f"{p}: unknown point cloud type '{ext}' (known: {', '.join(CLOUD_EXTENSIONS)})")
-    if not p.is_file():
-        raise FileNotFoundError(f"point cloud file not found: '{p}'")
-    if ext == ".npy":
-        try:
-            raw = np.load(p, allow_pickle=False)
-        except (ValueError, OSError) as e:
-            raise ValueError(f"{p}: not a readable .npy array: {e}") from None
-    else:
-        raw = _read_open3d(p)
+    p = checked_file(path, CLOUD_EXTENSIONS, "point cloud")
+    raw = load_npy(p) if p.suffix.lower() == ".npy" else _read_open3d(p)
     P = as_points(raw, name=str(p), units=units)
     check_extent(P, str(p), units, lo=0.0, hi=SCENE_EXTENT_MAX)
     return P
+
+
+def checked_file(path: Union[str, os.PathLike], extensions, what: str) -> Path:
+    """``path`` as a Path, if its extension is one of ``extensions`` (ValueError) and it exists
+    (FileNotFoundError)."""
+    p = Path(path)
+    ext = p.suffix.lower()
+    if ext not in extensions:
+        raise ValueError(f"{p}: unknown {what} type '{ext}' (known: {', '.join(extensions)})")
+    if not p.is_file():
+        raise FileNotFoundError(f"{what} file not found: '{p}'")
+    return p
+
+
+def load_npy(p: Path) -> np.ndarray:
+    """A ``.npy`` array (never a pickle); ValueError if it cannot be read."""
+    try:
+        return np.load(p, allow_pickle=False)
+    except (ValueError, OSError) as e:
+        raise ValueError(f"{p}: not a readable .npy array: {e}") from None
 
 
 def _read_open3d(p: Path) -> np.ndarray:
