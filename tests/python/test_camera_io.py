@@ -306,3 +306,20 @@ def test_the_mm_cloud_registers_with_units_mm(mug_scan, capsys):
     np.save(d / "cloud_mm.npy", np.asarray(o3d.io.read_point_cloud(str(d / "cloud.ply")).points) * 1000.0)
     assert main(["register", "--cloud", str(d / "cloud_mm.npy"), "--units", "mm", "--models", "mug/3", "--json"]) == 0
     assert _json(capsys.readouterr().out)["models"][0]["success"]
+
+
+def test_the_yaw_profile_of_the_fit_is_lowest_at_the_true_yaw_and_spreads_when_the_yaw_is_ambiguous():
+    """A box seen from a camera: its fit over turns about the vertical is lowest at the truth and
+    again 180 degrees away (the box's symmetry), so the belief's yaw spread covers both."""
+    from bayesgrasp.experiments.vision_start import vision_start
+
+    o = load_object(box_mesh(extent=(0.05, 0.12, 0.08)))
+    T = look_at((0.45, -0.35, 0.45), (0.0, 0.0, 0.04))
+    scan = render_scan(o.vertices, o.faces, T, KINECT, noise=False)
+    view = to_table_frame(cloud_from_depth(scan.depth, KINECT), T)
+    st = vision_start(o, view.object_points, view.viewpoint)
+    turn = np.degrees(st.yaw_offsets)
+    best = np.argmin(st.yaw_delta)
+    assert abs(((np.degrees(st.estimate[2]) + 90) % 180) - 90) < 5.1          # 0 or 180 degrees
+    assert st.yaw_delta[np.argmin(np.abs(np.abs(turn - turn[best]) - 90))] > 3 * st.yaw_delta[best]
+    assert st.half_width[2] > np.radians(170)

@@ -163,6 +163,8 @@ def test_plan_cli_starts_its_belief_from_registering_the_mesh_to_a_depth_image(s
     est, hw = np.asarray(doc["vision"]["estimate"]), np.asarray(doc["vision"]["half_width"])
     assert np.hypot(est[0] - 0.1, est[1] + 0.05) < 0.01
     np.testing.assert_allclose(doc["estimate"], est)
-    assert 0.01 <= hw[0] <= 0.04 and np.radians(10) - 1e-9 <= hw[2] <= np.radians(45) + 1e-9
+    assert 0.01 <= hw[0] <= 0.04 and np.radians(10) - 1e-9 <= hw[2] <= np.pi + 1e-9
+    yaw_error = abs((est[2] + 1.0 + np.pi) % (2 * np.pi) - np.pi)
+    assert yaw_error <= hw[2]                                # the initial belief covers the true yaw
     assert cli(args + ["--estimate", "0,0,0"]) == 2
     assert "--estimate" in capsys.readouterr().err
