@@ -51,7 +51,8 @@ def _print_attempt(a: dict) -> None:
 
 
 def _loop(args, pose, attempts: int = 4, estimate=None, noise: float = 0.0, quiet: bool = False,
-          half_width=None) -> dict:
+          half_width=None, obj=None) -> dict:
+    """The episode on ``obj`` (default: --object by name)."""
     from dataclasses import replace
 
     from ..experiments.episode import EpisodeSettings, run_episode
@@ -61,11 +62,7 @@ def _loop(args, pose, attempts: int = 4, estimate=None, noise: float = 0.0, quie
     if attempts < 1:
         raise CliError(f"--attempts: must be at least 1, got {attempts}")
     ctx = context(args)
-    obj = args.object
-    if getattr(args, "units", None):                  # a mesh file in another unit: scaled once, here
-        from ..objects import load_object
-
-        obj = load_object(obj, units=args.units)
+    obj = args.object if obj is None else obj
     World.single(obj, pose=pose, hand=ctx.hand)  # a clear error for an unknown object or a pose off the table
     models = ctx.models(obj)
     planner = PlannerSettings() if half_width is None else replace(PlannerSettings(), half_width=tuple(half_width))
@@ -125,11 +122,16 @@ def plan(args) -> int:
     if not (np.isfinite(args.noise) and args.noise >= 0):
         raise CliError(f"--noise: must be >= 0, got {args.noise}")
     png = output_file(args.png, "--png")
-    start = _vision_start(args, est, quiet=args.json)
+    obj = args.object
+    if args.units or camera_input.given(args):       # the mesh read once, in its unit
+        from ..objects import load_object
+
+        obj = load_object(args.object, units=args.units)
+    start = _vision_start(args, obj, est, quiet=args.json)
     half_width = None
     if start is not None:
         est, half_width = start.estimate.tolist(), start.half_width.tolist()
-    r = _loop(args, pose, args.attempts, est, args.noise, quiet=args.json, half_width=half_width)
+    r = _loop(args, pose, args.attempts, est, args.noise, quiet=args.json, half_width=half_width, obj=obj)
     if png:
         _belief_png(r, png)
     if args.json:
@@ -143,18 +145,17 @@ def plan(args) -> int:
     return 0
 
 
-def _vision_start(args, estimate, quiet: bool):
-    """The estimate and belief spread from registering --object's mesh to the camera data, or None."""
+def _vision_start(args, obj, estimate, quiet: bool):
+    """The estimate and belief spread from registering ``obj`` (--object's mesh) to the camera
+    data, or None."""
     view = camera_input.observe(args)
     if view is None:
         return None
     if estimate is not None:
         raise CliError("--estimate: not with --cloud or --depth (the estimate comes from registering to them)")
     from ..experiments.vision_start import vision_start
-    from ..objects import load_object
 
-    start = vision_start(load_object(args.object, units=args.units), view.object_points, view.viewpoint,
-                         seed=args.seed)
+    start = vision_start(obj, view.object_points, view.viewpoint, seed=args.seed)
     if not quiet:
         x, y, yaw = start.estimate
         hx, _, hyaw = start.half_width

@@ -40,13 +40,13 @@ class VisionStart:
     yaw_delta: np.ndarray
 
 
-def yaw_profile(samples: np.ndarray, T: np.ndarray, cloud: np.ndarray, offsets: np.ndarray, tau: float) -> np.ndarray:
+def yaw_profile(samples: np.ndarray, T: np.ndarray, c: np.ndarray, cloud: np.ndarray, offsets: np.ndarray,
+                tau: float) -> np.ndarray:
     """delta of the model (surface ``samples``, model frame) placed by ``T`` turned by each offset
-    about the vertical through its placed centre, against ``cloud`` (table frame)."""
+    about the vertical through ``c`` (its placed centre), against ``cloud`` (table frame)."""
     from scipy.spatial import cKDTree
 
     tree = cKDTree(samples)
-    c = T[:3, :3] @ samples.mean(axis=0) + T[:3, 3]
     out = np.empty(len(offsets))
     for k, a in enumerate(offsets):
         Rz = np.array([[np.cos(a), -np.sin(a), 0.0], [np.sin(a), np.cos(a), 0.0], [0.0, 0.0, 1.0]])
@@ -66,13 +66,13 @@ def vision_start(obj, cloud, viewpoint: Optional[np.ndarray] = None, seed: int =
     T = np.asarray(r.transform, float)
     samples, _ = model_samples(obj, voxel=voxel, seed=seed)
     offsets = np.arange(-np.pi, np.pi, YAW_STEP)
-    delta = yaw_profile(samples, T, np.asarray(cloud, float), offsets, 1.5 * voxel)
+    c = T[:3, :3] @ samples.mean(axis=0) + T[:3, 3]
+    delta = yaw_profile(samples, T, c, np.asarray(cloud, float), offsets, 1.5 * voxel)
     best = int(np.argmin(delta))
     plausible = delta <= YAW_TOLERANCE[0] * delta[best] + YAW_TOLERANCE[1]
     turn = np.abs((offsets - offsets[best] + np.pi) % (2 * np.pi) - np.pi)
     yaw_spread = float(np.clip(turn[plausible].max(), YAW_MIN, np.pi))
     a = offsets[best]
-    c = T[:3, :3] @ samples.mean(axis=0) + T[:3, 3]
     Rz = np.array([[np.cos(a), -np.sin(a)], [np.sin(a), np.cos(a)]])
     xy = Rz @ (T[:2, 3] - c[:2]) + c[:2]                                  # the model origin after the turn
     yaw = float((np.arctan2(T[1, 0], T[0, 0]) + a + np.pi) % (2 * np.pi) - np.pi)

@@ -143,10 +143,8 @@ def to_table_frame(cloud, extrinsic=None, *, frame: str = "camera", viewpoint=No
 
 # ---- the steps ---------------------------------------------------------------------------------------------
 def downsample(pcd, voxel: float):
-    """Open3D's voxel grid filter (a new cloud; ``voxel`` 0: a copy)."""
-    import open3d as o3d
-
-    return pcd.voxel_down_sample(voxel) if voxel > 0 else o3d.geometry.PointCloud(pcd)
+    """Open3D's voxel grid filter (``voxel`` 0: the cloud as it is)."""
+    return pcd.voxel_down_sample(voxel) if voxel > 0 else pcd
 
 
 def fit_table_plane(P: np.ndarray, opts: TableFrameOptions) -> np.ndarray:
