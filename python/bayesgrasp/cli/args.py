@@ -176,3 +176,24 @@ def model_settings(assignments, success: str):
         return ModelSettings(**values)
     except ValueError as e:
         raise CliError(f"--set: {e}") from None
+
+
+FORMATS = ("text", "json", "ros")
+
+
+def add_format_options(p: argparse.ArgumentParser) -> None:
+    """--format text|json|ros and --json (the same as --format json)."""
+    p.add_argument("--format", choices=FORMATS, default=None,
+                   help="text (default), json (one JSON object, the grasp in the schema of "
+                        "bayesgrasp/data/schema/grasp.schema.json) or ros (JSON shaped like moveit_msgs/Grasp)")
+    p.add_argument("--json", action="store_true", help="print one JSON object (the same as --format json)")
+
+
+def output_format(args: argparse.Namespace) -> str:
+    """The chosen output format; --json with another --format is an error."""
+    fmt = getattr(args, "format", None)
+    if getattr(args, "json", False):
+        if fmt not in (None, "json"):
+            raise CliError(f"--json: not with --format {fmt}")
+        return "json"
+    return fmt or "text"

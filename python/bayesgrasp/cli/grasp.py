@@ -21,7 +21,7 @@ from pathlib import Path
 
 import numpy as np
 
-from .args import CliError, floats, output_file
+from .args import CliError, add_format_options, floats, output_file, output_format
 
 
 def add(sub) -> None:
@@ -45,12 +45,13 @@ def add(sub) -> None:
     g.add_argument("--hand", default="barrett_bh8", help="hand file name or path")
     g.add_argument("--keep-origin", action="store_true", help="keep a loaded mesh's own origin")
     g.add_argument("--no-lift", action="store_true", help="skip the physical lift test")
-    g.add_argument("--json", action="store_true", help="print one JSON object")
+    add_format_options(g)
     g.add_argument("--png", default=None, metavar="FILE", help="write a PNG of the hand, the object and the contacts")
     g.set_defaults(run=run)
 
 
 def run(args) -> int:
+    from ..io.grasp_schema import hand_grasp_record, to_ros
     from ..world import World
 
     if args.approach is None and (args.roll is not None or args.at is not None):
@@ -74,7 +75,11 @@ def run(args) -> int:
         "mode": request["mode"], "frame": args.frame, "approach": request.get("approach"), "pose": request.get("pose"),
         "stopped_by_table": g["stopped_by_table"], "hand_pose_object": np.asarray(g["hand_pose_object"]).tolist(),
     }
-    if args.json:
+    out["grasp"] = hand_grasp_record(world.hand, g["hand_pose"], g["joint_angles"], world.spread if args.spread is None else args.spread)
+    fmt = output_format(args)
+    if fmt == "ros":
+        print(json.dumps(to_ros(out["grasp"], grasp_id=f"{args.object}-{request['mode']}", quality=out["epsilon"])))
+    elif fmt == "json":
         print(json.dumps(out))
     else:
         _print(out, args.object, pose)
@@ -82,7 +87,7 @@ def run(args) -> int:
         from ..viz import plot_grasp
 
         plot_grasp(world, grasp, png, title=f"{world.hand.name} on {args.object}: {_describe(out)}")
-        if not args.json:
+        if fmt == "text":
             print(f"saved {png}")
     return 0
 
