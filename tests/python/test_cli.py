@@ -75,7 +75,7 @@ def test_plan_json_on_a_user_mesh_file(tmp_path):
     r = json.loads(out)
     assert isinstance(r["success"], bool) and 1 <= len(r["attempts"]) <= 4
     for a in r["attempts"]:
-        assert a["plan_type"] in ("stability", "explore") and len(a["grasp"]) == 3
+        assert a["plan_type"] in ("stability", "explore") and len(a["top_grasp"]) == 3
         assert 0.0 <= a["predicted_stability"] <= 1.0 and a["outcome"] in ("success", "failure")
         assert a["success"] == bool(a["lifted"])   # the default criterion: held in the lift test
         assert {"entropy", "epsilon", "lifted"} <= set(a)

@@ -94,3 +94,33 @@ def test_grasp_format_ros_has_the_moveit_grasp_fields(capsys):
 def test_json_and_format_ros_together_is_an_error(capsys):
     assert main(["grasp", "--object", "cylinder", "--top", "0,0,0", "--json", "--format", "ros"]) == 2
     assert "--json: not with --format ros" in capsys.readouterr().err
+
+
+SMALL = ["--set", "models.n_samples=300", "--set", "models.n_inducing=50", "--set", "models.max_iter=30",
+         "--set", "models.n_lift_samples=150", "--set", "models.n_calibration=100", "--set", "models.n_pilot=40",
+         "--set", "models.n_pilot_lifts=10"]
+
+
+@pytest.fixture(scope="module")
+def plan_cache(tmp_path_factory):
+    return str(tmp_path_factory.mktemp("cache"))
+
+
+def test_plan_json_has_a_valid_grasp_per_attempt(capsys, plan_cache):
+    argv = ["plan", "--object", "cylinder", "--true-pose", "0.01,-0.01,0.4", "--attempts", "2", "--cache", plan_cache,
+            *SMALL]
+    d = cli_json(capsys, *argv, "--json")
+    for a in d["attempts"]:
+        g = a["grasp"]
+        validate(g)
+        x, y, yaw = a["top_grasp"]
+        T = np.array(g["pose"])
+        np.testing.assert_allclose(T[:2, 3], [x, y], atol=1e-9)   # the executed top grasp: down at (x, y)
+        assert g["approach"] == pytest.approx([0, 0, -1], abs=1e-9) and T[2, 3] > 0
+        assert len(g["joint_positions"]) == len(g["joint_names"])
+    r = cli_json(capsys, *argv, "--format", "ros")
+    assert len(r["attempts"]) == len(d["attempts"])
+    for ros, a in zip(r["attempts"], d["attempts"]):
+        p = ros["grasp_pose"]["pose"]["position"]
+        assert [p["x"], p["y"], p["z"]] == a["grasp"]["position"]
+        assert ros["grasp_posture"]["points"][0]["positions"] == a["grasp"]["joint_positions"]

@@ -8,7 +8,8 @@ from pathlib import Path
 import numpy as np
 
 from . import camera_input
-from .args import CliError, add_context_options, bounded_int, context, floats, out_dir, output_file
+from .args import (CliError, add_context_options, add_format_options, bounded_int, context, floats, out_dir,
+                   output_file, output_format)
 
 METHODS = ["stability", "explore", "ml_pose", "open_loop"]
 
@@ -31,7 +32,7 @@ def add(sub) -> None:
     p.add_argument("--attempts", type=bounded_int(1, 1000), default=4)
     p.add_argument("--noise", type=float, default=0.0, help="joint-angle measurement noise std (rad)")
     p.add_argument("--png", default=None, help="write a PNG of the belief's evolution")
-    p.add_argument("--json", action="store_true", help="print one JSON object")
+    add_format_options(p)
     add_context_options(p)
     camera_input.add(p)
     p.set_defaults(run=plan)
@@ -102,22 +103,35 @@ def demo(args) -> int:
     return 0
 
 
+def _attempt_grasps(r: dict, hand_name: str) -> list:
+    """Each attempt's executed grasp in the schema (world frame, where the hand closed)."""
+    from ..hand import Hand
+    from ..io.grasp_schema import hand_grasp_record
+
+    hand = Hand.load(hand_name)
+    spread = r["planner"].models.spread
+    return [hand_grasp_record(hand, a["hand_pose"], a["joint_positions"], spread) for a in r["attempts"]]
+
+
 def _plan_json(args, pose, r: dict) -> dict:
     f = r["final_belief"]
+    grasps = _attempt_grasps(r, args.hand)
     return {"object": args.object, "method": args.method, "true_pose": pose, "estimate": r["estimate"],
             "success_criterion": args.success, "success": r["success"],
-            "attempts": [{"plan_type": a["kind"], "grasp": a["action"], "predicted_stability": a["predicted_stability"],
+            "attempts": [{"plan_type": a["kind"], "top_grasp": a["action"], "grasp": g, "predicted_stability": a["predicted_stability"],
                           "expected_entropy": a["expected_entropy"], "entropy": a["belief_before"]["kde_entropy"],
                           "epsilon": a["epsilon"], "stable": a["stable"], "lifted": a["lifted"],
                           "success": a["success"], "outcome": "success" if a["success"] else "failure",
                           "plan_seconds": a["plan_seconds"],
-                          "joint_angles": a["joint_angles"]} for a in r["attempts"]],
+                          "joint_angles": a["joint_angles"]} for a, g in zip(r["attempts"], grasps)],
             "final_belief": {"mean": f["mean"], "std": f["std"], "entropy": f["kde_entropy"], "ess": f["ess"],
                              "position_error": f["position_error"], "yaw_error": f["yaw_error"]}}
 
 
 def plan(args) -> int:
     pose = floats(args.true_pose, 3, "--true-pose")
+    fmt = output_format(args)
+    quiet = fmt != "text"
     est = floats(args.estimate, 3, "--estimate") if args.estimate else None
     if not (np.isfinite(args.noise) and args.noise >= 0):
         raise CliError(f"--noise: must be >= 0, got {args.noise}")
@@ -127,14 +141,19 @@ def plan(args) -> int:
         from ..objects import load_object
 
         obj = load_object(args.object, units=args.units)
-    start = _vision_start(args, obj, est, quiet=args.json)
+    start = _vision_start(args, obj, est, quiet=quiet)
     half_width = None
     if start is not None:
         est, half_width = start.estimate.tolist(), start.half_width.tolist()
-    r = _loop(args, pose, args.attempts, est, args.noise, quiet=args.json, half_width=half_width, obj=obj)
+    r = _loop(args, pose, args.attempts, est, args.noise, quiet=quiet, half_width=half_width, obj=obj)
     if png:
         _belief_png(r, png)
-    if args.json:
+    if fmt == "ros":
+        from ..io.grasp_schema import to_ros
+
+        print(json.dumps({"attempts": [to_ros(g, grasp_id=f"attempt-{a['attempt']}", quality=a["predicted_stability"])
+                                       for a, g in zip(r["attempts"], _attempt_grasps(r, args.hand))]}))
+    elif fmt == "json":
         doc = _plan_json(args, pose, r)
         if start is not None:
             doc["vision"] = {"scene": args.cloud or args.depth, "estimate": start.estimate.tolist(),

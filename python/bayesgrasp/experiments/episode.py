@@ -56,6 +56,7 @@ class Execution:
     success: bool
     collision_at_start: bool
     joint_angles: np.ndarray
+    hand_pose: Optional[np.ndarray] = None   # (4, 4) world pose of the hand where it closed
 
 
 def initial_estimate(true_pose: np.ndarray, settings: PlannerSettings, rng: np.random.Generator) -> np.ndarray:
@@ -80,7 +81,8 @@ def execute(world: World, models: GraspModels, action: np.ndarray, true_pose: np
     if not by_lift and ctx.lift and stable:
         lifted = bool(world.grasp_batch(rel[None, :], spread=models.spread, lift=True).lifted[0])
     return Execution(rel, eps, bool(stable), lifted, bool(lifted) if by_lift else bool(stable),
-                     bool(g.collision_at_start[0]), np.asarray(g.joint_angles[0], dtype=float))
+                     bool(g.collision_at_start[0]), np.asarray(g.joint_angles[0], dtype=float),
+                     np.asarray(g.hand_pose[0], dtype=float))
 
 
 def read_fingers(execution: Execution, models: GraspModels, noise: float, rng: np.random.Generator) -> np.ndarray:
@@ -97,7 +99,9 @@ def _attempt_record(k: int, plan, ex: Execution, q: np.ndarray, before: dict) ->
             "objective": float(plan.objective), "expected_entropy": plan.expected_entropy,
             "plan_seconds": plan.seconds, "evaluations": plan.evaluations, "epsilon": ex.epsilon,
             "force_closure": ex.epsilon > 0.0, "stable": ex.stable, "lifted": ex.lifted, "success": ex.success,
-            "collision_at_start": ex.collision_at_start, "joint_angles": q.tolist(), "belief_before": before}
+            "collision_at_start": ex.collision_at_start, "joint_angles": q.tolist(),
+            "hand_pose": None if ex.hand_pose is None else ex.hand_pose.tolist(),
+            "joint_positions": ex.joint_angles.tolist(), "belief_before": before}
 
 
 def _check_pose(true_pose) -> np.ndarray:
