@@ -3,6 +3,7 @@
 Sub-commands:
   demo        the main job: plan, grasp, update the belief, re-plan, on a built-in mug
   plan        the same loop for any object (built-in or mesh file) at a given true pose
+  episode     the same loop with your robot executing: new, observe (joints, lifted), show
   experiment  the thesis's experiments (pub2, baselines, pub4, entropy_order, landscapes)
   grasp       close the hand on an object from a top grasp, an approach direction or a hand pose
   category    grasp a new member of a known category for a task (Eq. 4.1)
@@ -19,10 +20,10 @@ import argparse
 import os
 import sys
 
-from . import category, experiment, fuse, grasp, objects, plan, register, touch
+from . import category, episode, experiment, fuse, grasp, objects, plan, register, touch
 from .args import CliError, join_negative_values
 
-COMMANDS = (grasp, plan, category, fuse, experiment, register, objects, touch)
+COMMANDS = (grasp, plan, episode, category, fuse, experiment, register, objects, touch)
 
 
 def build_parser() -> argparse.ArgumentParser:
