@@ -379,7 +379,7 @@ def plot_fusion_rounds(names: Sequence[str], rounds: Sequence[dict], true_pose, 
             x, y, yaw = r["poses"][n]
             b.arrow(100 * x, 100 * y, 1.5 * np.cos(yaw), 1.5 * np.sin(yaw), color=cmap(k % 10), alpha=shade,
                     width=0.05, head_width=0.4)
-        gx, gy, gyaw = r["grasp"]
+        gx, gy, gyaw = r["top_grasp"]
         b.plot(100 * gx, 100 * gy, "s" if r["lifted"] else "x", color="k", alpha=shade, ms=8,
                label="grasp (square: lifted)" if t == 0 else None)
     tx, ty, tyaw = true_pose

@@ -14,6 +14,7 @@ from bayesgrasp.models.task_grasps import (TaskGraspSettings, generate_task_gras
                                            load_task_grasp_file)
 from bayesgrasp.models.tasks import task_rule
 from bayesgrasp.world import World
+from bayesgrasp.io.grasp_schema import validate
 
 SMALL = TaskGraspSettings(candidates=150, spreads=(0.0, float(np.radians(60))), lift_tests=6, keep=2)
 
@@ -91,6 +92,7 @@ def test_category_cli_json_and_png(grasp_file, tmp_path, capsys):
     doc = json.loads(out[:out.rindex("}") + 1])
     assert set(doc) >= {"grasp", "method", "models", "epsilon", "lifted", "task_ok", "success"}
     assert np.asarray(doc["grasp"]["pose"]).shape == (4, 4)
+    validate(doc["grasp"])                                      # the one grasp schema
     assert [m["model"] for m in doc["models"]] == [f"mug/{i}" for i in (0, 1, 2, 4, 5, 6)]
     assert png.stat().st_size > 1000
 
@@ -143,7 +145,9 @@ def test_category_cli_plans_on_a_camera_cloud_and_executes_on_the_stand_in(grasp
     assert main(base + ["--scene-object", "mug/3", "--pose", "0.1,-0.05,-1.0"]) == 0
     done = json.loads(capsys.readouterr().out)
     assert done["executed"] is True and isinstance(done["lifted"], bool)
-    np.testing.assert_allclose(done["grasp"]["pose"], G)    # the same plan, now executed
+    np.testing.assert_allclose(done["planned_pose"], G)     # the same plan, now executed
+    validate(done["grasp"])                                 # where the hand closed
+    assert done["grasp"]["joint_positions"] != doc["grasp"]["joint_positions"]   # closed, not the open preshape
     assert main(base[:-4] + ["--complete", "--cloud", str(scan / "cloud.ply")]) == 2
     assert "--complete" in capsys.readouterr().err
 

@@ -10,6 +10,7 @@ from bayesgrasp.experiments.tactile_fusion import FusionTrial, planar_top_grasps
 from bayesgrasp.models import ModelSettings
 from bayesgrasp.models.task_grasps import TaskGraspSettings, generate_task_grasps, grasp_to_json
 from bayesgrasp.models.tasks import task_rule
+from bayesgrasp.io.grasp_schema import validate
 
 SMALL = ModelSettings(n_samples=400, n_inducing=60, max_iter=40, n_lift_samples=200, n_calibration=150, n_pilot=60,
                       n_pilot_lifts=15)
@@ -89,7 +90,10 @@ def test_fuse_cli(grasps, cache, tmp_path, capsys):
             "--cache", cache, "--rounds", "2", "--json", "--png", str(png)]
     assert main(args + small_models_and_grasps(grasps, tmp_path)) == 0
     doc = json.loads(capsys.readouterr().out)
-    assert doc["rounds"] and set(doc["rounds"][0]) >= {"grasp", "weights", "poses", "epsilon", "lifted"}
+    assert doc["rounds"] and set(doc["rounds"][0]) >= {"grasp", "top_grasp", "weights", "poses", "epsilon", "lifted"}
+    for r in doc["rounds"]:
+        validate(r["grasp"])                                    # the one grasp schema
+        np.testing.assert_allclose(np.array(r["grasp"]["pose"])[:2, 3], r["top_grasp"][:2], atol=1e-9)
     assert doc["success"] == any(r["lifted"] for r in doc["rounds"])
     assert png.stat().st_size > 1000
     assert main(["fuse", "--scene-object", "mug/3", "--set", "models.n_samples=x"]) == 2

@@ -5,6 +5,7 @@ import numpy as np
 import pytest
 
 from bayesgrasp.cli import main
+from bayesgrasp.io.grasp_schema import validate
 
 
 def _json(capsys, *args):
@@ -18,7 +19,9 @@ def test_touch_json_on_the_cube(capsys):
     d = _json(capsys, "--object", "cube", "--true-pose", "0.01,-0.01,0.3", "--estimate", "-0.01,0.005,0.45",
               "--budget", "400")
     assert d["status"] == "estimated" and d["evaluations"] == 400
-    assert d["grasp"]["x"] == -0.01 and d["readings"]["contact_links"]
+    assert d["top_grasp"]["x"] == -0.01 and d["readings"]["contact_links"]
+    validate(d["grasp"])                                        # the one grasp schema
+    assert d["grasp"]["pose"] == d["readings"]["hand_pose"] and d["grasp"]["joint_positions"] == d["readings"]["joint_angles"]
     assert d["fitness"] <= d["initial_fitness"]
     assert d["errors_after"]["orientation_error"] is not None   # the cube: modulo 90 degrees
     assert d["trace"]["evaluations"][-1] == 400

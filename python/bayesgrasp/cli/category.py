@@ -52,7 +52,7 @@ def run(args) -> int:
         raise CliError("no training model registered to the cloud (is the object in view, is it of this category?)")
     grasps = task_grasps_arg(args)
     out = plan_and_execute(ep, args.category, args.task, args.method, ctx, seed=args.seed, grasps=grasps)
-    doc = {"grasp": {"pose": out["pose"], "spread": out.get("spread"), "frame": "table"}, "method": args.method,
+    doc = {"grasp": _grasp_record(out, ctx), "planned_pose": out["pose"], "method": args.method,
            "category": args.category, "task": args.task, "scene_object": args.scene_object,
            "object_pose": pose if args.scene_object else None, "executed": out["executed"],
            "scene": (args.cloud or args.depth) if view is not None else "simulated view",
@@ -68,6 +68,20 @@ def run(args) -> int:
         _png(ep, out, ctx, png, doc)
         print(f"saved {png}")
     return 0
+
+
+def _grasp_record(out: dict, ctx):
+    """The plan in the grasp schema (world = the table frame): executed, where the hand closed and
+    its closed fingers; planned only, the planned pose with the open preshape (None: no grasp)."""
+    from ..hand import Hand
+    from ..io.grasp_schema import hand_grasp_record
+
+    if out["pose"] is None:
+        return None
+    hand = Hand.load(ctx.hand)
+    if out["executed"]:
+        return hand_grasp_record(hand, out["hand_pose"], out["joint_angles"], out["spread"])
+    return hand_grasp_record(hand, out["pose"], hand.open_joints(out["spread"]), out["spread"])
 
 
 def _print(doc: dict) -> None:

@@ -53,10 +53,16 @@ def run(args) -> int:
                         exclude=args.exclude if args.exclude is not None else [args.scene_object], seed=args.seed,
                         category=args.category, grasps=grasps,
                         observation=None if view is None else camera_input.observation(view))
+    from ..hand import Hand
+    from ..io.grasp_schema import hand_grasp_record
+
+    hand = Hand.load(ctx.hand)
     rounds = []
     r = trial.run(args.start, rounds=args.rounds, on_round=None if args.json else _print_round(trial.names))
     for rec in r["rounds"]:
-        rounds.append({"round": rec["round"], "grasp": rec["action"], "epsilon": rec["epsilon"], "lifted": rec["lifted"],
+        rounds.append({"round": rec["round"], "top_grasp": rec["action"],
+                       "grasp": hand_grasp_record(hand, rec["hand_pose"], rec["joint_positions"], trial.spread),
+                       "epsilon": rec["epsilon"], "lifted": rec["lifted"],
                        "weights": dict(zip(trial.names, rec["weights"])),
                        "poses": dict(zip(trial.names, rec["poses"])), "underflow": rec["underflow"]})
     success = any(x["lifted"] for x in rounds)

@@ -78,12 +78,15 @@ def _errors(obj, state, truth) -> dict:
 
 
 def _result(args, planner, grasp, readings, r, truth, guess, case) -> dict:
+    from ..io.grasp_schema import hand_grasp_record
+
     names = list(planner.model.hand.core.link_names)
     est = np.asarray(planner.estimate, dtype=float)
     return {
         "object": args.object, "case": case, "optimizer": args.optimizer, "contact_term": args.contact_term,
         "true_state": truth.tolist(), "initial": guess.tolist(), "estimate": est.tolist(),
-        "grasp": {"x": grasp.x, "y": grasp.y, "yaw": grasp.yaw, "spread": grasp.spread},
+        "top_grasp": {"x": grasp.x, "y": grasp.y, "yaw": grasp.yaw, "spread": grasp.spread},
+        "grasp": hand_grasp_record(planner.model.hand, readings.hand_pose, readings.joints, grasp.spread),
         "readings": {"joint_angles": np.asarray(readings.joints).tolist(),
                      "joint_names": list(planner.model.hand.core.joint_names),
                      "contact_links": [n for n, c in zip(names, readings.contact) if c],
@@ -121,7 +124,7 @@ def _deg(v):
 
 
 def _print(o: dict) -> None:
-    g, rd = o["grasp"], o["readings"]
+    g, rd = o["top_grasp"], o["readings"]
     print(f"touch on {o['object']} ({o['case']}, {o['optimizer']}, contact term {o['contact_term']})")
     print(f"  true state      x={o['true_state'][0]:.4f} y={o['true_state'][1]:.4f} "
           f"yaw={o['true_state'][2]:.4f} scale={o['true_state'][3]:.3f}")

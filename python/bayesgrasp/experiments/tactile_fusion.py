@@ -54,7 +54,7 @@ def top_grasp(world: World, action: np.ndarray, true_pose: np.ndarray, spread: f
     rel = relative_top_grasps(action, true_pose)[0]
     b = world.grasp_batch(rel, spread=spread, lift=True)
     return {"action": action.tolist(), "lifted": bool(b.lifted[0]), "epsilon": float(b.epsilon[0]),
-            "joint_angles": np.asarray(b.joint_angles[0], float)}
+            "joint_angles": np.asarray(b.joint_angles[0], float), "hand_pose": np.asarray(b.hand_pose[0]).tolist()}
 
 
 class FusionTrial:
@@ -124,6 +124,7 @@ class FusionTrial:
     def _execute(self, action) -> dict:
         e = top_grasp(self.world, np.asarray(action, float), self.pose, self.spread)
         idx = self.models[0].joint_index
+        e["joint_positions"] = np.asarray(e["joint_angles"]).tolist()
         e["measurement"] = np.asarray(e.pop("joint_angles"))[idx]
         return e
 
