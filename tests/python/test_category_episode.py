@@ -148,6 +148,12 @@ def test_category_cli_plans_on_a_camera_cloud_and_executes_on_the_stand_in(grasp
     np.testing.assert_allclose(done["planned_pose"], G)     # the same plan, now executed
     validate(done["grasp"])                                 # where the hand closed
     assert done["grasp"]["joint_positions"] != doc["grasp"]["joint_positions"]   # closed, not the open preshape
+    ros = base[:base.index("--json")] + base[base.index("--json") + 1:] + ["--format", "ros"]
+    assert main(ros) == 0                                   # plan only, as moveit_msgs/Grasp
+    r = json.loads(capsys.readouterr().out)
+    p = r["grasp_pose"]["pose"]["position"]
+    np.testing.assert_allclose([p["x"], p["y"], p["z"]], G[:3, 3])
+    assert r["pre_grasp_posture"]["joint_names"] == doc["grasp"]["joint_names"]
     assert main(base[:-4] + ["--complete", "--cloud", str(scan / "cloud.ply")]) == 2
     assert "--complete" in capsys.readouterr().err
 

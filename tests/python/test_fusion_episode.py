@@ -119,3 +119,15 @@ def test_fuse_cli_sees_a_camera_cloud(grasps, cache, tmp_path, capsys):
     assert doc["scene"] == str(scan / "cloud.ply")
     poses = np.array(list(doc["rounds"][0]["poses"].values()))
     assert np.all(np.hypot(poses[:, 0] - 0.05, poses[:, 1] + 0.03) < 0.02)
+
+
+def test_fuse_format_ros_has_one_grasp_per_round(grasps, cache, tmp_path, capsys):
+    args = ["fuse", "--scene-object", "mug/3", "--pose", "0.01,0.02,0.7", "--exclude", *EXCLUDE, "mug/3",
+            "--cache", cache, "--rounds", "1"] + small_models_and_grasps(grasps, tmp_path)
+    assert main(args + ["--json"]) == 0
+    doc = json.loads(capsys.readouterr().out)
+    assert main(args + ["--format", "ros"]) == 0
+    ros = json.loads(capsys.readouterr().out)
+    assert [r["grasp_posture"]["points"][0]["positions"] for r in ros["rounds"]] == \
+        [r["grasp"]["joint_positions"] for r in doc["rounds"]]
+    assert all(r["grasp_pose"]["header"]["frame_id"] == "world" for r in ros["rounds"])

@@ -124,3 +124,13 @@ def test_plan_json_has_a_valid_grasp_per_attempt(capsys, plan_cache):
         p = ros["grasp_pose"]["pose"]["position"]
         assert [p["x"], p["y"], p["z"]] == a["grasp"]["position"]
         assert ros["grasp_posture"]["points"][0]["positions"] == a["grasp"]["joint_positions"]
+
+
+def test_touch_format_ros_is_its_grasp(capsys):
+    argv = ["touch", "--object", "cube", "--true-pose", "0.01,-0.01,0.3", "--estimate", "-0.01,0.005,0.45",
+            "--budget", "50"]
+    d = cli_json(capsys, *argv, "--json")
+    r = cli_json(capsys, *argv, "--format", "ros")
+    assert r["grasp_posture"]["points"][0]["positions"] == d["grasp"]["joint_positions"]
+    o = r["grasp_pose"]["pose"]["orientation"]
+    assert [o["x"], o["y"], o["z"], o["w"]] == d["grasp"]["quaternion_xyzw"]

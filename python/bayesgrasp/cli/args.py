@@ -114,7 +114,7 @@ def add_category_options(p: argparse.ArgumentParser, png_help: str) -> None:
                    help="demonstrated grasps to use instead of generating them (JSON {\"grasps\": [{model, task, pose "
                         "(4x4, model frame), spread, epsilon, lifted}]}; the generator's cache files have this format, "
                         "so hand-made grasps can be added to a copy of one)")
-    p.add_argument("--json", action="store_true", help="print one JSON object")
+    add_format_options(p)
     p.add_argument("--png", default=None, metavar="FILE", help=png_help)
 
 

@@ -11,7 +11,8 @@ import json
 import numpy as np
 
 from . import camera_input
-from .args import CliError, add_category_options, add_context_options, context, floats, output_file, task_grasps_arg
+from .args import (CliError, add_category_options, add_context_options, context, floats, output_file, output_format,
+                   task_grasps_arg)
 
 
 def add(sub) -> None:
@@ -60,13 +61,20 @@ def run(args) -> int:
                       for m in ep.models],
            "epsilon": out["epsilon"], "lifted": out["lifted"], "task_ok": out["task_ok"], "success": out["success"],
            "failure": out["failure"], "reason": out["reason"] or None, "contact_parts": out.get("contact_parts", [])}
-    if args.json:
+    fmt = output_format(args)
+    if fmt == "ros":
+        from ..io.grasp_schema import to_ros
+
+        print(json.dumps(None if doc["grasp"] is None else
+                         to_ros(doc["grasp"], grasp_id=f"{args.category}-{args.task}", quality=out["objective"])))
+    elif fmt == "json":
         print(json.dumps(doc))
     else:
         _print(doc)
     if png and out["executed"]:
         _png(ep, out, ctx, png, doc)
-        print(f"saved {png}")
+        if fmt == "text":
+            print(f"saved {png}")
     return 0
 
 

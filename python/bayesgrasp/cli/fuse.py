@@ -11,7 +11,7 @@ import numpy as np
 
 from . import camera_input
 from .args import (CliError, add_category_options, add_context_options, bounded_int, context, floats, output_file,
-                   task_grasps_arg)
+                   output_format, task_grasps_arg)
 
 
 def add(sub) -> None:
@@ -58,7 +58,8 @@ def run(args) -> int:
 
     hand = Hand.load(ctx.hand)
     rounds = []
-    r = trial.run(args.start, rounds=args.rounds, on_round=None if args.json else _print_round(trial.names))
+    fmt = output_format(args)
+    r = trial.run(args.start, rounds=args.rounds, on_round=None if fmt != "text" else _print_round(trial.names))
     for rec in r["rounds"]:
         rounds.append({"round": rec["round"], "top_grasp": rec["action"],
                        "grasp": hand_grasp_record(hand, rec["hand_pose"], rec["joint_positions"], trial.spread),
@@ -69,7 +70,11 @@ def run(args) -> int:
     doc = {"scene_object": args.scene_object, "object_pose": pose, "category": args.category, "task": args.task,
            "start": args.start, "belief": args.belief, "rounds": rounds, "success": success,
            "scene": (args.cloud or args.depth) if view is not None else "simulated view"}
-    if args.json:
+    if fmt == "ros":
+        from ..io.grasp_schema import to_ros
+
+        print(json.dumps({"rounds": [to_ros(x["grasp"], grasp_id=f"round-{x['round']}") for x in rounds]}))
+    elif fmt == "json":
         print(json.dumps(doc))
     else:
         print(f"{'success' if success else 'no grasp lifted'} after {len(rounds)} grasp(s)")
@@ -77,7 +82,7 @@ def run(args) -> int:
         from ..viz import plot_fusion_rounds
 
         plot_fusion_rounds(trial.names, rounds, pose, png, title=f"{args.scene_object}: vision then touch")
-        if not args.json:
+        if fmt == "text":
             print(f"saved {png}")
     return 0
 

@@ -11,7 +11,7 @@ import json
 
 import numpy as np
 
-from .args import SEED_MAX, CliError, bounded_int, floats, output_file
+from .args import SEED_MAX, CliError, add_format_options, bounded_int, floats, output_file, output_format
 
 
 def add(sub) -> None:
@@ -29,7 +29,7 @@ def add(sub) -> None:
     t.add_argument("--spread", type=float, default=None, help="finger spread of the touch (rad); default: the hand's")
     t.add_argument("--seed", type=bounded_int(0, SEED_MAX), default=0, help="the optimiser's seed")
     t.add_argument("--hand", default="barrett_bh8", help="hand file name or path")
-    t.add_argument("--json", action="store_true", help="print one JSON object")
+    add_format_options(t)
     t.add_argument("--png", default=None, metavar="PATH", help="write the fitness landscape to this PNG")
     t.set_defaults(run=run)
 
@@ -61,7 +61,12 @@ def run(args) -> int:
     out = _result(args, planner, grasp, readings, r, truth, guess, case)
     if png:
         out["png"] = str(_landscape(planner, grasp, readings, truth, guess, png, args))
-    if args.json:
+    fmt = output_format(args)
+    if fmt == "ros":
+        from ..io.grasp_schema import to_ros
+
+        print(json.dumps(to_ros(out["grasp"], grasp_id=f"{args.object}-touch")))
+    elif fmt == "json":
         print(json.dumps(out))
     else:
         _print(out)
