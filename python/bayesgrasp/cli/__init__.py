@@ -21,15 +21,36 @@ import os
 import sys
 
 from . import category, episode, experiment, fuse, grasp, objects, plan, register, touch
+from .. import __version__
 from .args import CliError, join_negative_values
 
 COMMANDS = (grasp, plan, episode, category, fuse, experiment, register, objects, touch)
 
 
+class HelpFormatter(argparse.RawDescriptionHelpFormatter):
+    """Descriptions as written; every option's default appended to its help unless the help
+    already tells it (or the default is None / False: nothing to tell)."""
+
+    def _get_help_string(self, action):
+        h = action.help or ""
+        if ("default" in h.lower() or action.default in (None, False, argparse.SUPPRESS)
+                or not action.option_strings or action.default == []):
+            return h
+        return h + " (default: %(default)s)"
+
+
+class Parser(argparse.ArgumentParser):
+    """Every (sub-)parser shows its defaults (:class:`HelpFormatter`)."""
+
+    def __init__(self, *a, **kw):
+        kw.setdefault("formatter_class", HelpFormatter)
+        super().__init__(*a, **kw)
+
+
 def build_parser() -> argparse.ArgumentParser:
-    parser = argparse.ArgumentParser(prog="bayesgrasp", description=__doc__,
-                                     formatter_class=argparse.RawDescriptionHelpFormatter)
-    sub = parser.add_subparsers(dest="command", metavar="COMMAND")
+    parser = Parser(prog="bayesgrasp", description=__doc__)
+    parser.add_argument("--version", action="version", version=f"bayesgrasp {__version__}")
+    sub = parser.add_subparsers(dest="command", metavar="COMMAND", parser_class=Parser)
     for command in COMMANDS:
         command.add(sub)
     return parser

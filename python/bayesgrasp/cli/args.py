@@ -91,14 +91,14 @@ def output_file(path: Optional[str], what: str) -> Optional[Path]:
 
 def add_context_options(p: argparse.ArgumentParser, lift: bool = False, seed: bool = True) -> None:
     """The options every run context is built from: --hand, --cache, --success (and --seed, --no-lift)."""
-    p.add_argument("--hand", default="barrett_bh8", help="hand file name or path")
+    p.add_argument("--hand", type=hand_name, default="barrett_bh8", help="built-in hand name or hand file path")
     p.add_argument("--success", default="lift", choices=["lift", "epsilon"],
                    help="what a successful grasp is: held in the lift test (default) or epsilon above the "
                         "models' eps_stable (the thesis's simulation criterion)")
     p.add_argument("--cache", default=None, help="model cache directory (default: $BAYESGRASP_CACHE/models, "
                                                  "$BAYESGRASP_CACHE defaulting to ~/.cache/bayesgrasp)")
     if seed:
-        p.add_argument("--seed", type=bounded_int(0, SEED_MAX), default=0, help="seed")
+        p.add_argument("--seed", type=bounded_int(0, SEED_MAX), default=0, help="seed of every random draw (same seed, same result)")
     p.add_argument("--set", action="append", default=[], metavar="models.FIELD=VALUE",
                    help="override a grasp-model setting (bayesgrasp.models.ModelSettings), e.g. models.n_samples=500; "
                         "repeatable")
@@ -197,3 +197,18 @@ def output_format(args: argparse.Namespace) -> str:
             raise CliError(f"--json: not with --format {fmt}")
         return "json"
     return fmt or "text"
+
+
+def hand_name(text: str) -> str:
+    """An argparse type for --hand: a built-in hand's name or a hand file that exists (argparse then
+    names --hand in the error, before any work)."""
+    from ..hand import HANDS_DIR, builtin_hands
+
+    p = Path(text)
+    if p.is_file() or (not p.suffix and (HANDS_DIR / f"{text}.json").is_file()):
+        return text
+    raise argparse.ArgumentTypeError(f"unknown hand {text!r} (built-in: {', '.join(builtin_hands())}; or the path "
+                                     "of a hand file)")
+
+
+hand_name.__name__ = "hand"

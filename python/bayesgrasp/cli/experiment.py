@@ -7,7 +7,10 @@ from .args import CliError, add_context_options, bounded_int, context, out_dir
 
 
 def add(sub) -> None:
-    e = sub.add_parser("experiment", help="run (or resume) one of the thesis's experiments")
+    e = sub.add_parser("experiment", help="run (or resume) one of the thesis's experiments",
+                       description="Runs (or resumes) one of the thesis's experiments, run by run in worker "
+                                   "processes; every finished run is stored in the output directory's results.sqlite, "
+                                   "so an interrupted experiment resumes without repeating a run.")
     e.add_argument("name", help="the experiment's name; `bayesgrasp experiment list` lists them")
     e.add_argument("--runs", type=bounded_int(1, 10**7), default=None, help="runs per object (default: the experiment's)")
     e.add_argument("--workers", type=bounded_int(1, 1024), default=1, help="worker processes")

@@ -3,7 +3,8 @@ from __future__ import annotations
 
 
 def add(sub) -> None:
-    sub.add_parser("objects", help="list the built-in objects").set_defaults(run=run)
+    sub.add_parser("objects", help="list the built-in objects",
+                   description="Lists the built-in objects (names for --object and --scene-object).").set_defaults(run=run)
 
 
 def run(args) -> int:

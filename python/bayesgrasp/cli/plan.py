@@ -15,21 +15,28 @@ METHODS = ["stability", "explore", "ml_pose", "open_loop"]
 
 
 def add(sub) -> None:
-    d = sub.add_parser("demo", help="the main job: grasping a mug whose pose is uncertain")
+    d = sub.add_parser("demo", help="the main job: grasping a mug whose pose is uncertain",
+                       description="The main job: a mug at a hidden pose known to +-4 cm and +-45 deg; plan, grasp, "
+                                   "read the fingers, update the belief, re-plan until it is lifted; writes "
+                                   "belief_evolution.png and demo.json to --out.")
     d.add_argument("--object", default="mug", help="built-in object name or mesh file")
-    d.add_argument("--method", default="explore", choices=METHODS)
+    d.add_argument("--method", default="explore", choices=METHODS, help="stability: the most stable grasp (Eq. 3.1); explore: informative grasps while none is likely to hold (Eq. 3.2); ml_pose: the most stable grasp at the most likely pose; open_loop: the most stable grasp at the estimate, no update")
     d.add_argument("--out", default="out/demo", help="directory for the PNG and results")
     add_context_options(d)
     d.set_defaults(run=demo)
 
-    p = sub.add_parser("plan", help="run the planning loop on an object at a hidden true pose")
+    p = sub.add_parser("plan", help="run the planning loop on an object at a hidden true pose",
+                       description="The closed loop of thesis Figs. 3.1 and 3.4 on any object (built-in or mesh file) "
+                                   "whose true pose is hidden from the planner: plan, execute in the simulator, read "
+                                   "the joint angles, update the belief, re-plan; until a grasp is lifted or the "
+                                   "attempts run out. To execute on your own robot, use `bayesgrasp episode`.")
     p.add_argument("--object", required=True, help="built-in object name or mesh file")
     p.add_argument("--true-pose", required=True, metavar="X,Y,YAW", help="the hidden pose: metres, metres, radians")
-    p.add_argument("--method", default="explore", choices=METHODS)
+    p.add_argument("--method", default="explore", choices=METHODS, help="stability: the most stable grasp (Eq. 3.1); explore: informative grasps while none is likely to hold (Eq. 3.2); ml_pose: the most stable grasp at the most likely pose; open_loop: the most stable grasp at the estimate, no update")
     p.add_argument("--estimate", default=None, metavar="X,Y,YAW",
                    help="the initial pose estimate (default: from --cloud / --depth by registering the object's "
                         "mesh, its spread set by the fit; else the true pose + uniform noise within the belief)")
-    p.add_argument("--attempts", type=bounded_int(1, 1000), default=4)
+    p.add_argument("--attempts", type=bounded_int(1, 1000), default=4, help="grasps at most")
     p.add_argument("--noise", type=float, default=0.0, help="joint-angle measurement noise std (rad)")
     p.add_argument("--png", default=None, help="write a PNG of the belief's evolution")
     add_format_options(p)

@@ -11,13 +11,16 @@ from .args import SEED_MAX, CliError, bounded_int, floats, output_file
 
 
 def add(sub) -> None:
-    r = sub.add_parser("register", help="register a camera's cloud (or a simulated view) against models")
+    r = sub.add_parser("register", help="register a camera's cloud (or a simulated view) against models",
+                       description="One view of an object (a camera's --cloud or --depth, or a simulated view of "
+                                   "--scene-object), the table segmented off, and each model registered to it "
+                                   "(FPFH + RANSAC, then ICP; thesis section 4.2): pose, fit and weight per model.")
     r.add_argument("--scene-object", default=None,
                    help="simulated view: object placed in the scene (built-in name or mesh file)")
     r.add_argument("--pose", default="0,0,0", metavar="X,Y,YAW", help="its pose on the table")
     r.add_argument("--models", required=True, nargs="+", metavar="NAME_OR_PATH", help="models to register against")
     r.add_argument("--voxel", type=float, default=0.005, help="voxel size (m); all radii scale from it")
-    r.add_argument("--seed", type=bounded_int(0, SEED_MAX), default=0)
+    r.add_argument("--seed", type=bounded_int(0, SEED_MAX), default=0, help="seed of the registration's random draws")
     r.add_argument("--png", default=None, help="write a PNG of the cloud over each registered model")
     r.add_argument("--json", action="store_true", help="print one JSON object")
     camera_input.add(r)

@@ -11,16 +11,19 @@ import json
 
 import numpy as np
 
-from .args import SEED_MAX, CliError, add_format_options, bounded_int, floats, output_file, output_format
+from .args import SEED_MAX, CliError, add_format_options, bounded_int, floats, hand_name, output_file, output_format
 
 
 def add(sub) -> None:
-    t = sub.add_parser("touch", help="estimate an object's pose (and size) from one touch (Pub. I)")
+    t = sub.add_parser("touch", help="estimate an object's pose (and size) from one touch (Pub. I)",
+                       description=__doc__)
     t.add_argument("--object", required=True, help="built-in object name (see `bayesgrasp objects`) or mesh file")
     t.add_argument("--true-pose", required=True, metavar="X,Y,YAW", help="the object's hidden pose (m, m, rad)")
     t.add_argument("--true-scale", type=float, default=1.0, help="the object's hidden uniform scale")
     t.add_argument("--estimate", required=True, metavar="X,Y,YAW", help="the initial guess (m, m, rad)")
-    t.add_argument("--optimizer", default="pso", choices=["pso", "sa", "firefly", "descent", "trust_region"])
+    t.add_argument("--optimizer", default="pso", choices=["pso", "sa", "firefly", "descent", "trust_region"],
+                   help="the fit's optimiser: particle swarm, simulated annealing, firefly, gradient descent or "
+                        "trust region (Pub. I compares them)")
     t.add_argument("--size", action="store_true", help="estimate the scale too (4 DoF; the guess is scale 1)")
     t.add_argument("--orientation-only", action="store_true", help="estimate the yaw alone, the position given")
     t.add_argument("--budget", type=bounded_int(1, 10**7), default=2000, help="fitness evaluations (re-simulated closings)")
@@ -28,7 +31,7 @@ def add(sub) -> None:
                    help="0/1 contact flags, or the continuous distance of the touching links to the surface")
     t.add_argument("--spread", type=float, default=None, help="finger spread of the touch (rad); default: the hand's")
     t.add_argument("--seed", type=bounded_int(0, SEED_MAX), default=0, help="the optimiser's seed")
-    t.add_argument("--hand", default="barrett_bh8", help="hand file name or path")
+    t.add_argument("--hand", type=hand_name, default="barrett_bh8", help="built-in hand name or hand file path")
     add_format_options(t)
     t.add_argument("--png", default=None, metavar="PATH", help="write the fitness landscape to this PNG")
     t.set_defaults(run=run)
