@@ -6,7 +6,7 @@
   cloud.ply        the depth image back-projected, in the camera frame (what a driver publishes)
   truth.json       the object and its pose on the table (x, y, yaw), for the simulated stand-in
 
-Usage: python examples/make_scan.py [--object mug/3] [--pose 0.03,-0.02,0.8] [--out out/scan]
+Usage: python examples/make_scan.py [--object mug/3] [--object-pose 0.03,-0.02,0.8] [--out out/scan]
 """
 from __future__ import annotations
 
@@ -24,7 +24,8 @@ from bayesgrasp.objects import load_object
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--object", default="mug/3", help="built-in object or mesh file")
-    ap.add_argument("--pose", default="0.03,-0.02,0.8", help="x,y,yaw on the table (m, m, rad)")
+    ap.add_argument("--object-pose", "--pose", dest="pose", default="0.03,-0.02,0.8",
+                    help="x,y,yaw on the table (m, m, rad); --pose: the old spelling")
     ap.add_argument("--eye", default="0.5,-0.45,0.5", help="camera position relative to the object (m)")
     ap.add_argument("--seed", type=int, default=0)
     ap.add_argument("--out", default="out/scan")

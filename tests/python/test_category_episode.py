@@ -86,7 +86,7 @@ def test_the_complete_model_mode_registers_the_whole_surface():
 def test_category_cli_json_and_png(grasp_file, tmp_path, capsys):
     f, _ = grasp_file
     png = tmp_path / "c.png"
-    assert main(["category", "--category", "mug", "--task", "top", "--scene-object", "mug/3", "--pose", "-0.01,0.02,0.4",
+    assert main(["category", "--category", "mug", "--task", "top", "--scene-object", "mug/3", "--object-pose", "-0.01,0.02,0.4",
                  "--method", "laplace", "--task-grasps", str(f), "--json", "--png", str(png)]) == 0
     out = capsys.readouterr().out
     doc = json.loads(out[:out.rindex("}") + 1])
@@ -142,7 +142,7 @@ def test_category_cli_plans_on_a_camera_cloud_and_executes_on_the_stand_in(grasp
     assert doc["executed"] is False and doc["lifted"] is None and doc["success"] is None
     G = np.asarray(doc["grasp"]["pose"])
     assert np.hypot(G[0, 3] - 0.1, G[1, 3] + 0.05) < 0.08   # over the scanned mug, not the origin
-    assert main(base + ["--scene-object", "mug/3", "--pose", "0.1,-0.05,-1.0"]) == 0
+    assert main(base + ["--scene-object", "mug/3", "--object-pose", "0.1,-0.05,-1.0"]) == 0
     done = json.loads(capsys.readouterr().out)
     assert done["executed"] is True and isinstance(done["lifted"], bool)
     np.testing.assert_allclose(done["planned_pose"], G)     # the same plan, now executed

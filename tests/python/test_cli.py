@@ -54,7 +54,7 @@ def test_grasp_relative_to_the_object_pose_is_invariant():
     (["experiment", "pub2", "--objects", "no_such_thing"], "neither a built-in"),
     (["experiment", "pub2", "--out", "/proc/forbidden/dir"], "--out"),
     (["experiment", "pub2", "--no-lift"], "--success epsilon"),
-    (["register", "--scene-object", "cube", "--pose", "1,2", "--models", "cube"], "--pose"),
+    (["register", "--scene-object", "cube", "--object-pose", "1,2", "--models", "cube"], "--object-pose"),
 ])
 def test_bad_input_gives_a_message_and_exit_status_2(args, needle, capsys):
     assert main(args) == 2
@@ -108,7 +108,7 @@ def test_experiment_writes_tables_and_plots_and_resumes(tmp_path):
     (["plan", "--object", "cube", "--true-pose", "-0.02,0.01,0.3"], "true_pose", [-0.02, 0.01, 0.3]),
     (["plan", "--object", "cube", "--true-pose", "0,0,0", "--estimate", "-.5e-2,-0.01,-3"], "estimate",
      [-0.005, -0.01, -3.0]),
-    (["register", "--scene-object", "mug/3", "--pose", "-0.05,0,1", "--models", "mug/0"], "pose", [-0.05, 0.0, 1.0]),
+    (["register", "--scene-object", "mug/3", "--object-pose", "-0.05,0,1", "--models", "mug/0"], "object_pose", [-0.05, 0.0, 1.0]),
 ])
 def test_comma_separated_options_take_negative_numbers(argv, dest, expected):
     from bayesgrasp.cli import build_parser
@@ -134,7 +134,7 @@ def test_negative_lone_numbers_and_option_like_values_are_left_to_argparse():
 
 def test_register_json_and_png(tmp_path, capsys):
     png = tmp_path / "reg.png"
-    assert main(["register", "--scene-object", "cube", "--pose", "0.05,0.0,0.4", "--models", "cube", "cylinder",
+    assert main(["register", "--scene-object", "cube", "--object-pose", "0.05,0.0,0.4", "--models", "cube", "cylinder",
                  "--json", "--png", str(png)]) == 0
     out = capsys.readouterr().out
     doc = json.loads(out[:out.rindex("}") + 1])
@@ -203,12 +203,12 @@ def test_grasp_from_a_pose_file(capsys, tmp_path):
     T = [[1, 0, 0, 0.0], [0, -1, 0, 0.0], [0, 0, -1, 0.2], [0, 0, 0, 1]]   # palm down 20 cm above the origin
     (tmp_path / "list.json").write_text(json.dumps(T))
     (tmp_path / "dict.json").write_text(json.dumps({"pose": T}))
-    a = grasp_json(capsys, "--object", "cube", "--pose", str(tmp_path / "list.json"), "--object-pose", "0.1,0,0")
-    b = grasp_json(capsys, "--object", "cube", "--pose", str(tmp_path / "dict.json"), "--object-pose", "0.1,0,0")
+    a = grasp_json(capsys, "--object", "cube", "--hand-pose", str(tmp_path / "list.json"), "--object-pose", "0.1,0,0")
+    b = grasp_json(capsys, "--object", "cube", "--hand-pose", str(tmp_path / "dict.json"), "--object-pose", "0.1,0,0")
     assert a["mode"] == "pose" and a["pose"] == T and a["joint_angles"] == b["joint_angles"]
     np.testing.assert_allclose(a["hand_pose_object"], T, atol=1e-12)
     np.testing.assert_allclose(np.array(a["hand_pose"])[:3, 3], [0.1, 0.0, 0.2], atol=1e-12)
-    w = grasp_json(capsys, "--object", "cube", "--pose", str(tmp_path / "list.json"), "--object-pose", "0.1,0,0",
+    w = grasp_json(capsys, "--object", "cube", "--hand-pose", str(tmp_path / "list.json"), "--object-pose", "0.1,0,0",
                    "--frame", "world")
     np.testing.assert_allclose(w["hand_pose"], T, atol=1e-12)
 
@@ -219,9 +219,9 @@ def test_grasp_from_a_pose_file(capsys, tmp_path):
     (["--approach", "0,0,-1", "--at", "2,0,0.05"], "--approach: target: off the table"),
     (["--approach", "0,0"], "--approach"),
     (["--top", "0,0,0", "--roll", "1"], "--roll: only with --approach"),
-    (["--pose", "NOFILE"], "--pose: cannot read"),
-    (["--pose", "BAD"], "--pose: hand_pose: pose rotation"),
-    (["--pose", "SHAPE"], "--pose: .* must hold a 4x4"),
+    (["--hand-pose", "NOFILE"], "--hand-pose: cannot read"),
+    (["--hand-pose", "BAD"], "--hand-pose: hand_pose: pose rotation"),
+    (["--hand-pose", "SHAPE"], "--hand-pose: .* must hold a 4x4"),
 ])
 def test_grasp_bad_input_is_a_clear_error(args, needle, tmp_path, capsys):
     (tmp_path / "bad.json").write_text(json.dumps([[2, 0, 0, 0], [0, 1, 0, 0], [0, 0, 1, 0.2], [0, 0, 0, 1]]))
@@ -245,7 +245,7 @@ def test_integer_options_out_of_range_are_usage_errors_naming_the_flag(args, cap
 
 
 @pytest.mark.parametrize("args, needle", [
-    ([], "one of the arguments --top --approach --pose is required"),
+    ([], "one of the arguments --top --approach --hand-pose/--pose is required"),
     (["--top", "0,0,0", "--approach", "0,0,-1"], "not allowed with"),
 ])
 def test_grasp_needs_exactly_one_of_top_approach_pose(args, needle, capsys):

@@ -58,3 +58,39 @@ def test_an_unknown_hand_names_the_option(capsys, argv):
     err = capsys.readouterr().err
     assert e.value.code == 2 and "argument --hand: unknown hand 'nosuch'" in err and "barrett_bh8" in err
     assert "name_or_path" not in err
+
+
+@pytest.mark.parametrize("old, new, argv", [
+    ("--pose", "--object-pose", ["register", "--scene-object", "cube", "--models", "cube"]),
+    ("--pose", "--object-pose", ["category", "--category", "mug", "--task", "top"]),
+    ("--pose", "--object-pose", ["fuse", "--scene-object", "mug/3"]),
+])
+def test_old_spellings_still_work_and_warn(capsys, old, new, argv):
+    """The old spelling is parsed into the same setting as the new one, with one deprecation line."""
+    parser = build_parser()
+    a = parser.parse_args(argv + [old, "0.01,0.02,0.3"])
+    err = capsys.readouterr().err
+    assert f"{old} is deprecated" in err and f"use {new}" in err
+    b = parser.parse_args(argv + [new, "0.01,0.02,0.3"])
+    assert vars(a) == vars(b) and a.object_pose == "0.01,0.02,0.3"
+
+
+def test_old_spelling_warns_once_naming_the_new_one(capsys):
+    build_parser().parse_args(["fuse", "--scene-object", "mug/3", "--pose", "0,0,0"])
+    err = capsys.readouterr().err.strip().splitlines()
+    assert err == ["bayesgrasp fuse: warning: --pose is deprecated and will be removed in the next release; "
+                   "use --object-pose"]
+    build_parser().parse_args(["fuse", "--scene-object", "mug/3", "--object-pose", "0,0,0"])
+    assert capsys.readouterr().err == ""
+
+
+def test_grasp_hand_pose_old_spelling(capsys, tmp_path):
+    import json
+
+    f = tmp_path / "T.json"
+    f.write_text(json.dumps([[1, 0, 0, 0], [0, -1, 0, 0], [0, 0, -1, 0.3], [0, 0, 0, 1]]))
+    assert main(["grasp", "--object", "cube", "--pose", str(f), "--json"]) == 0
+    out, err = capsys.readouterr()
+    assert "--pose is deprecated" in err and "use --hand-pose" in err
+    assert main(["grasp", "--object", "cube", "--hand-pose", str(f), "--json"]) == 0
+    assert json.loads(capsys.readouterr().out)["joint_angles"] == json.loads(out)["joint_angles"]

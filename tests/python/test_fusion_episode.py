@@ -86,7 +86,7 @@ def small_models_and_grasps(grasps, tmp_path) -> list:
 
 def test_fuse_cli(grasps, cache, tmp_path, capsys):
     png = tmp_path / "f.png"
-    args = ["fuse", "--scene-object", "mug/3", "--pose", "0.01,0.02,0.7", "--exclude", *EXCLUDE, "mug/3",
+    args = ["fuse", "--scene-object", "mug/3", "--object-pose", "0.01,0.02,0.7", "--exclude", *EXCLUDE, "mug/3",
             "--cache", cache, "--rounds", "2", "--json", "--png", str(png)]
     assert main(args + small_models_and_grasps(grasps, tmp_path)) == 0
     doc = json.loads(capsys.readouterr().out)
@@ -111,7 +111,7 @@ def test_fuse_cli_sees_a_camera_cloud(grasps, cache, tmp_path, capsys):
     root = Path(__file__).resolve().parents[2]
     subprocess.run([sys.executable, str(root / "examples" / "make_scan.py"), "--object", "mug/3", "--pose",
                     "0.05,-0.03,0.7", "--out", str(scan)], check=True, capture_output=True)
-    args = ["fuse", "--scene-object", "mug/3", "--pose", "0.01,0.02,0.7", "--exclude", *EXCLUDE, "mug/3",
+    args = ["fuse", "--scene-object", "mug/3", "--object-pose", "0.01,0.02,0.7", "--exclude", *EXCLUDE, "mug/3",
             "--cache", cache, "--rounds", "1", "--json", "--cloud", str(scan / "cloud.ply"),
             "--extrinsic", str(scan / "extrinsic.json")]
     assert main(args + small_models_and_grasps(grasps, tmp_path)) == 0
@@ -122,7 +122,7 @@ def test_fuse_cli_sees_a_camera_cloud(grasps, cache, tmp_path, capsys):
 
 
 def test_fuse_format_ros_has_one_grasp_per_round(grasps, cache, tmp_path, capsys):
-    args = ["fuse", "--scene-object", "mug/3", "--pose", "0.01,0.02,0.7", "--exclude", *EXCLUDE, "mug/3",
+    args = ["fuse", "--scene-object", "mug/3", "--object-pose", "0.01,0.02,0.7", "--exclude", *EXCLUDE, "mug/3",
             "--cache", cache, "--rounds", "1"] + small_models_and_grasps(grasps, tmp_path)
     assert main(args + ["--json"]) == 0
     doc = json.loads(capsys.readouterr().out)

@@ -212,3 +212,21 @@ def hand_name(text: str) -> str:
 
 
 hand_name.__name__ = "hand"
+
+
+class Renamed(argparse.Action):
+    """Stores the value like ``store``; given by one of its ``old`` spellings (kept for one
+    release), it also prints one deprecation line on stderr naming the new spelling."""
+
+    def __init__(self, option_strings, dest, old=(), **kw):
+        self.old = tuple(old)
+        super().__init__(option_strings, dest, **kw)
+
+    def __call__(self, parser, namespace, values, option_string=None):
+        if option_string in self.old:
+            import sys
+
+            new = next(o for o in self.option_strings if o not in self.old)
+            print(f"{parser.prog}: warning: {option_string} is deprecated and will be removed in the next release; "
+                  f"use {new}", file=sys.stderr)
+        setattr(namespace, self.dest, values)

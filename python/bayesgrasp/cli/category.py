@@ -11,7 +11,7 @@ import json
 import numpy as np
 
 from . import camera_input
-from .args import (CliError, add_category_options, add_context_options, context, floats, output_file, output_format,
+from .args import (CliError, Renamed, add_category_options, add_context_options, context, floats, output_file, output_format,
                    task_grasps_arg)
 
 
@@ -22,8 +22,9 @@ def add(sub) -> None:
     c.add_argument("--task", required=True, help="the task (mug: top, side, handle; bottle: side; knife: handle)")
     c.add_argument("--scene-object", default=None,
                    help="the new object (built-in name or mesh file): the simulated view, or with camera data the "
-                        "simulated stand-in the grasp is executed on (at --pose, in the table frame)")
-    c.add_argument("--pose", default="0,0,0", metavar="X,Y,YAW", help="its pose on the table")
+                        "simulated stand-in the grasp is executed on (at --object-pose, in the table frame)")
+    c.add_argument("--object-pose", "--pose", dest="object_pose", action=Renamed, old=["--pose"], default="0,0,0",
+                   metavar="X,Y,YAW", help="its pose on the table (--pose: the old spelling, deprecated)")
     c.add_argument("--method", default="laplace", choices=["laplace", "regularised", "gaussian", "baseline"],
                    help="Eq. 4.1's density, or the best-single-grasp baseline")
     c.add_argument("--complete", action="store_true", help="use the object's whole surface as the cloud")
@@ -37,7 +38,7 @@ def run(args) -> int:
     from ..experiments.category import plan_and_execute, see
     from ..models.tasks import task_rule
 
-    pose = floats(args.pose, 3, "--pose")
+    pose = floats(args.object_pose, 3, "--object-pose")
     png = output_file(args.png, "--png")
     task_rule(args.category, args.task)   # a clear error for an unknown category or task
     view = camera_input.observe(args)

@@ -2,7 +2,7 @@
 model a weight and a pose; each executed top grasp's joint angles update them (Eqs. 4.4-4.5); the
 next grasp maximises stability x task (Eq. 4.6); until a grasp is lifted or the rounds run out.
 The view is a camera's (``--cloud``, ``--depth``) or a simulated one of ``--scene-object``; the
-grasps are executed on ``--scene-object`` at ``--pose``, the simulated stand-in for the robot."""
+grasps are executed on ``--scene-object`` at ``--object-pose``, the simulated stand-in for the robot."""
 from __future__ import annotations
 
 import json
@@ -10,7 +10,7 @@ import json
 import numpy as np
 
 from . import camera_input
-from .args import (CliError, add_category_options, add_context_options, bounded_int, context, floats, output_file,
+from .args import (CliError, Renamed, add_category_options, add_context_options, bounded_int, context, floats, output_file,
                    output_format, task_grasps_arg)
 
 
@@ -21,7 +21,8 @@ def add(sub) -> None:
     f.add_argument("--task", default="top", help="the task whose demonstrated top grasps define P(T)")
     f.add_argument("--scene-object", required=True,
                    help="the new object (built-in name or mesh file), seen (without camera data) and grasped")
-    f.add_argument("--pose", default="0,0,0", metavar="X,Y,YAW", help="its pose on the table")
+    f.add_argument("--object-pose", "--pose", dest="object_pose", action=Renamed, old=["--pose"], default="0,0,0",
+                   metavar="X,Y,YAW", help="its pose on the table (--pose: the old spelling, deprecated)")
     f.add_argument("--rounds", type=bounded_int(0, 1000), default=3, help="tactile rounds after the first grasp")
     f.add_argument("--start", choices=["vision", "random"], default="vision",
                    help="G(0): planned from the view (Eq. 4.6's task term) or at random above the object")
@@ -39,7 +40,7 @@ def run(args) -> int:
     from ..experiments.tactile_fusion import FusionTrial
     from ..planners.fusion import FusionSettings
 
-    pose = floats(args.pose, 3, "--pose")
+    pose = floats(args.object_pose, 3, "--object-pose")
     if args.rounds < 0:
         raise CliError(f"--rounds: must be >= 0, got {args.rounds}")
     if not (np.isfinite(args.noise) and args.noise >= 0):

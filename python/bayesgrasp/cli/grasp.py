@@ -9,7 +9,7 @@ Exactly one of:
   first contact with the object or the table, then closes; the roll turns the hand about
   -direction (roll 0: the palm-down top-grasp hand tilted by the smallest rotation taking -z
   onto the direction; ``--approach 0,0,-1 --roll YAW --at X,Y,0`` is ``--top X,Y,YAW``);
-* ``--pose FILE.json``: the hand closes at a 4x4 pose (a JSON list of 4 rows, or
+* ``--hand-pose FILE.json``: the hand closes at a 4x4 pose (a JSON list of 4 rows, or
   ``{"pose": [...]}``).
 
 Everything is in the object's frame unless ``--frame world``.
@@ -21,7 +21,7 @@ from pathlib import Path
 
 import numpy as np
 
-from .args import CliError, add_format_options, floats, hand_name, output_file, output_format
+from .args import CliError, Renamed, add_format_options, floats, hand_name, output_file, output_format
 
 
 def add(sub) -> None:
@@ -31,13 +31,15 @@ def add(sub) -> None:
     mode = g.add_mutually_exclusive_group(required=True)
     mode.add_argument("--top", metavar="X,Y,YAW", help="top grasp: metres, metres, radians")
     mode.add_argument("--approach", metavar="DX,DY,DZ", help="approach direction (any length but zero)")
-    mode.add_argument("--pose", metavar="FILE.json", help="4x4 hand pose: a JSON list of 4 rows or {\"pose\": ...}")
+    mode.add_argument("--hand-pose", "--pose", dest="hand_pose", action=Renamed, old=["--pose"], metavar="FILE.json",
+                      help="4x4 hand pose: a JSON list of 4 rows or {\"pose\": ...} (--pose: the old spelling, "
+                           "deprecated)")
     g.add_argument("--roll", type=float, default=None, help="with --approach: roll about -direction (radians; default 0)")
     g.add_argument("--at", metavar="X,Y,Z", default=None,
                    help="with --approach: a point on the palm's line of motion (default: the centre of the object's "
                         "bounding box)")
     g.add_argument("--frame", choices=["object", "world"], default="object",
-                   help="frame of --top, --approach/--roll/--at and --pose (default: the object's)")
+                   help="frame of --top, --approach/--roll/--at and --hand-pose (default: the object's)")
     g.add_argument("--object-pose", default="0,0,0", metavar="X,Y,YAW", help="object pose on the table")
     g.add_argument("--spread", type=float, default=None, help="finger spread (radians); default: the hand's")
     g.add_argument("--standoff", type=float, default=0.0,
@@ -101,23 +103,23 @@ def _request(args) -> dict:
         target = None if args.at is None else floats(args.at, 3, "--at")
         return {"mode": "approach", "approach": {"direction": direction, "roll": float(args.roll or 0.0),
                                                  "target": target}}
-    return {"mode": "pose", "pose": _read_pose(args.pose)}
+    return {"mode": "pose", "pose": _read_pose(args.hand_pose)}
 
 
 def _read_pose(path: str) -> list:
     try:
         doc = json.loads(Path(path).read_text())
     except OSError as e:
-        raise CliError(f"--pose: cannot read {path}: {e.strerror or e}") from None
+        raise CliError(f"--hand-pose: cannot read {path}: {e.strerror or e}") from None
     except ValueError as e:
-        raise CliError(f"--pose: {path} is not JSON: {e}") from None
+        raise CliError(f"--hand-pose: {path} is not JSON: {e}") from None
     m = doc.get("pose") if isinstance(doc, dict) else doc
     try:
         M = np.asarray(m, dtype=float)
     except (TypeError, ValueError):
         M = np.zeros(0)
     if M.shape != (4, 4):
-        raise CliError(f"--pose: {path} must hold a 4x4 matrix (a list of 4 rows of 4 numbers, or {{\"pose\": ...}})")
+        raise CliError(f"--hand-pose: {path} must hold a 4x4 matrix (a list of 4 rows of 4 numbers, or {{\"pose\": ...}})")
     return M.tolist()
 
 
@@ -139,7 +141,7 @@ def _grasp(world, args, request):
                                   lift=lift)
         return world.grasp_pose(request["pose"], spread=args.spread, frame=args.frame, lift=lift)
     except ValueError as e:
-        option = {"top": "--top", "approach": "--approach", "pose": "--pose"}[request["mode"]]
+        option = {"top": "--top", "approach": "--approach", "pose": "--hand-pose"}[request["mode"]]
         raise CliError(f"{option}: {e}") from None
 
 

@@ -7,7 +7,7 @@ import json
 import numpy as np
 
 from . import camera_input
-from .args import SEED_MAX, CliError, bounded_int, floats, output_file
+from .args import SEED_MAX, CliError, Renamed, bounded_int, floats, output_file
 
 
 def add(sub) -> None:
@@ -17,7 +17,8 @@ def add(sub) -> None:
                                    "(FPFH + RANSAC, then ICP; thesis section 4.2): pose, fit and weight per model.")
     r.add_argument("--scene-object", default=None,
                    help="simulated view: object placed in the scene (built-in name or mesh file)")
-    r.add_argument("--pose", default="0,0,0", metavar="X,Y,YAW", help="its pose on the table")
+    r.add_argument("--object-pose", "--pose", dest="object_pose", action=Renamed, old=["--pose"], default="0,0,0",
+                   metavar="X,Y,YAW", help="its pose on the table (--pose: the old spelling, deprecated)")
     r.add_argument("--models", required=True, nargs="+", metavar="NAME_OR_PATH", help="models to register against")
     r.add_argument("--voxel", type=float, default=0.005, help="voxel size (m); all radii scale from it")
     r.add_argument("--seed", type=bounded_int(0, SEED_MAX), default=0, help="seed of the registration's random draws")
@@ -31,7 +32,7 @@ def run(args) -> int:
     from ..objects import load_object
     from ..vision import register
 
-    pose = floats(args.pose, 3, "--pose")
+    pose = floats(args.object_pose, 3, "--object-pose")
     if not (args.voxel > 0 and np.isfinite(args.voxel)):
         raise CliError(f"--voxel: must be positive, got {args.voxel}")
     if camera_input.given(args) == bool(args.scene_object):
