@@ -1,7 +1,8 @@
 """Gaussian-process regression: exact and sparse (FITC), scikit-learn style.
 
-``ExactGP`` and ``SparseGP`` wrap the C++ models in :mod:`bayesgrasp._core.gp` and follow the
-scikit-learn estimator conventions, so they can be swapped for ``GaussianProcessRegressor``::
+``ExactGP`` and ``SparseGP`` wrap the C++ models in :mod:`bayesgrasp._core.gp` and are
+scikit-learn estimators (``BaseEstimator``, ``RegressorMixin``, when scikit-learn is installed),
+so they can be swapped for ``GaussianProcessRegressor``::
 
     gp = SparseGP(kernel="se", n_inducing=200, seed=0).fit(X, y)   # X (N, D), y (N,) or (N, P)
     mean, std = gp.predict(Xs, return_std=True)
@@ -44,7 +45,13 @@ def _as_2d(a, name, cols=None):
     return np.ascontiguousarray(a)
 
 
-class _GPBase:
+try:   # scikit-learn (installed by `make`) makes them real estimators: clone, cross_val_score, Pipeline
+    from sklearn.base import BaseEstimator as _Estimator, RegressorMixin as _Regressor
+except ImportError:   # pragma: no cover - the same API without scikit-learn's machinery
+    _Estimator, _Regressor = object, object
+
+
+class _GPBase(_Regressor, _Estimator):
     _core_cls = None
 
     def __init__(self, kernel="se", lengthscale=None, variance=1.0, noise=1e-2, mean="zero", optimize=True,
