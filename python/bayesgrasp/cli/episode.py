@@ -1,9 +1,12 @@
 """``bayesgrasp episode``: the closed loop with your robot doing the executing (thesis Figs. 3.1,
 3.4). ``new`` writes the belief and settings to a directory and prints the first grasp; the robot
 executes it; ``observe`` takes its joint reading and the lift verdict, updates the belief and prints
-the next grasp; ``show`` prints the history and the belief. The grasps are top grasps: the hand
-comes down along -z at (x, y, yaw) until it touches, then closes (the printed ``grasp`` is where
-it is expected to close, simulated at the belief's mean)."""
+the next grasp; ``show`` prints the history and the belief. Three kinds: pose uncertainty (Pub.
+II-IV, --method stability|explore: top grasps, the hand comes down along -z at (x, y, yaw) until it
+touches, then closes; the printed ``grasp`` is where it is expected to close, simulated at the
+belief's mean); a category task (Pub. V, --category C --task T: one task grasp from one view, the
+robot approaches along the printed pose); vision then touch (Pub. VI, --category C --task T
+--method fusion: top grasps, each reading updates the models' weights and poses)."""
 from __future__ import annotations
 
 import json
@@ -11,7 +14,11 @@ import json
 import numpy as np
 
 from . import camera_input
-from .args import CliError, add_context_options, add_format_options, bounded_int, context, floats, output_format
+from .args import (CliError, add_context_options, add_format_options, bounded_int, context, floats, output_format,
+                   task_grasps_arg)
+
+POSE_METHODS = ("stability", "explore")
+CATEGORY_METHODS = ("laplace", "regularised", "gaussian", "baseline", "fusion")
 
 
 def add(sub) -> None:
@@ -21,11 +28,22 @@ def add(sub) -> None:
 
     n = cmds.add_parser("new", help="start an episode and print the first grasp",
                         description="Writes the belief and settings to --dir and prints the first grasp.")
-    n.add_argument("--object", required=True, help="built-in object name (see `bayesgrasp objects`) or mesh file")
+    n.add_argument("--object", default=None,
+                   help="built-in object name (see `bayesgrasp objects`) or mesh file: the object (pose episodes), or "
+                        "with --category and no camera data the object whose simulated view is taken")
     n.add_argument("--estimate", default=None, metavar="X,Y,YAW",
                    help="the object's estimated pose on the table (m, m, rad); or give --cloud / --depth")
-    n.add_argument("--method", default="explore", choices=["stability", "explore"],
-                   help="stability: the most stable grasp (Eq. 3.1); explore: also grasps that inform (Eq. 3.2)")
+    n.add_argument("--method", default=None, choices=list(POSE_METHODS + CATEGORY_METHODS),
+                   help="pose: stability (Eq. 3.1) or explore (Eq. 3.2, default); with --category: laplace (default), "
+                        "regularised, gaussian, baseline (Eq. 4.1, one grasp) or fusion (vision then touch, Eq. 4.6)")
+    n.add_argument("--category", default=None, help="a category task or vision-then-touch episode: mug, bottle or knife")
+    n.add_argument("--task", default=None, help="the task, with --category (mug: top, side, handle; ...)")
+    n.add_argument("--object-pose", default="0,0,0", metavar="X,Y,YAW",
+                   help="with --category and no camera data: the pose of --object for its simulated view")
+    n.add_argument("--exclude", nargs="*", default=None, metavar="NAME",
+                   help="with --category: training models to leave out (default: --object, if it is one)")
+    n.add_argument("--task-grasps", default=None, metavar="FILE",
+                   help="with --category: demonstrated grasps to use instead of generating them (as for `category`)")
     n.add_argument("--attempts", type=bounded_int(1, 1000), default=4, help="grasps at most")
     n.add_argument("--dir", required=True, help="the episode's directory (created; must not hold an episode)")
     add_format_options(n)
@@ -58,6 +76,16 @@ def new(args) -> int:
     from .plan import _vision_start
 
     fmt = output_format(args)
+    if args.category or args.task:
+        return _new_category(args, fmt)
+    for opt in ("exclude", "task_grasps"):
+        if getattr(args, opt) is not None:
+            raise CliError(f"--{opt.replace('_', '-')}: only with --category")
+    if args.object is None:
+        raise CliError("--object: needed (the object whose pose is uncertain)")
+    method = args.method or "explore"
+    if method not in POSE_METHODS:
+        raise CliError(f"--method: {method} needs --category and --task")
     est = floats(args.estimate, 3, "--estimate") if args.estimate else None
     obj = args.object
     if args.units or camera_input.given(args):
@@ -71,17 +99,48 @@ def new(args) -> int:
         settings = settings.with_(half_width=tuple(start.half_width.tolist()))
     if est is None:
         raise CliError("--estimate: needed (or --cloud / --depth to register the object to)")
-    ep = PoseEpisode.new(args.dir, obj, est, context(args), method=args.method, attempts=args.attempts,
+    ep = PoseEpisode.new(args.dir, obj, est, context(args), method=method, attempts=args.attempts,
                          seed=args.seed, planner=settings)
+    _print_next(ep, fmt)
+    return 0
+
+
+def _new_category(args, fmt: str) -> int:
+    """A category task (Pub. V) or vision-then-touch (Pub. VI) episode from one view."""
+    from ..experiments.category import observe
+    from ..experiments.outside_loop_category import CategoryTaskEpisode, FusionEpisode
+
+    if not (args.category and args.task):
+        raise CliError("--category, --task: give both")
+    if args.estimate:
+        raise CliError("--estimate: not with --category (the view's registrations place the models)")
+    method = args.method or "laplace"
+    if method in POSE_METHODS:
+        raise CliError(f"--method: {method} is a pose-uncertainty method; with --category one of "
+                       f"{', '.join(CATEGORY_METHODS)}")
+    view = camera_input.observe(args)
+    if view is not None:
+        obs = camera_input.observation(view)
+    elif args.object:
+        obs = observe(args.object, floats(args.object_pose, 3, "--object-pose"), seed=args.seed)
+    else:
+        raise CliError("--cloud, --depth or --object: the view to plan from")
+    exclude = args.exclude if args.exclude is not None else [m for m in [args.object] if m]
+    common = dict(exclude=exclude, seed=args.seed, grasps=task_grasps_arg(args))
+    if method == "fusion":
+        ep = FusionEpisode.new(args.dir, obs, args.category, args.task, context(args), attempts=args.attempts,
+                               **common)
+    else:
+        ep = CategoryTaskEpisode.new(args.dir, obs, args.category, args.task, context(args), method=method, **common)
     _print_next(ep, fmt)
     return 0
 
 
 def _open(args):
     from ..experiments.context import stderr_progress
-    from ..experiments.outside_loop import PoseEpisode
+    from ..experiments.outside_loop_category import open_episode
 
-    return PoseEpisode.open(args.dir, cache_dir=args.cache, progress=stderr_progress)
+    return open_episode(args.dir, cache_dir=args.cache, progress=stderr_progress)
 
 
 def observe(args) -> int:
@@ -92,45 +151,69 @@ def observe(args) -> int:
     return 0
 
 
+def _quality(nxt: dict) -> float:
+    """The planner's score of a grasp: predicted P(success) (pose) or the objective (category kinds)."""
+    return float(nxt["predicted_stability"] if "predicted_stability" in nxt else nxt["objective"])
+
+
+def _score(nxt: dict) -> str:
+    if "predicted_stability" in nxt:
+        return f"predicted P(success) {nxt['predicted_stability']:.2f}"
+    return f"objective {nxt['objective']:.3g}"
+
+
 def _print_next(ep, fmt: str) -> None:
     nxt = ep.next
-    doc = {"episode": str(ep.directory), "status": ep.state["status"], "attempts_made": len(ep.state["steps"]),
-           "next": nxt}
+    doc = {"episode": str(ep.directory), "kind": ep.kind, "status": ep.state["status"],
+           "attempts_made": len(ep.state["steps"]), "next": nxt}
     if fmt == "ros":
         from ..io.grasp_schema import to_ros
 
         doc = {"episode": doc["episode"], "status": doc["status"],
                "next": None if nxt is None else to_ros(nxt["grasp"], grasp_id=f"attempt-{nxt['attempt']}",
-                                                       quality=nxt["predicted_stability"])}
+                                                       quality=_quality(nxt))}
     if fmt != "text":
         print(json.dumps(doc))
         return
     if nxt is None:
         print(f"episode {ep.directory}: {ep.state['status']} after {len(ep.state['steps'])} grasp(s)")
         return
-    x, y, yaw = nxt["top_grasp"]
-    z = nxt["grasp"]["position"][2]
-    print(f"attempt {nxt['attempt']} ({nxt['kind']}): top grasp at ({x:.4f} m, {y:.4f} m, yaw {yaw:.4f} rad), "
-          f"expected to close at z {z:.3f} m; predicted P(success) {nxt['predicted_stability']:.2f}")
-    print("  joints " + ",".join(nxt["grasp"]["joint_names"]))
+    g = nxt["grasp"]
+    if "top_grasp" in nxt:
+        x, y, yaw = nxt["top_grasp"]
+        print(f"attempt {nxt['attempt']} ({nxt['kind']}): top grasp at ({x:.4f} m, {y:.4f} m, yaw {yaw:.4f} rad), "
+              f"expected to close at z {g['position'][2]:.3f} m; {_score(nxt)}")
+    else:
+        p, a = g["position"], g["approach"]
+        print(f"attempt {nxt['attempt']} ({nxt['kind']}): palm at ({p[0]:.4f}, {p[1]:.4f}, {p[2]:.4f}) m, approach "
+              f"({a[0]:.3f}, {a[1]:.3f}, {a[2]:.3f}), spread {g['spread']:.3f} rad; {_score(nxt)}")
+    print("  joints " + ",".join(g["joint_names"]))
     print("  then: bayesgrasp episode observe " + str(ep.directory) + " --joints A,B,... --lifted yes|no")
 
 
 def show(args) -> int:
     ep = _open(args)
     belief = ep.belief()
-    doc = {"episode": str(ep.directory), "object": ep.state["object"], "method": ep.state["method"],
-           "status": ep.state["status"], "estimate": ep.state["estimate"], "steps": ep.state["steps"],
-           "next": ep.next, "belief": belief}
+    st = ep.state
+    doc = {"episode": str(ep.directory), "kind": ep.kind, "method": st["method"], "status": st["status"],
+           "steps": st["steps"], "next": ep.next, "belief": belief}
+    doc.update({k: st[k] for k in ("object", "estimate", "category", "task") if k in st})
     if args.json:
         print(json.dumps(doc))
         return 0
-    print(f"episode {ep.directory}: {ep.state['object']}, {ep.state['method']}, {ep.state['status']}")
-    for s in ep.state["steps"]:
-        x, y, yaw = s["top_grasp"]
-        print(f"  attempt {s['attempt']}: ({x:.4f}, {y:.4f}, {np.degrees(yaw):.1f} deg) -> "
-              f"{'lifted' if s['lifted'] else 'not lifted'}")
-    m, sd = belief["mean"], belief["std"]
-    print(f"  belief: mean ({m[0]:.4f} m, {m[1]:.4f} m, {np.degrees(m[2]):.1f} deg), std ({100 * sd[0]:.1f} cm, "
-          f"{100 * sd[1]:.1f} cm, {np.degrees(sd[2]):.1f} deg), ESS {belief['ess']:.0f}")
+    what = st.get("object") or f"{st['category']} / {st['task']}"
+    print(f"episode {ep.directory}: {what}, {st['method']}, {st['status']}")
+    for s in st["steps"]:
+        if "top_grasp" in s:
+            x, y, yaw = s["top_grasp"]
+            where = f"({x:.4f}, {y:.4f}, {np.degrees(yaw):.1f} deg)"
+        else:
+            where = "palm at ({:.4f}, {:.4f}, {:.4f}) m".format(*(row[3] for row in s["planned_pose"][:3]))
+        print(f"  attempt {s['attempt']}: {where} -> {'lifted' if s['lifted'] else 'not lifted'}")
+    if "mean" in belief:
+        m, sd = belief["mean"], belief["std"]
+        print(f"  belief: mean ({m[0]:.4f} m, {m[1]:.4f} m, {np.degrees(m[2]):.1f} deg), std ({100 * sd[0]:.1f} cm, "
+              f"{100 * sd[1]:.1f} cm, {np.degrees(sd[2]):.1f} deg), ESS {belief['ess']:.0f}")
+    else:
+        print("  weights: " + ", ".join(f"{m} {w:.3f}" for m, w in (belief["weights"] or {}).items()))
     return 0

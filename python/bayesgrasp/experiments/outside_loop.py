@@ -116,70 +116,49 @@ def check_lifted(text: Union[str, bool]) -> bool:
     raise EpisodeError(f"--lifted: yes or no, got {text!r}")
 
 
-# ---- the episode --------------------------------------------------------------------------------
-class PoseEpisode:
-    """An episode under pose uncertainty (Pub. II-IV) whose grasps a robot outside executes.
+# ---- what every episode on disk shares ----------------------------------------------------------
+class DiskEpisode:
+    """An episode on disk whose grasps a robot outside executes: ``next`` is the grasp to execute,
+    ``observe(joints, lifted)`` feeds back the robot's reading (every hand joint, rad) and the lift
+    verdict and returns the next grasp (None when the episode ended). A kind supplies
+    ``_replay`` (its planner after the logged steps), ``_absorb`` (one reading into the belief),
+    ``_plan_next`` and ``belief``. ``open`` resumes one in a later process (any kind:
+    :func:`~.outside_loop_category.open_episode`)."""
 
-    ``PoseEpisode.new(directory, "mug", estimate, ctx)`` starts it; ``episode.next`` is the grasp
-    to execute; ``episode.observe(joints, lifted)`` feeds back the robot's reading (every hand
-    joint, rad) and the lift verdict and returns the next grasp (None when the episode ended);
-    ``PoseEpisode.open(directory)`` resumes it in a later process."""
+    kind = ""
 
-    def __init__(self, directory: Path, state: dict, ctx: RunContext, obj: Optional[ObjectModel] = None):
+    def __init__(self, directory: Path, state: dict, ctx: RunContext):
         self.directory, self.state, self.ctx = Path(directory), state, ctx
-        self.object = obj if obj is not None else load_object(state["object"])
         self.hand = Hand.load(ctx.hand)
-        self.models: GraspModels = ctx.models(obj if obj is not None else state["object"])
-        if self.models.info.get("key") != state["models_key"]:
-            raise EpisodeError(f"{self.directory}: the episode was planned with other models (key "
-                               f"{state['models_key']}, now {self.models.info.get('key')}): same --hand, --cache "
-                               "and --set as at `episode new`")
-        self.planner = self._replay()
 
-    # ---- making and opening ----
-    @classmethod
-    def new(cls, directory, obj: Union[str, ObjectModel], estimate: Sequence[float], ctx: RunContext,
-            method: str = "explore", attempts: int = 4, seed: int = 0,
-            planner: Optional[PlannerSettings] = None) -> "PoseEpisode":
-        directory = Path(directory)
-        if method not in METHODS:
-            raise EpisodeError(f"--method: one of {', '.join(METHODS)}; got {method!r}")
+    @staticmethod
+    def _base_state(kind: str, ctx: RunContext, attempts: int, seed: int) -> dict:
         if attempts < 1:
             raise EpisodeError(f"--attempts: must be at least 1, got {attempts}")
-        if (directory / STATE_FILE).exists():
-            raise EpisodeError(f"{directory}: already holds an episode (remove it or pick another --dir)")
         if ctx.success != "lift":
             raise EpisodeError("--success: an episode's success is the robot's lift verdict (success 'lift')")
-        est = np.asarray(estimate, dtype=float).ravel()
-        if est.shape != (3,) or not np.all(np.isfinite(est)):
-            raise EpisodeError(f"--estimate: expected three finite numbers (x, y, yaw), got {estimate}")
-        settings = planner or PlannerSettings()
-        obj_model = load_object(obj) if isinstance(obj, str) else obj
-        models = ctx.models(obj if isinstance(obj, str) else obj_model)
-        state = {"format": FORMAT, "bayesgrasp": __version__, "kind": "pose",
-                 "object": obj if isinstance(obj, str) else obj_model.name, "hand": ctx.hand,
-                 "models_key": models.info.get("key"), "cache": ctx.cache_dir,
-                 "model_settings": None if ctx.model_settings is None else dataclasses.asdict(ctx.model_settings), "method": method, "attempts": int(attempts), "seed": int(seed),
-                 "estimate": est.tolist(), "planner": _planner_json(settings), "steps": [], "next": None,
-                 "status": "open"}
-        episode = cls(directory, state, ctx, obj_model)
-        with _locked(directory):
-            if (directory / STATE_FILE).exists():
-                raise EpisodeError(f"{directory}: already holds an episode (remove it or pick another --dir)")
-            episode._plan_next()
-            _write(directory, episode.state)
-        return episode
+        return {"format": FORMAT, "bayesgrasp": __version__, "kind": kind, "hand": ctx.hand, "cache": ctx.cache_dir,
+                "model_settings": None if ctx.model_settings is None else dataclasses.asdict(ctx.model_settings),
+                "attempts": int(attempts), "seed": int(seed), "steps": [], "next": None, "status": "open"}
 
     @classmethod
-    def open(cls, directory, cache_dir: Optional[str] = None, progress=None) -> "PoseEpisode":
+    def open(cls, directory, cache_dir: Optional[str] = None, progress=None) -> "DiskEpisode":
         """The episode in ``directory``, with the hand, success criterion and model settings it
         was started with (the model cache: ``cache_dir``, default the one at ``new``)."""
-        directory = Path(directory)
-        state = _read(directory)
-        ms = state["model_settings"]
-        ctx = RunContext(hand=state["hand"], cache_dir=cache_dir or state["cache"], progress=progress,
-                         model_settings=None if ms is None else ModelSettings(**ms))
+        state, ctx = open_state(directory, cache_dir, progress)
+        if state.get("kind") != cls.kind:
+            raise EpisodeError(f"{directory}: a {state.get('kind')} episode, not a {cls.kind} one")
         return cls(directory, state, ctx)
+
+    def _create(self, before_write=None) -> None:
+        """Plans the first grasp and writes the new episode (refused if the directory holds one)."""
+        with _locked(self.directory):
+            if (self.directory / STATE_FILE).exists():
+                raise EpisodeError(f"{self.directory}: already holds an episode (remove it or pick another --dir)")
+            self._plan_next()
+            if before_write:
+                before_write()
+            _write(self.directory, self.state)
 
     # ---- the loop ----
     @property
@@ -202,13 +181,10 @@ class PoseEpisode:
             if _read(self.directory) != self.state:
                 raise EpisodeError(f"{self.directory}: changed by another process since it was opened; open it again")
             state = json.loads(json.dumps(self.state))
-            action = np.asarray(state["next"]["top_grasp"], dtype=float)
-            measurement = q[self.models.joint_index]
-            step = {"attempt": len(state["steps"]) + 1, "top_grasp": action.tolist(), "joints": q.tolist(),
+            step = {"attempt": len(state["steps"]) + 1, **self._executed(state["next"]), "joints": q.tolist(),
                     "lifted": up}
             if not up:
-                self.planner.observe(action, measurement, stable=False)
-                step["belief_after"] = self.planner.summary()
+                self._absorb(step, q)
             state["steps"].append(step)
             self.state = state
             if up:
@@ -220,12 +196,88 @@ class PoseEpisode:
             _write(self.directory, state)
         return self.next
 
+    def _executed(self, nxt: dict) -> dict:
+        """What a step records of the grasp the robot executed (default: its top grasp)."""
+        return {"top_grasp": nxt["top_grasp"]}
+
+    def _check_replayed(self, what: str, planned, recorded) -> None:
+        if planned != recorded:
+            raise EpisodeError(f"{self.directory}: replaying {what} planned another grasp than the one recorded "
+                               "(other models, settings or version)")
+
+
+def open_state(directory, cache_dir: Optional[str] = None, progress=None):
+    """An episode's checked state and the run context it was started with."""
+    state = _read(Path(directory))
+    ms = state["model_settings"]
+    ctx = RunContext(hand=state["hand"], cache_dir=cache_dir or state["cache"], progress=progress,
+                     model_settings=None if ms is None else ModelSettings(**ms))
+    return state, ctx
+
+
+def predicted_top_grasp(hand: Hand, hand_name: str, obj, pose, action, spread: float) -> dict:
+    """A top grasp (x, y, yaw) as the schema's world-frame grasp: where the hand closes and how,
+    simulated on ``obj`` at ``pose`` (the robot descends along -z until contact)."""
+    obj = load_object(obj) if isinstance(obj, str) else obj
+    try:
+        world = World.single(obj, pose=pose, hand=hand_name)
+    except ValueError:   # the pose is off the table: the palm at the object's height
+        T = Hand.top_grasp_pose(*action, float(obj.vertices[:, 2].max()))
+        return hand_grasp_record(hand, T, hand.open_joints(spread), spread)
+    rel = relative_top_grasps(np.asarray(action, float), np.asarray(pose, float))[0, 0]
+    g = world.grasp_batch(rel[None, :], spread=spread, lift=False)
+    return hand_grasp_record(hand, g.hand_pose[0], g.joint_angles[0], spread)
+
+
+def particles_digest(*arrays) -> str:
+    """SHA-256 of a belief's arrays (bit-for-bit checks)."""
+    return hashlib.sha256(b"".join(np.ascontiguousarray(a, dtype=float).tobytes() for a in arrays)).hexdigest()
+
+
+# ---- the pose-uncertainty episode (Pub. II-IV) --------------------------------------------------
+class PoseEpisode(DiskEpisode):
+    """An episode under pose uncertainty (Pub. II-IV): ``PoseEpisode.new(directory, "mug",
+    estimate, ctx)`` starts it; ``PoseEpisode.open(directory)`` resumes it."""
+
+    kind = "pose"
+
+    def __init__(self, directory: Path, state: dict, ctx: RunContext, obj: Optional[ObjectModel] = None):
+        super().__init__(directory, state, ctx)
+        self.object = obj if obj is not None else load_object(state["object"])
+        self.models: GraspModels = ctx.models(obj if obj is not None else state["object"])
+        if self.models.info.get("key") != state["models_key"]:
+            raise EpisodeError(f"{self.directory}: the episode was planned with other models (key "
+                               f"{state['models_key']}, now {self.models.info.get('key')}): same --hand, --cache "
+                               "and --set as at `episode new`")
+        self.planner = self._replay()
+
+    @classmethod
+    def new(cls, directory, obj: Union[str, ObjectModel], estimate: Sequence[float], ctx: RunContext,
+            method: str = "explore", attempts: int = 4, seed: int = 0,
+            planner: Optional[PlannerSettings] = None) -> "PoseEpisode":
+        directory = Path(directory)
+        if method not in METHODS:
+            raise EpisodeError(f"--method: one of {', '.join(METHODS)}; got {method!r}")
+        if (directory / STATE_FILE).exists():
+            raise EpisodeError(f"{directory}: already holds an episode (remove it or pick another --dir)")
+        state = cls._base_state(cls.kind, ctx, attempts, seed)
+        est = np.asarray(estimate, dtype=float).ravel()
+        if est.shape != (3,) or not np.all(np.isfinite(est)):
+            raise EpisodeError(f"--estimate: expected three finite numbers (x, y, yaw), got {estimate}")
+        settings = planner or PlannerSettings()
+        obj_model = load_object(obj) if isinstance(obj, str) else obj
+        models = ctx.models(obj if isinstance(obj, str) else obj_model)
+        state.update({"object": obj if isinstance(obj, str) else obj_model.name, "models_key": models.info.get("key"),
+                      "method": method, "estimate": est.tolist(), "planner": settings_json(settings)})
+        episode = cls(directory, state, ctx, obj_model)
+        episode._create()
+        return episode
+
     def belief(self) -> dict:
         """The belief now: the summary, and the SHA-256 of its particles and weights (bit-for-bit checks)."""
         b = self.planner.belief
         out = self.planner.summary()
-        out["particles_sha256"] = hashlib.sha256(np.ascontiguousarray(b.particles).tobytes()
-                                                 + np.ascontiguousarray(b.weights).tobytes()).hexdigest()
+        out["particles_sha256"] = particles_digest(b.particles, b.weights)
         return out
 
     # ---- named steps ----
@@ -242,37 +294,26 @@ class PoseEpisode:
             if step["lifted"]:
                 break
             plan = planner.plan()
-            if plan.action.tolist() != step["top_grasp"]:
-                raise EpisodeError(f"{self.directory}: replaying attempt {step['attempt']} planned another grasp than "
-                                   "the one recorded (other models, settings or version)")
+            self._check_replayed(f"attempt {step['attempt']}", plan.action.tolist(), step["top_grasp"])
             planner.observe(plan.action, np.asarray(step["joints"])[self.models.joint_index], stable=False)
         if self.state["next"] is not None:
-            plan = planner.plan()
-            if plan.action.tolist() != self.state["next"]["top_grasp"]:
-                raise EpisodeError(f"{self.directory}: replaying the pending grasp planned another one than the one "
-                                   "recorded (other models, settings or version)")
+            self._check_replayed("the pending grasp", planner.plan().action.tolist(), self.state["next"]["top_grasp"])
         return planner
+
+    def _absorb(self, step: dict, q: np.ndarray) -> None:
+        self.planner.observe(np.asarray(step["top_grasp"], dtype=float), q[self.models.joint_index], stable=False)
+        step["belief_after"] = self.planner.summary()
 
     def _plan_next(self) -> None:
         plan = self.planner.plan()
         self.state["next"] = {"attempt": len(self.state["steps"]) + 1, "kind": plan.kind,
                               "top_grasp": plan.action.tolist(), "predicted_stability": float(plan.predicted_stability),
                               "expected_entropy": plan.expected_entropy,
-                              "grasp": self._predicted_grasp(plan.action), "belief": self.planner.summary()}
-
-    def _predicted_grasp(self, action: np.ndarray) -> dict:
-        """The top grasp as the schema's world-frame grasp: where the hand closes and how, simulated
-        on the object at the belief's mean pose (the robot descends along -z until contact)."""
-        mean = self.planner.belief.mean()
-        try:
-            world = World.single(self.object, pose=mean, hand=self.ctx.hand)
-        except ValueError:   # the mean pose is off the table: the palm at the object's height
-            T = Hand.top_grasp_pose(*action, float(self.object.vertices[:, 2].max()))
-            return hand_grasp_record(self.hand, T, self.hand.open_joints(self.models.spread), self.models.spread)
-        rel = relative_top_grasps(action, mean)[0, 0]
-        g = world.grasp_batch(rel[None, :], spread=self.models.spread, lift=False)
-        return hand_grasp_record(self.hand, g.hand_pose[0], g.joint_angles[0], self.models.spread)
+                              "grasp": predicted_top_grasp(self.hand, self.ctx.hand, self.object,
+                                                           self.planner.belief.mean(), plan.action, self.models.spread),
+                              "belief": self.planner.summary()}
 
 
-def _planner_json(settings: PlannerSettings) -> dict:
+def settings_json(settings) -> dict:
+    """A settings dataclass as JSON (tuples as lists)."""
     return {k: (list(v) if isinstance(v, tuple) else v) for k, v in dataclasses.asdict(settings).items()}

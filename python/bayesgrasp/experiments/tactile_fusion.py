@@ -67,7 +67,8 @@ class FusionTrial:
         """``observation``: the vision step's cloud from a camera (a
         :class:`~bayesgrasp.experiments.category.Observation` in the table frame) instead of a
         simulated view of ``obj``; ``obj`` at ``pose`` is then the simulated stand-in the grasps
-        are executed on."""
+        are executed on (None: no stand-in, a robot outside executes them; see
+        :mod:`~bayesgrasp.experiments.outside_loop`)."""
         cat = category or (obj.split("/")[0] if "/" in str(obj) else "mug")
         self.obj, self.pose, self.ctx, self.seed = obj, np.asarray(pose, float), ctx, seed
         kw = {} if eye_offset is None else {"eye_offset": eye_offset}
@@ -83,12 +84,18 @@ class FusionTrial:
         self.w0 = np.array([r.phi if r.success else 0.0 for r in regs])
         self.p0 = np.array([planar_pose(r.transform) for r in regs])
         self.settings = settings or FusionSettings()
-        self.world = World.single(obj, pose=pose, hand=ctx.hand)
+        self.world = None if obj is None else World.single(obj, pose=pose, hand=ctx.hand)
         self.spread = float(np.median([m.spread for m in self.models]))
 
     def belief(self) -> ModelMixtureBelief:
         w = self.w0 if self.w0.sum() > 0 else np.ones(len(self.w0))
         return ModelMixtureBelief(self.names, self.models, w, self.p0, self.settings, seed=self.seed)
+
+    def start(self):
+        """The trial's random stream, the vision belief and its planner (seeded from the stream)."""
+        rng = np.random.default_rng(self.seed)
+        belief = self.belief()
+        return rng, belief, FusionPlanner(belief, self.task_grasps, seed=int(rng.integers(2**31)))
 
     def random_grasp(self, rng: np.random.Generator) -> np.ndarray:
         """G(0) at random in the area above the object: its centre +-3 cm, any yaw."""
@@ -99,9 +106,7 @@ class FusionTrial:
 
     def run(self, mode: str = "random", rounds: int = ROUNDS, on_round=None) -> dict:
         """G(0) (random or vision-planned) and up to ``rounds`` tactile rounds."""
-        rng = np.random.default_rng(self.seed)
-        belief = self.belief()
-        planner = FusionPlanner(belief, self.task_grasps, seed=int(rng.integers(2**31)))
+        rng, belief, planner = self.start()
         g0 = self.random_grasp(rng) if mode == "random" else planner.plan().action
         records = [self._record(0, self._execute(g0), belief)]
         if on_round:
