@@ -17,7 +17,7 @@ LAYERS = [
     {"world"},
     {"models"},
     {"planners"},
-    {"viz"},
+    {"viz", "viewer"},
     {"experiments"},
     {"cli"},
 ]

@@ -20,11 +20,11 @@ import argparse
 import os
 import sys
 
-from . import category, episode, experiment, fuse, grasp, objects, plan, register, touch
+from . import category, episode, experiment, fuse, grasp, objects, plan, register, touch, view
 from .. import __version__
 from .args import CliError, join_negative_values
 
-COMMANDS = (grasp, plan, episode, category, fuse, experiment, register, objects, touch)
+COMMANDS = (grasp, plan, episode, category, fuse, experiment, register, objects, touch, view)
 
 
 class HelpFormatter(argparse.RawDescriptionHelpFormatter):

@@ -1,0 +1,39 @@
+"""``bayesgrasp view FILE.json``: any command's JSON output in 3D in the browser (viser): the
+object with its parts coloured and the table, the camera's cloud, the registered models with their
+weights, and per attempt or round the hand at the grasp (fingers at the read joint angles), the
+pre-grasp, the approach and the contacts with their normals; a slider steps through the attempts,
+toggles switch the layers. The server listens on localhost (over SSH: ``ssh -L 8080:localhost:8080
+HOST``, then open http://localhost:8080); Ctrl-C stops it."""
+from __future__ import annotations
+
+import sys
+import time
+
+from .args import bounded_int
+
+
+def add(sub) -> None:
+    v = sub.add_parser("view", help="a result in 3D in the browser (viser)", description=__doc__)
+    v.add_argument("file", help="a command's --json output, an episode directory's episode.json or `episode show --json`")
+    v.add_argument("--port", type=bounded_int(1, 65535), default=8080, help="port (the next free one if busy)")
+    v.add_argument("--host", default="127.0.0.1", help="address to listen on")
+    v.add_argument("--seconds", type=float, default=None, help="stop after this long (default: until Ctrl-C)")
+    v.set_defaults(run=run)
+
+
+def run(args) -> int:
+    from ..viewer import read_result, scene_from_result, serve
+
+    scene = scene_from_result(read_result(args.file))      # refused before a server starts
+    server, _ = serve(scene, port=args.port, host=args.host)
+    print(f"viewing {args.file} ({scene.kind}, {len(scene.steps)} step(s)) at http://{args.host}:{server.get_port()}"
+          " (Ctrl-C stops)", flush=True)
+    try:
+        deadline = None if args.seconds is None else time.monotonic() + args.seconds
+        while deadline is None or time.monotonic() < deadline:
+            time.sleep(0.2)
+    except KeyboardInterrupt:
+        print("stopped", file=sys.stderr)
+    finally:
+        server.stop()
+    return 0

@@ -1,0 +1,173 @@
+"""What a result shows, independent of how it is drawn: the object at its pose on the table, the
+camera's cloud, the registered models with their weights, and per step (an attempt, a fusion round,
+an episode's grasp) the hand posed at the grasp with its fingers at the read joint angles, the
+pre-grasp, the approach and the contacts with their normals.
+
+:func:`scene_from_result` reads the JSON of ``grasp``, ``plan``, ``category``, ``fuse``,
+``touch``, ``register`` and an episode (``episode show --json`` or ``episode.json``); anything else
+is refused with the reason. World frame = the table frame (z up, table at z = 0).
+"""
+from __future__ import annotations
+
+import json
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import List, Optional, Sequence
+
+import numpy as np
+
+from ..objects import ObjectModel, load_object
+
+
+class ResultError(ValueError):
+    """A file that is no bayesgrasp result, or one whose object cannot be loaded."""
+
+
+@dataclass
+class Contact:
+    point: np.ndarray      # (3,) world
+    normal: np.ndarray     # (3,) unit, world
+    part: str = ""
+    link: str = ""
+
+
+@dataclass
+class Step:
+    """One grasp of the result: ``grasp`` a schema grasp record (world frame), or None."""
+
+    label: str
+    grasp: Optional[dict]
+    outcome: str = ""                       # "lifted", "dropped", "planned", ...
+    contacts: List[Contact] = field(default_factory=list)
+    models: List[tuple] = field(default_factory=list)   # (name, planar pose (x, y, yaw), weight) overlays
+
+
+@dataclass
+class ResultScene:
+    kind: str
+    object: Optional[ObjectModel]
+    object_pose: Optional[np.ndarray]        # (x, y, yaw) on the table, or None (not known)
+    steps: List[Step]
+    cloud: Optional[np.ndarray] = None
+    title: str = ""
+
+
+def planar_transform(pose: Sequence[float]) -> np.ndarray:
+    """(x, y, yaw) on the table as a 4x4."""
+    x, y, yaw = (float(v) for v in pose)
+    c, s = np.cos(yaw), np.sin(yaw)
+    T = np.eye(4)
+    T[:2, :2] = [[c, -s], [s, c]]
+    T[:2, 3] = x, y
+    return T
+
+
+def read_result(path) -> dict:
+    p = Path(path)
+    try:
+        doc = json.loads(p.read_text())
+    except OSError as e:
+        raise ResultError(f"{p}: cannot read ({e.strerror})") from None
+    except ValueError as e:
+        raise ResultError(f"{p}: not JSON ({e})") from None
+    if isinstance(doc, dict) and "state" in doc and "sha256" in doc:    # an episode.json
+        doc = {"episode": str(p.parent), "kind": doc["state"].get("kind"), **doc["state"]}
+    if not isinstance(doc, dict):
+        raise ResultError(f"{p}: not a bayesgrasp result (a JSON object is expected)")
+    return doc
+
+
+def _object(name) -> Optional[ObjectModel]:
+    if name is None:
+        return None
+    try:
+        return load_object(name)
+    except (OSError, ValueError, KeyError) as e:
+        raise ResultError(f"object {name!r}: cannot be loaded ({e}); was its mesh file moved?") from None
+
+
+def _contacts(items) -> List[Contact]:
+    return [Contact(np.asarray(c["point"], float), np.asarray(c["normal"], float), c.get("part") or "",
+                    c.get("link_name") or "") for c in items or [] if not c.get("on_table")]
+
+
+def _verdict(lifted) -> str:
+    return "planned" if lifted is None else ("lifted" if lifted else "not lifted")
+
+
+def scene_from_result(doc: dict) -> ResultScene:
+    """The scene of one command's JSON output (see the module's docstring)."""
+    for key, make in _KINDS:
+        if key(doc):
+            return make(doc)
+    raise ResultError("not a bayesgrasp result: no grasp, attempts, rounds, registrations or episode in it "
+                      f"(keys: {', '.join(sorted(doc)[:8])})")
+
+
+def _grasp(doc) -> ResultScene:
+    step = Step("grasp", doc["grasp"], _verdict(doc.get("lifted")), _contacts(doc.get("contacts")))
+    return ResultScene("grasp", _object(doc["object"]), np.asarray(doc.get("object_pose") or (0, 0, 0), float), [step],
+                       title=f"{doc['object']}: {step.outcome}, epsilon {doc.get('epsilon', 0.0):.3f}")
+
+
+def _plan(doc) -> ResultScene:
+    steps = [Step(f"attempt {k + 1} ({a.get('plan_type', '')})", a["grasp"], _verdict(a.get("lifted")))
+             for k, a in enumerate(doc["attempts"])]
+    return ResultScene("plan", _object(doc["object"]), np.asarray(doc["true_pose"], float), steps,
+                       title=f"{doc['object']}: {'success' if doc.get('success') else 'no grasp lifted'}")
+
+
+def _category(doc) -> ResultScene:
+    pose = doc.get("object_pose")
+    models = [(m["model"], None, m["weight"]) for m in doc.get("models", [])]
+    step = Step(f"{doc['task']} ({doc['method']})", doc["grasp"], _verdict(doc.get("lifted")),
+                _contacts(doc.get("contacts")), models)
+    return ResultScene("category", _object(doc.get("scene_object")), None if pose is None else np.asarray(pose, float),
+                       [step], title=f"{doc.get('scene_object') or doc.get('scene')}, {doc['task']}: "
+                                     f"{'success' if doc.get('success') else doc.get('failure') or 'planned'}")
+
+
+def _fuse(doc) -> ResultScene:
+    steps = [Step(f"round {r['round']}", r["grasp"], _verdict(r.get("lifted")),
+                  models=[(m, r["poses"][m], r["weights"][m]) for m in r["weights"]]) for r in doc["rounds"]]
+    return ResultScene("fuse", _object(doc["scene_object"]), np.asarray(doc["object_pose"], float), steps,
+                       title=f"{doc['scene_object']}: vision then touch, "
+                             f"{'success' if doc.get('success') else 'no grasp lifted'}")
+
+
+def _touch(doc) -> ResultScene:
+    """The object at its true pose, the touch, and the model at the fitted estimate (weight 1)."""
+    truth, est = doc["true_state"], doc["estimate"]
+    step = Step("touch", doc.get("grasp"), "touched", models=[(doc["object"], est[:3], 1.0)])
+    return ResultScene("touch", _object(doc["object"]), np.asarray(truth[:3], float), [step],
+                       title=f"{doc['object']}: one touch, {doc.get('optimizer', '')} estimate overlaid")
+
+
+def _register(doc) -> ResultScene:
+    models = [(m["model"], None, m.get("phi", 0.0)) for m in doc["models"]]
+    return ResultScene("register", None, None, [Step("registration", None, "", models=models)],
+                       title=f"{doc.get('scene')}: {len(models)} model(s) registered")
+
+
+def _episode(doc) -> ResultScene:
+    steps = []
+    for s in doc.get("steps", []):
+        steps.append(Step(f"attempt {s['attempt']}", s.get("grasp"), _verdict(s.get("lifted"))))
+    nxt = doc.get("next")
+    if nxt is not None:
+        steps.append(Step(f"attempt {nxt['attempt']} (next)", nxt["grasp"], "planned"))
+    obj = doc.get("object")
+    pose = doc.get("estimate")
+    return ResultScene("episode", _object(obj), None if pose is None else np.asarray(pose, float), steps,
+                       title=f"episode {doc.get('episode', '')}: {doc.get('status', '')}")
+
+
+_KINDS = [
+    (lambda d: "episode" in d and "steps" in d, _episode),
+    (lambda d: "rounds" in d and "scene_object" in d, _fuse),
+    (lambda d: "attempts" in d and "true_pose" in d, _plan),
+    (lambda d: "task" in d and "grasp" in d and "models" in d, _category),
+    (lambda d: "readings" in d and "true_state" in d, _touch),
+    (lambda d: "grasp" in d and "object" in d and "contacts" in d, _grasp),
+    (lambda d: "models" in d and "scene" in d, _register),
+]

@@ -1,0 +1,165 @@
+"""A :class:`~.scene.ResultScene` in the browser (viser): the nodes, a slider over the steps and a
+toggle per layer. Node names (the tests check them through viser's scene API):
+
+``/table``, ``/object/<part>``, ``/cloud``, and per step k ``/steps/k/hand/<link>-<i>``,
+``/steps/k/pregrasp/<link>-<i>``, ``/steps/k/approach``, ``/steps/k/contacts``,
+``/steps/k/normals``, ``/steps/k/models/<name>``.
+"""
+from __future__ import annotations
+
+import sys
+from functools import lru_cache
+from typing import Dict, List, Optional, Tuple
+
+import numpy as np
+
+from ..hand import Hand, builtin_hands
+from ..viz import box_mesh, capsule_mesh
+from .scene import ResultScene, Step, planar_transform
+
+LAYERS = ("object", "hand", "pregrasp", "approach", "contacts", "models", "cloud")
+PART_COLOURS = [(230, 150, 60), (70, 140, 220), (90, 180, 90), (200, 80, 160), (160, 160, 60), (90, 200, 200)]
+HAND_COLOUR, PREGRASP_COLOUR, CONTACT_COLOUR = (120, 120, 130), (180, 180, 200), (230, 30, 30)
+TABLE_HALF = 0.25     # m, half side of the drawn table square
+
+
+def _rgb(weight: float, base=(70, 140, 220)) -> Tuple[int, int, int]:
+    return tuple(int(c) for c in np.asarray(base) * (0.4 + 0.6 * float(np.clip(weight, 0, 1))))
+
+
+def _placed(V: np.ndarray, T: np.ndarray) -> np.ndarray:
+    return V @ T[:3, :3].T + T[:3, 3]
+
+
+def hand_link_meshes(hand: Hand, q, pose) -> List[Tuple[str, np.ndarray, np.ndarray]]:
+    """The hand's collision shapes at joints ``q`` and 4x4 ``pose`` as (name, V, F) meshes."""
+    out, count = [], {}
+    for s in hand.link_geometry(np.asarray(q, float), np.asarray(pose, float)):
+        if s.type == "capsule":
+            V, F = capsule_mesh(s.p0, s.p1, s.radius)
+        else:
+            T = np.eye(4)
+            T[:3, :3], T[:3, 3] = s.rotation, s.center
+            V, F = box_mesh(T, s.half_extents)
+        i = count[s.name] = count.get(s.name, -1) + 1
+        out.append((f"{s.name.replace('/', '_')}-{i}", np.asarray(V, float), np.asarray(F, np.int32)))
+    return out
+
+
+@lru_cache(maxsize=8)
+def hand_named(name: str) -> Hand:
+    """The hand a grasp record names: a built-in hand's file name, its display name, or a hand file."""
+    for builtin in builtin_hands():
+        hand = Hand.load(builtin)
+        if name in (builtin, hand.name):
+            return hand
+    return Hand.load(name)
+
+
+class SceneView:
+    """The scene's nodes on a viser server, with the GUI (slider, layer toggles)."""
+
+    def __init__(self, server, scene: ResultScene):
+        self.server, self.scene = server, scene
+        self.layers: Dict[Tuple[Optional[int], str], list] = {}
+        self._add_static()
+        for k, step in enumerate(scene.steps):
+            self._add_step(k, step)
+        self._add_gui()
+        self.show(len(scene.steps) - 1 if scene.steps else 0)
+
+    # ---- nodes ----
+    def _keep(self, k: Optional[int], layer: str, handle) -> None:
+        self.layers.setdefault((k, layer), []).append(handle)
+
+    def _add_static(self) -> None:
+        sc, add = self.scene, self.server.scene
+        h = TABLE_HALF
+        add.add_box("/table", color=(200, 190, 170), dimensions=(2 * h, 2 * h, 0.01), position=(0.0, 0.0, -0.005))
+        if sc.object is not None and sc.object_pose is not None:
+            T = planar_transform(sc.object_pose)
+            V = _placed(sc.object.vertices, T)
+            F = np.asarray(sc.object.faces, np.int32)
+            parts = sc.object.parts
+            names = sc.object.part_names or ("body",)
+            ids = np.zeros(len(F), int) if parts is None else np.asarray(parts)
+            for i in np.unique(ids):
+                name = names[i] if i < len(names) else f"part{i}"
+                self._keep(None, "object", add.add_mesh_simple(f"/object/{name}", V, F[ids == i],
+                                                               color=PART_COLOURS[i % len(PART_COLOURS)]))
+        if sc.cloud is not None and len(sc.cloud):
+            self._keep(None, "cloud", add.add_point_cloud("/cloud", np.asarray(sc.cloud, np.float32),
+                                                          colors=(40, 40, 40), point_size=0.003))
+
+    def _add_step(self, k: int, step: Step) -> None:
+        add, base = self.server.scene, f"/steps/{k}"
+        g = step.grasp
+        if g is not None:
+            hand = hand_named(g["hand"])
+            for name, V, F in hand_link_meshes(hand, g["joint_positions"], g["pose"]):
+                self._keep(k, "hand", add.add_mesh_simple(f"{base}/hand/{name}", V, F, color=HAND_COLOUR))
+            pre = g["pregrasp"]
+            for name, V, F in hand_link_meshes(hand, pre["joint_positions"], pre["pose"]):
+                self._keep(k, "pregrasp", add.add_mesh_simple(f"{base}/pregrasp/{name}", V, F, color=PREGRASP_COLOUR,
+                                                              opacity=0.25))
+            p0 = np.asarray(pre["pose"], float)[:3, 3]
+            p1 = np.asarray(g["position"], float)
+            self._keep(k, "approach", add.add_arrows(f"{base}/approach", np.array([[p0, p1]]), colors=(20, 20, 20),
+                                                     shaft_radius=0.002, head_radius=0.006, head_length=0.012))
+        if step.contacts:
+            P = np.array([c.point for c in step.contacts])
+            N = np.array([c.normal for c in step.contacts])
+            self._keep(k, "contacts", add.add_point_cloud(f"{base}/contacts", P.astype(np.float32),
+                                                          colors=CONTACT_COLOUR, point_size=0.008,
+                                                          point_shape="circle"))
+            self._keep(k, "contacts", add.add_arrows(f"{base}/normals", np.stack([P, P + 0.03 * N], axis=1),
+                                                     colors=CONTACT_COLOUR, shaft_radius=0.001, head_radius=0.003,
+                                                     head_length=0.006))
+        for name, pose, weight in step.models:
+            if pose is None:
+                continue
+            from ..objects import load_object
+
+            m = load_object(name)
+            V = _placed(m.vertices, planar_transform(pose))
+            self._keep(k, "models", add.add_mesh_simple(f"{base}/models/{name.replace('/', '_')}", V,
+                                                        np.asarray(m.faces, np.int32), color=_rgb(weight),
+                                                        opacity=0.15 + 0.5 * float(np.clip(weight, 0, 1))))
+
+    # ---- GUI ----
+    def _add_gui(self) -> None:
+        gui = self.server.gui
+        gui.add_markdown(f"**{self.scene.title}**")
+        n = len(self.scene.steps)
+        self.slider = gui.add_slider("step", min=0, max=max(n - 1, 1), step=1, initial_value=max(n - 1, 0),
+                                     disabled=n < 2)
+        self.label = gui.add_markdown("")
+        self.toggles = {layer: gui.add_checkbox(layer, initial_value=layer != "pregrasp") for layer in LAYERS}
+        self.slider.on_update(lambda _: self.show(int(self.slider.value)))
+        for t in self.toggles.values():
+            t.on_update(lambda _: self.show(int(self.slider.value)))
+
+    def show(self, k: int) -> None:
+        """Step ``k`` with the toggled layers; the other steps hidden."""
+        self.current = k
+        for (step, layer), handles in self.layers.items():
+            on = (step is None or step == k) and self.toggles[layer].value
+            for h in handles:
+                h.visible = on
+        if self.scene.steps:
+            s = self.scene.steps[k]
+            self.label.content = f"{s.label}: {s.outcome}" + (
+                "; " + ", ".join(f"{m} {w:.2f}" for m, _, w in s.models) if s.models else "")
+
+
+def serve(scene: ResultScene, port: int = 8080, host: str = "127.0.0.1", say=None):
+    """A viser server on ``host`` showing the scene (the next free port if ``port`` is busy).
+    Returns (server, view); ``server.stop()`` ends it."""
+    import viser
+
+    say = say or (lambda m: print(m, file=sys.stderr))
+    server = viser.ViserServer(host=host, port=port, verbose=False)
+    if server.get_port() != port:
+        say(f"port {port} is in use; serving on {server.get_port()}")
+    server.scene.set_up_direction("+z")
+    return server, SceneView(server, scene)

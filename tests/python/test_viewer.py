@@ -1,0 +1,128 @@
+"""`bayesgrasp view`: each result type's scene graph has the named nodes (object parts, table, hand
+links, pre-grasp, approach, contacts, model overlays), checked through viser's scene API; the
+slider shows one step at a time; bad files are refused in one line; the server's port is free
+again after stop."""
+import json
+import socket
+
+import numpy as np
+import pytest
+
+pytest.importorskip("viser")
+
+from bayesgrasp.cli import main  # noqa: E402
+from bayesgrasp.viewer import ResultError, read_result, scene_from_result, serve  # noqa: E402
+
+
+def cli_json(capsys, *argv):
+    code = main([str(a) for a in argv])
+    out, err = capsys.readouterr()
+    assert code == 0, err
+    return json.loads(out)
+
+
+def free_port() -> int:
+    with socket.socket() as s:
+        s.bind(("127.0.0.1", 0))
+        return s.getsockname()[1]
+
+
+def port_free(port: int) -> bool:
+    with socket.socket() as s:
+        try:
+            s.bind(("127.0.0.1", port))
+            return True
+        except OSError:
+            return False
+
+
+def nodes(server) -> set:
+    return set(server.scene._handle_from_node_name)
+
+
+@pytest.fixture()
+def grasp_doc(capsys):
+    return cli_json(capsys, "grasp", "--object", "mug/3", "--top", "0,0,0.3", "--json")
+
+
+def test_grasp_scene_has_object_parts_table_hand_and_contacts(grasp_doc):
+    scene = scene_from_result(grasp_doc)
+    assert scene.kind == "grasp" and len(scene.steps) == 1
+    port = free_port()
+    server, view = serve(scene, port=port)
+    try:
+        names = nodes(server)
+        assert {"/table", "/object/body", "/object/handle"} <= names
+        hand = {n for n in names if n.startswith("/steps/0/hand/")}
+        assert len(hand) >= 7 and any("finger1_distal" in n for n in hand)   # palm and every finger link
+        assert any(n.startswith("/steps/0/pregrasp/") for n in names)
+        assert {"/steps/0/approach", "/steps/0/contacts", "/steps/0/normals"} <= names
+        assert len(grasp_doc["contacts"]) == len(server.scene._handle_from_node_name["/steps/0/contacts"].points)
+    finally:
+        server.stop()
+    assert port_free(port)
+
+
+def test_the_slider_shows_one_fusion_round_with_its_model_overlays(capsys, grasp_doc):
+    """A fuse-shaped result: two rounds, each with its models' poses and weights."""
+    rounds = [{"round": k, "grasp": grasp_doc["grasp"], "lifted": k == 1, "weights": {"mug/1": 0.7 - 0.4 * k,
+               "mug/2": 0.3 + 0.4 * k}, "poses": {"mug/1": [0.0, 0.01 * k, 0.3], "mug/2": [0.01, 0.0, 0.2]}}
+              for k in range(2)]
+    doc = {"scene_object": "mug/3", "object_pose": [0, 0, 0], "rounds": rounds, "success": True}
+    server, view = serve(scene_from_result(doc), port=free_port())
+    try:
+        h = server.scene._handle_from_node_name
+        assert {"/steps/0/models/mug_1", "/steps/1/models/mug_2"} <= set(h)
+        view.show(0)
+        assert h["/steps/0/models/mug_1"].visible and not h["/steps/1/models/mug_1"].visible
+        view.toggles["models"].value = False
+        view.show(0)
+        assert not h["/steps/0/models/mug_1"].visible and h["/object/body"].visible
+    finally:
+        server.stop()
+
+
+def test_touch_and_register_results_have_scenes(capsys, tmp_path):
+    touch = cli_json(capsys, "touch", "--object", "mug/3", "--true-pose", "0.01,0,0.3", "--estimate", "0,0,0",
+                     "--budget", 100, "--json")
+    s = scene_from_result(touch)
+    assert s.kind == "touch" and s.steps[0].grasp is not None and s.steps[0].models[0][0] == "mug/3"
+    np.testing.assert_allclose(s.object_pose, touch["true_state"][:3])
+
+
+def test_bad_files_are_refused_in_one_line(capsys, tmp_path):
+    f = tmp_path / "x.json"
+    f.write_text('{"hello": 1}')
+    assert main(["view", str(f)]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "not a bayesgrasp result" in err[0]
+    f.write_text("{not json")
+    with pytest.raises(ResultError, match="not JSON"):
+        read_result(f)
+    with pytest.raises(ResultError, match="cannot read"):
+        read_result(tmp_path / "missing.json")
+    moved = {"object": str(tmp_path / "gone.stl"), "grasp": {}, "contacts": []}
+    with pytest.raises(ResultError, match="moved"):
+        scene_from_result(moved)
+
+
+def test_a_busy_port_falls_back_to_the_next(grasp_doc):
+    msgs = []
+    with socket.socket() as s:
+        s.bind(("127.0.0.1", 0))
+        s.listen()
+        busy = s.getsockname()[1]
+        server, _ = serve(scene_from_result(grasp_doc), port=busy, say=msgs.append)
+        try:
+            assert server.get_port() != busy and msgs and f"port {busy} is in use" in msgs[0]
+        finally:
+            server.stop()
+
+
+def test_view_command_serves_then_stops(capsys, tmp_path, grasp_doc):
+    f = tmp_path / "g.json"
+    f.write_text(json.dumps(grasp_doc))
+    port = free_port()
+    assert main(["view", str(f), "--port", str(port), "--seconds", "0.5"]) == 0
+    assert f"http://127.0.0.1:{port}" in capsys.readouterr().out
+    assert port_free(port)
