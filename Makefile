@@ -10,7 +10,7 @@ export CMAKE_BUILD_PARALLEL_LEVEL ?= $(JOBS)
 # Debian packages the build needs (checked one by one; only missing ones are installed).
 DEB_PACKAGES := build-essential cmake pkg-config python3-dev python3-venv \
   libeigen3-dev libfcl-dev libbullet-dev libqhull-dev nlohmann-json3-dev liblbfgspp-dev \
-  libpcl-dev libgtest-dev libbenchmark-dev libopenblas-openmp-dev
+  libpcl-dev libgtest-dev libbenchmark-dev libopenblas-openmp-dev chromium chromium-driver
 
 SOURCES := $(shell find cpp python tests/cpp bench -type f \( -name '*.cpp' -o -name '*.hpp' -o -name '*.h' -o -name '*.py' -o -name '*.json' \) 2>/dev/null) \
            CMakeLists.txt pyproject.toml
@@ -36,7 +36,7 @@ deps: build/.deps-ok
 $(VENV)/.base: build/.deps-ok Makefile
 	$(PYTHON) -m venv $(VENV)
 	$(PY) -m pip install -q --upgrade pip
-	$(PY) -m pip install -q "scikit-build-core>=0.10" "pybind11>=2.12" ninja numpy scipy matplotlib trimesh manifold3d "coacd>=1.0.14,<1.1" tqdm pytest scikit-learn hypothesis "open3d>=0.18" "jsonschema>=4.0" "viser>=1.0"
+	$(PY) -m pip install -q "scikit-build-core>=0.10" "pybind11>=2.12" ninja numpy scipy matplotlib trimesh manifold3d "coacd>=1.0.14,<1.1" tqdm pytest scikit-learn hypothesis "open3d>=0.18" "jsonschema>=4.0" "viser>=1.0" "selenium>=4.20"
 	@touch $@
 
 # The package is built by scikit-build-core in build/py (kept between builds, so a second

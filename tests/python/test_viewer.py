@@ -28,12 +28,10 @@ def free_port() -> int:
 
 
 def port_free(port: int) -> bool:
+    """Nothing listens on the port any more (a connection is refused)."""
     with socket.socket() as s:
-        try:
-            s.bind(("127.0.0.1", port))
-            return True
-        except OSError:
-            return False
+        s.settimeout(1.0)
+        return s.connect_ex(("127.0.0.1", port)) != 0
 
 
 def nodes(server) -> set:
@@ -125,4 +123,25 @@ def test_view_command_serves_then_stops(capsys, tmp_path, grasp_doc):
     port = free_port()
     assert main(["view", str(f), "--port", str(port), "--seconds", "0.5"]) == 0
     assert f"http://127.0.0.1:{port}" in capsys.readouterr().out
+    assert port_free(port)
+
+
+def test_a_headless_screenshot_is_not_blank_and_differs_between_attempts(capsys, tmp_path, grasp_doc):
+    from bayesgrasp.viewer.snapshot import NoBrowser, _variance, find_browser, snapshot
+
+    try:
+        find_browser()
+    except NoBrowser as e:
+        pytest.skip(str(e))                      # names the Debian packages to install
+    other = cli_json(capsys, "grasp", "--object", "mug/3", "--top", "0.03,0.0,1.4", "--json")
+    rounds = [{"round": k, "grasp": g["grasp"], "lifted": g["lifted"], "weights": {}, "poses": {}}
+              for k, g in enumerate([grasp_doc, other])]
+    scene = scene_from_result({"scene_object": "mug/3", "object_pose": [0, 0, 0], "rounds": rounds})
+    port = free_port()
+    a = snapshot(scene, tmp_path / "a.png", port=port, step=0).read_bytes()
+    b = snapshot(scene, tmp_path / "b.png", port=port, step=1).read_bytes()
+    assert _variance(a) > 1e-3 and _variance(b) > 1e-3
+    import matplotlib.image as mpimg
+    A, B = mpimg.imread(tmp_path / "a.png"), mpimg.imread(tmp_path / "b.png")
+    assert A.shape == B.shape and np.abs(A[..., :3] - B[..., :3]).mean() > 1e-3
     assert port_free(port)

@@ -17,6 +17,9 @@ def add(sub) -> None:
     v.add_argument("file", help="a command's --json output, an episode directory's episode.json or `episode show --json`")
     v.add_argument("--port", type=bounded_int(1, 65535), default=8080, help="port (the next free one if busy)")
     v.add_argument("--host", default="127.0.0.1", help="address to listen on")
+    v.add_argument("--snapshot", default=None, metavar="FILE.png",
+                   help="write a screenshot (headless Chromium) instead of serving until Ctrl-C")
+    v.add_argument("--step", type=int, default=None, help="with --snapshot: the attempt or round shown (default: last)")
     v.add_argument("--seconds", type=float, default=None, help="stop after this long (default: until Ctrl-C)")
     v.set_defaults(run=run)
 
@@ -25,6 +28,8 @@ def run(args) -> int:
     from ..viewer import read_result, scene_from_result, serve
 
     scene = scene_from_result(read_result(args.file))      # refused before a server starts
+    if args.snapshot:
+        return _snapshot(args, scene)
     server, _ = serve(scene, port=args.port, host=args.host)
     print(f"viewing {args.file} ({scene.kind}, {len(scene.steps)} step(s)) at http://{args.host}:{server.get_port()}"
           " (Ctrl-C stops)", flush=True)
@@ -36,4 +41,19 @@ def run(args) -> int:
         print("stopped", file=sys.stderr)
     finally:
         server.stop()
+    return 0
+
+
+def _snapshot(args, scene) -> int:
+    from ..viewer.snapshot import NoBrowser, snapshot
+    from .args import CliError, output_file
+
+    png = output_file(args.snapshot, "--snapshot")
+    if args.step is not None and not 0 <= args.step < len(scene.steps):
+        raise CliError(f"--step: between 0 and {len(scene.steps) - 1}, got {args.step}")
+    try:
+        snapshot(scene, png, port=args.port, step=args.step)
+    except NoBrowser as e:
+        raise CliError(f"--snapshot: {e}") from None
+    print(f"saved {png}")
     return 0

@@ -66,6 +66,7 @@ class SceneView:
         for k, step in enumerate(scene.steps):
             self._add_step(k, step)
         self._add_gui()
+        self.frame_camera()
         self.show(len(scene.steps) - 1 if scene.steps else 0)
 
     # ---- nodes ----
@@ -125,6 +126,20 @@ class SceneView:
             self._keep(k, "models", add.add_mesh_simple(f"{base}/models/{name.replace('/', '_')}", V,
                                                         np.asarray(m.faces, np.int32), color=_rgb(weight),
                                                         opacity=0.15 + 0.5 * float(np.clip(weight, 0, 1))))
+
+    def frame_camera(self) -> None:
+        """The initial camera: looking at the object (or the grasps) from the front, above."""
+        sc = self.scene
+        if sc.object is not None and sc.object_pose is not None:
+            V = _placed(sc.object.vertices, planar_transform(sc.object_pose))
+        else:
+            V = np.array([g.grasp["position"] for g in sc.steps if g.grasp] or [[0.0, 0.0, 0.05]])
+        centre = 0.5 * (V.min(axis=0) + V.max(axis=0))
+        r = max(float(np.linalg.norm(V.max(axis=0) - V.min(axis=0))), 0.1)
+        cam = self.server.initial_camera
+        cam.look_at = tuple(centre)
+        cam.position = tuple(centre + r * np.array([1.0, -1.3, 0.9]))
+        cam.up = (0.0, 0.0, 1.0)
 
     # ---- GUI ----
     def _add_gui(self) -> None:

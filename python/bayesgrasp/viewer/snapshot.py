@@ -1,0 +1,85 @@
+"""A served scene as a PNG, without a person: headless Chromium (Debian's ``chromium`` and
+``chromium-driver``, driven by selenium) opens the viser page and a screenshot is written. WebGL
+runs on the CPU (SwiftShader), so no GPU or display is needed. Nothing is downloaded: the browser
+and its driver are the Debian packages' binaries, given to selenium by path."""
+from __future__ import annotations
+
+import os
+import shutil
+import time
+from pathlib import Path
+from typing import Optional
+
+import numpy as np
+
+BROWSERS = ("chromium", "chromium-browser")
+DRIVERS = ("chromedriver",)
+PACKAGES = "chromium chromium-driver"
+
+
+class NoBrowser(RuntimeError):
+    """Headless Chromium or its driver is not installed."""
+
+
+def find_browser() -> tuple:
+    """(browser, driver) paths, or NoBrowser naming the Debian packages to install."""
+    browser = next((p for p in map(shutil.which, BROWSERS) if p), None)
+    driver = next((p for p in map(shutil.which, DRIVERS) if p), None)
+    if browser is None or driver is None:
+        raise NoBrowser(f"headless Chromium is not installed (Debian packages: {PACKAGES})")
+    return browser, driver
+
+
+def _variance(png: bytes) -> float:
+    from io import BytesIO
+
+    import matplotlib.image as mpimg
+
+    return float(np.asarray(mpimg.imread(BytesIO(png), format="png"))[..., :3].var())
+
+
+def screenshot(url: str, path, size=(960, 720), timeout: float = 30.0, min_variance: float = 1e-3,
+               settle: float = 1.5) -> Path:
+    """The page at ``url`` as ``path`` (PNG), once it has drawn something (the image's pixel
+    variance above ``min_variance``) and a further ``settle`` seconds have passed."""
+    from selenium import webdriver
+    from selenium.webdriver.chrome.service import Service
+
+    browser, driver = find_browser()
+    os.environ.setdefault("SE_OFFLINE", "true")         # selenium manager: never fetch a browser or driver
+    opts = webdriver.ChromeOptions()
+    opts.binary_location = browser
+    for a in ("--headless=new", "--no-sandbox", "--disable-dev-shm-usage", "--use-angle=swiftshader",
+              "--enable-unsafe-swiftshader", "--ignore-gpu-blocklist", f"--window-size={size[0]},{size[1]}"):
+        opts.add_argument(a)
+    d = webdriver.Chrome(service=Service(executable_path=driver), options=opts)
+    try:
+        d.get(url)
+        deadline, png = time.monotonic() + timeout, b""
+        while time.monotonic() < deadline:
+            time.sleep(0.5)
+            png = d.get_screenshot_as_png()
+            if _variance(png) > min_variance:
+                time.sleep(settle)
+                png = d.get_screenshot_as_png()
+                break
+        out = Path(path)
+        out.parent.mkdir(parents=True, exist_ok=True)
+        out.write_bytes(png)
+        return out
+    finally:
+        d.quit()
+
+
+def snapshot(scene, path, port: int = 8080, size=(960, 720), step: Optional[int] = None, say=None) -> Path:
+    """Serves ``scene``, screenshots it (at ``step``, default the last) and stops the server."""
+    from .serve import serve
+
+    server, view = serve(scene, port=port, say=say)
+    try:
+        if step is not None:
+            view.slider.value = step
+            view.show(step)
+        return screenshot(f"http://127.0.0.1:{server.get_port()}", path, size=size)
+    finally:
+        server.stop()
