@@ -184,10 +184,15 @@ def draw_segments(ax, P0, P1, color="k", linewidth: float = 1.5):
     return coll
 
 
-def draw_points(ax, P, color="r", size: float = 12.0):
-    """Scatter points P (K, 3)."""
+def draw_points(ax, P, color="r", size: float = 12.0, front: bool = False, label: Optional[str] = None):
+    """Scatter points P (K, 3); ``front``: drawn over every mesh (e.g. contacts, which would
+    otherwise be hidden inside the fingers that make them)."""
     P = np.atleast_2d(np.asarray(P, dtype=np.float64))
-    return ax.scatter(P[:, 0], P[:, 1], P[:, 2], c=color, s=size, depthshade=False)
+    if front:
+        ax.computed_zorder = False          # draw in zorder, not by mplot3d's depth sort
+        return ax.scatter(P[:, 0], P[:, 1], P[:, 2], c=color, s=size, depthshade=False, zorder=10,
+                          edgecolors="k", linewidths=0.6, label=label)
+    return ax.scatter(P[:, 0], P[:, 1], P[:, 2], c=color, s=size, depthshade=False, label=label)
 
 
 def _grow_limits(ax, V):
@@ -321,7 +326,7 @@ def plot_grasp(world, grasp, path, title: Optional[str] = None):
     return plot_scene(
         world.scene, path, title=title,
         extra_meshes=hand_meshes(world.hand, grasp.joint_angles, grasp.hand_pose, alpha=0.9),
-        extra=(lambda ax: draw_points(ax, pts, color="red", size=25)) if len(pts) else None)
+        extra=(lambda ax: draw_points(ax, pts, color="red", size=25, front=True)) if len(pts) else None)
 
 
 def plot_category_grasp(cloud, models: Sequence, transforms: Sequence, weights: Sequence[float], hand, joint_angles,

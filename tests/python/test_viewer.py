@@ -127,7 +127,7 @@ def test_view_command_serves_then_stops(capsys, tmp_path, grasp_doc):
 
 
 def test_a_headless_screenshot_is_not_blank_and_differs_between_attempts(capsys, tmp_path, grasp_doc):
-    from bayesgrasp.viewer.snapshot import NoBrowser, _variance, find_browser, snapshot
+    from bayesgrasp.viewer.snapshot import NoBrowser, _variance, find_browser, snapshot_steps
 
     try:
         find_browser()
@@ -138,8 +138,8 @@ def test_a_headless_screenshot_is_not_blank_and_differs_between_attempts(capsys,
               for k, g in enumerate([grasp_doc, other])]
     scene = scene_from_result({"scene_object": "mug/3", "object_pose": [0, 0, 0], "rounds": rounds})
     port = free_port()
-    a = snapshot(scene, tmp_path / "a.png", port=port, step=0).read_bytes()
-    b = snapshot(scene, tmp_path / "b.png", port=port, step=1).read_bytes()
+    pa, pb = snapshot_steps(scene, {0: tmp_path / "a.png", 1: tmp_path / "b.png"}, port=port)   # one browser
+    a, b = pa.read_bytes(), pb.read_bytes()
     assert _variance(a) > 1e-3 and _variance(b) > 1e-3
     import matplotlib.image as mpimg
     A, B = mpimg.imread(tmp_path / "a.png"), mpimg.imread(tmp_path / "b.png")

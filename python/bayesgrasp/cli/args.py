@@ -115,6 +115,7 @@ def add_category_options(p: argparse.ArgumentParser, png_help: str) -> None:
                         "(4x4, model frame), spread, epsilon, lifted}]}; the generator's cache files have this format, "
                         "so hand-made grasps can be added to a copy of one)")
     add_format_options(p)
+    add_view_option(p)
     p.add_argument("--png", default=None, metavar="FILE", help=png_help)
 
 
@@ -187,6 +188,15 @@ def add_format_options(p: argparse.ArgumentParser) -> None:
                    help="text (default), json (one JSON object, the grasp in the schema of "
                         "bayesgrasp/data/schema/grasp.schema.json) or ros (JSON shaped like moveit_msgs/Grasp)")
     p.add_argument("--json", action="store_true", help="print one JSON object (the same as --format json)")
+
+
+def add_view_option(p: argparse.ArgumentParser) -> None:
+    """--view [PORT]: after the output, the result in 3D in the browser (as `bayesgrasp view`)."""
+    p.add_argument("--view", nargs="?", type=bounded_int(1, 65535), const=8080, default=None, metavar="PORT",
+                   help="then show the result in 3D in the browser (viser) on PORT (default 8080; the next free one "
+                        "if busy) until Ctrl-C, as `bayesgrasp view FILE.json` does")
+    p.add_argument("--view-seconds", type=float, default=None, metavar="S",
+                   help="with --view: stop the viewer after S seconds (default: at Ctrl-C)")
 
 
 def output_format(args: argparse.Namespace) -> str:

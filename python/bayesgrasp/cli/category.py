@@ -36,6 +36,7 @@ def add(sub) -> None:
 
 def run(args) -> int:
     from ..experiments.category import plan_and_execute, see
+    from ..io.view_fields import cloud_json
     from ..models.tasks import task_rule
 
     pose = floats(args.object_pose, 3, "--object-pose")
@@ -58,8 +59,10 @@ def run(args) -> int:
            "category": args.category, "task": args.task, "scene_object": args.scene_object,
            "object_pose": pose if args.scene_object else None, "executed": out["executed"],
            "scene": (args.cloud or args.depth) if view is not None else "simulated view",
-           "models": [{"model": m, "weight": out["weights"][m], "contribution": out["contributions"][m]}
-                      for m in ep.models],
+           "models": [{"model": m, "weight": out["weights"][m], "contribution": out["contributions"][m],
+                       "success": bool(r.success), "transform": np.asarray(r.transform).tolist()}
+                      for m, r in zip(ep.models, ep.registrations)],
+           "cloud": cloud_json(ep.observation.cloud),
            "epsilon": out["epsilon"], "lifted": out["lifted"], "task_ok": out["task_ok"], "success": out["success"],
            "failure": out["failure"], "reason": out["reason"] or None, "contact_parts": out.get("contact_parts", [])}
     fmt = output_format(args)
@@ -76,6 +79,9 @@ def run(args) -> int:
         _png(ep, out, ctx, png, doc)
         if fmt == "text":
             print(f"saved {png}")
+    from .view import show_result
+
+    show_result(args, doc)
     return 0
 
 

@@ -92,7 +92,7 @@ def new(args) -> int:
         from ..objects import load_object
 
         obj = load_object(args.object, units=args.units)
-    start = _vision_start(args, obj, est, quiet=fmt != "text")
+    start, _ = _vision_start(args, obj, est, quiet=fmt != "text")
     settings = PlannerSettings()
     if start is not None:
         est = start.estimate.tolist()

@@ -38,6 +38,7 @@ def add(sub) -> None:
 
 def run(args) -> int:
     from ..experiments.tactile_fusion import FusionTrial
+    from ..io.view_fields import cloud_json
     from ..planners.fusion import FusionSettings
 
     pose = floats(args.object_pose, 3, "--object-pose")
@@ -70,7 +71,8 @@ def run(args) -> int:
     success = any(x["lifted"] for x in rounds)
     doc = {"scene_object": args.scene_object, "object_pose": pose, "category": args.category, "task": args.task,
            "start": args.start, "belief": args.belief, "rounds": rounds, "success": success,
-           "scene": (args.cloud or args.depth) if view is not None else "simulated view"}
+           "scene": (args.cloud or args.depth) if view is not None else "simulated view",
+           "cloud": cloud_json(trial.episode.observation.cloud)}
     if fmt == "ros":
         from ..io.grasp_schema import to_ros
 
@@ -85,6 +87,9 @@ def run(args) -> int:
         plot_fusion_rounds(trial.names, rounds, pose, png, title=f"{args.scene_object}: vision then touch")
         if fmt == "text":
             print(f"saved {png}")
+    from .view import show_result
+
+    show_result(args, doc)
     return 0
 
 

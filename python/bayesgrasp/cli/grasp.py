@@ -21,7 +21,7 @@ from pathlib import Path
 
 import numpy as np
 
-from .args import CliError, Renamed, add_format_options, floats, hand_name, output_file, output_format
+from .args import CliError, Renamed, add_format_options, add_view_option, floats, hand_name, output_file, output_format
 
 
 def add(sub) -> None:
@@ -47,7 +47,10 @@ def add(sub) -> None:
     g.add_argument("--hand", type=hand_name, default="barrett_bh8", help="built-in hand name or hand file path")
     g.add_argument("--keep-origin", action="store_true", help="keep a loaded mesh's own origin")
     g.add_argument("--no-lift", action="store_true", help="skip the physical lift test")
+    g.add_argument("--lift-trace", action="store_true",
+                   help="record the lift test's trace (the object's path in the hand) in the JSON, for `view`")
     add_format_options(g)
+    add_view_option(g)
     g.add_argument("--png", default=None, metavar="FILE", help="write a PNG of the hand, the object and the contacts")
     g.set_defaults(run=run)
 
@@ -78,6 +81,8 @@ def run(args) -> int:
         "stopped_by_table": g["stopped_by_table"], "hand_pose_object": np.asarray(g["hand_pose_object"]).tolist(),
     }
     out["grasp"] = hand_grasp_record(world.hand, g["hand_pose"], g["joint_angles"], world.spread if args.spread is None else args.spread)
+    if args.lift_trace:
+        out["lift_trace"] = _lift_trace(world, args, g)
     fmt = output_format(args)
     if fmt == "ros":
         print(json.dumps(to_ros(out["grasp"], grasp_id=f"{args.object}-{request['mode']}", quality=out["epsilon"])))
@@ -88,10 +93,29 @@ def run(args) -> int:
     if png:
         from ..viz import plot_grasp
 
-        plot_grasp(world, grasp, png, title=f"{world.hand.name} on {args.object}: {_describe(out)}")
+        verdict = {True: "lifted", False: "FAILED: not lifted", None: "lift not tested"}[out["lifted"]]
+        plot_grasp(world, grasp, png, title=f"{world.hand.name} on {args.object}: {_describe(out)}\n{verdict}, "
+                                            f"epsilon {out['epsilon']:.3f}")
         if fmt == "text":
             print(f"saved {png}")
+    from .view import show_result
+
+    show_result(args, out)
     return 0
+
+
+def _lift_trace(world, args, g: dict) -> dict:
+    """The lift test run again with its trace recorded (same hand pose, joints and physics, so the
+    same verdict as the grasp's), as the object's path in the hand."""
+    from ..io.view_fields import lift_trace_json
+    from ..lift_trace import LiftTrace
+
+    if args.no_lift:
+        raise CliError("--lift-trace: not with --no-lift")
+    r = world.lift_tester().run(np.asarray(g["hand_pose"]), np.asarray(g["joint_angles"]), trace_every=10)
+    doc = lift_trace_json(LiftTrace.from_core(r.trace), g["hand_pose"])
+    doc["lifted"] = bool(r.lifted) and not g["collision_at_start"]
+    return doc
 
 
 def _request(args) -> dict:

@@ -8,7 +8,7 @@ from pathlib import Path
 import numpy as np
 
 from . import camera_input
-from .args import (CliError, add_context_options, add_format_options, bounded_int, context, floats, out_dir,
+from .args import (CliError, add_context_options, add_format_options, add_view_option, bounded_int, context, floats, out_dir,
                    output_file, output_format)
 
 METHODS = ["stability", "explore", "ml_pose", "open_loop"]
@@ -40,6 +40,7 @@ def add(sub) -> None:
     p.add_argument("--noise", type=float, default=0.0, help="joint-angle measurement noise std (rad)")
     p.add_argument("--png", default=None, help="write a PNG of the belief's evolution")
     add_format_options(p)
+    add_view_option(p)
     add_context_options(p)
     camera_input.add(p)
     p.set_defaults(run=plan)
@@ -88,10 +89,6 @@ def _belief_png(r: dict, path) -> Path:
                                  f"{np.degrees(r['true_pose'][2]):.0f} deg)", r["attempts"])
 
 
-def _json_ready(r: dict) -> dict:
-    return {k: v for k, v in r.items() if k not in ("planner", "snapshots")}
-
-
 def demo(args) -> int:
     """The main job: a mug at a displaced pose the robot knows only to +-4 cm and +-45 deg;
     plan, grasp, read the fingers, update the belief, re-plan until the grasp is stable."""
@@ -105,9 +102,33 @@ def demo(args) -> int:
     print(f"{'success' if r['success'] else 'no successful grasp'} after {len(r['attempts'])} attempt(s); "
           f"final belief error {100 * f['position_error']:.1f} cm, {np.degrees(f['yaw_error']):.0f} deg")
     png = _belief_png(r, out / "belief_evolution.png")
-    (out / "demo.json").write_text(json.dumps(_json_ready(r), indent=1))
-    print(f"saved {png} and {out / 'demo.json'}")
+    doc = _plan_json(args, pose, r)
+    (out / "demo.json").write_text(json.dumps(doc, indent=1))
+    pictures = _attempt_pictures(doc, out)
+    print(f"saved {png}, {out / 'demo.json'} (see it in 3D: bayesgrasp view {out / 'demo.json'}) and "
+          f"{len(pictures)} picture(s) of the hand on the {args.object}: {', '.join(p.name for p in pictures)}")
     return 0
+
+
+def _attempt_pictures(doc: dict, out: Path) -> list:
+    """attempt_K.png per attempt: the 3D view's screenshot (headless Chromium), or the same scene
+    drawn by matplotlib when no browser is installed (said on stderr)."""
+    from ..viewer import scene_from_result
+
+    scene = scene_from_result(doc)
+    paths = {k: out / f"attempt_{k + 1}.png" for k in range(len(scene.steps))}
+    try:
+        from ..viewer.snapshot import NoBrowser, find_browser, snapshot_steps
+
+        find_browser()
+        return snapshot_steps(scene, paths, port=8090)
+    except (ImportError, NoBrowser) as e:
+        import sys
+
+        from ..viewer.static import render_steps
+
+        print(f"no browser for the 3D view's screenshots ({e}); drawing them with matplotlib", file=sys.stderr)
+        return render_steps(scene, paths)
 
 
 def _attempt_grasps(r: dict, hand_name: str) -> list:
@@ -120,7 +141,24 @@ def _attempt_grasps(r: dict, hand_name: str) -> list:
     return [hand_grasp_record(hand, a["hand_pose"], a["joint_positions"], spread) for a in r["attempts"]]
 
 
-def _plan_json(args, pose, r: dict) -> dict:
+def _contacts(args, pose, r: dict, obj) -> list:
+    """Each attempt's contacts (with their parts): its grasp simulated again without the lift
+    (the same world, grasp and spread, so the same closing; checked against the attempt's pose)."""
+    from ..world import World
+
+    world = World.single(obj, pose=pose, hand=context(args).hand)
+    out = []
+    for a in r["attempts"]:
+        g = world.grasp(*a["relative_grasp"], spread=r["planner"].models.spread, lift=False)
+        same = np.allclose(g.hand_pose, a["hand_pose"], atol=1e-9)
+        out.append([c for c in g.to_dict()["contacts"] if not c["on_table"]] if same else [])
+    return out
+
+
+def _plan_json(args, pose, r: dict, obj=None) -> dict:
+    """plan's JSON; each attempt carries the belief it was planned from (its heaviest particles)."""
+    from ..io.view_fields import belief_json
+
     f = r["final_belief"]
     grasps = _attempt_grasps(r, args.hand)
     return {"object": args.object, "method": args.method, "true_pose": pose, "estimate": r["estimate"],
@@ -130,9 +168,11 @@ def _plan_json(args, pose, r: dict) -> dict:
                           "epsilon": a["epsilon"], "stable": a["stable"], "lifted": a["lifted"],
                           "success": a["success"], "outcome": "success" if a["success"] else "failure",
                           "plan_seconds": a["plan_seconds"],
-                          "joint_angles": a["joint_angles"]} for a, g in zip(r["attempts"], grasps)],
+                          "joint_angles": a["joint_angles"], "belief": belief_json(*r["snapshots"][k]),
+                          "contacts": c} for k, (a, g, c) in enumerate(zip(r["attempts"], grasps, _contacts(args, pose, r, obj or args.object)))],
             "final_belief": {"mean": f["mean"], "std": f["std"], "entropy": f["kde_entropy"], "ess": f["ess"],
-                             "position_error": f["position_error"], "yaw_error": f["yaw_error"]}}
+                             "position_error": f["position_error"], "yaw_error": f["yaw_error"],
+                             **belief_json(*r["snapshots"][-1])}}
 
 
 def plan(args) -> int:
@@ -148,7 +188,7 @@ def plan(args) -> int:
         from ..objects import load_object
 
         obj = load_object(args.object, units=args.units)
-    start = _vision_start(args, obj, est, quiet=quiet)
+    start, view = _vision_start(args, obj, est, quiet=quiet)
     half_width = None
     if start is not None:
         est, half_width = start.estimate.tolist(), start.half_width.tolist()
@@ -161,22 +201,34 @@ def plan(args) -> int:
         print(json.dumps({"attempts": [to_ros(g, grasp_id=f"attempt-{a['attempt']}", quality=a["predicted_stability"])
                                        for a, g in zip(r["attempts"], _attempt_grasps(r, args.hand))]}))
     elif fmt == "json":
-        doc = _plan_json(args, pose, r)
-        if start is not None:
-            doc["vision"] = {"scene": args.cloud or args.depth, "estimate": start.estimate.tolist(),
-                             "half_width": start.half_width.tolist(), "registration": start.registration.as_dict()}
-        print(json.dumps(doc))
+        print(json.dumps(_plan_doc(args, pose, r, start, view, obj)))
     else:
         print(f"{'success' if r['success'] else 'no successful grasp'} after {len(r['attempts'])} attempt(s)")
+    if args.view is not None:
+        from .view import show_result
+
+        show_result(args, _plan_doc(args, pose, r, start, view, obj))
     return 0
+
+
+def _plan_doc(args, pose, r: dict, start, view, obj=None) -> dict:
+    """plan's JSON, with the vision start (and its cloud) when the belief came from camera data."""
+    from ..io.view_fields import cloud_json
+
+    doc = _plan_json(args, pose, r, obj)
+    if start is not None:
+        doc["vision"] = {"scene": args.cloud or args.depth, "estimate": start.estimate.tolist(),
+                         "half_width": start.half_width.tolist(), "registration": start.registration.as_dict(),
+                         "cloud": cloud_json(view.object_points)}
+    return doc
 
 
 def _vision_start(args, obj, estimate, quiet: bool):
     """The estimate and belief spread from registering ``obj`` (--object's mesh) to the camera
-    data, or None."""
+    data, and the camera data (None, None without them)."""
     view = camera_input.observe(args)
     if view is None:
-        return None
+        return None, None
     if estimate is not None:
         raise CliError("--estimate: not with --cloud or --depth (the estimate comes from registering to them)")
     from ..experiments.vision_start import vision_start
@@ -188,4 +240,4 @@ def _vision_start(args, obj, estimate, quiet: bool):
         print(f"vision: {args.object} registered to {args.cloud or args.depth} at ({100 * x:.1f} cm, {100 * y:.1f} cm, "
               f"{np.degrees(yaw):.0f} deg), fit {1000 * start.registration.delta:.1f} mm -> belief "
               f"+-{100 * hx:.1f} cm, +-{np.degrees(hyaw):.0f} deg")
-    return start
+    return start, view

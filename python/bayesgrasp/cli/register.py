@@ -7,7 +7,7 @@ import json
 import numpy as np
 
 from . import camera_input
-from .args import SEED_MAX, CliError, Renamed, bounded_int, floats, output_file
+from .args import SEED_MAX, CliError, Renamed, add_view_option, bounded_int, floats, output_file
 
 
 def add(sub) -> None:
@@ -24,6 +24,7 @@ def add(sub) -> None:
     r.add_argument("--seed", type=bounded_int(0, SEED_MAX), default=0, help="seed of the registration's random draws")
     r.add_argument("--png", default=None, help="write a PNG of the cloud over each registered model")
     r.add_argument("--json", action="store_true", help="print one JSON object")
+    add_view_option(r)
     camera_input.add(r)
     r.set_defaults(run=run)
 
@@ -42,7 +43,10 @@ def run(args) -> int:
     points, viewpoint, source = _scene(args, pose)
     res = register(points, models, voxel=args.voxel, seed=args.seed, viewpoint=viewpoint,
                    names=[str(m) for m in args.models])
-    doc = {"scene": source, "scene_points": int(len(points)), "models": [r.as_dict() for r in res]}
+    from ..io.view_fields import cloud_json
+
+    doc = {"scene": source, "scene_points": int(len(points)), "models": [r.as_dict() for r in res],
+           "cloud": cloud_json(points)}
     if args.scene_object:
         doc.update(scene_object=str(args.scene_object), pose=pose)
     if args.json:
@@ -54,6 +58,9 @@ def run(args) -> int:
 
         plot_registrations(points, models, res, str(png))
         print(f"saved {png}")
+    from .view import show_result
+
+    show_result(args, doc)
     return 0
 
 

@@ -11,7 +11,7 @@ import json
 
 import numpy as np
 
-from .args import SEED_MAX, CliError, add_format_options, bounded_int, floats, hand_name, output_file, output_format
+from .args import SEED_MAX, CliError, add_format_options, add_view_option, bounded_int, floats, hand_name, output_file, output_format
 
 
 def add(sub) -> None:
@@ -33,6 +33,7 @@ def add(sub) -> None:
     t.add_argument("--seed", type=bounded_int(0, SEED_MAX), default=0, help="the optimiser's seed")
     t.add_argument("--hand", type=hand_name, default="barrett_bh8", help="built-in hand name or hand file path")
     add_format_options(t)
+    add_view_option(t)
     t.add_argument("--png", default=None, metavar="PATH", help="write the fitness landscape to this PNG")
     t.set_defaults(run=run)
 
@@ -73,6 +74,9 @@ def run(args) -> int:
         print(json.dumps(out))
     else:
         _print(out)
+    from .view import show_result
+
+    show_result(args, out)
     return 0
 
 

@@ -25,23 +25,39 @@ def add(sub) -> None:
 
 
 def run(args) -> int:
-    from ..viewer import read_result, scene_from_result, serve
+    from ..viewer import read_result, scene_from_result
 
     scene = scene_from_result(read_result(args.file))      # refused before a server starts
     if args.snapshot:
         return _snapshot(args, scene)
-    server, _ = serve(scene, port=args.port, host=args.host)
-    print(f"viewing {args.file} ({scene.kind}, {len(scene.steps)} step(s)) at http://{args.host}:{server.get_port()}"
-          " (Ctrl-C stops)", flush=True)
+    _serve_until_stopped(scene, args.file, args.port, args.host, args.seconds)
+    return 0
+
+
+def show_result(args, doc: dict) -> None:
+    """A command's ``--view``: its result document in the viewer until Ctrl-C (nothing without it)."""
+    if getattr(args, "view", None) is None:
+        return
+    from ..viewer import scene_from_result
+
+    _serve_until_stopped(scene_from_result(doc), f"this {args.command} result", args.view, "127.0.0.1",
+                         getattr(args, "view_seconds", None), stream=sys.stderr)
+
+
+def _serve_until_stopped(scene, what: str, port: int, host: str, seconds=None, stream=None) -> None:
+    from ..viewer.serve import serve, stop
+
+    server, _ = serve(scene, port=port, host=host)
+    print(f"viewing {what} ({scene.kind}, {len(scene.steps)} step(s)) at http://{host}:{server.get_port()}"
+          " (Ctrl-C stops)", file=stream or sys.stdout, flush=True)
     try:
-        deadline = None if args.seconds is None else time.monotonic() + args.seconds
+        deadline = None if seconds is None else time.monotonic() + seconds
         while deadline is None or time.monotonic() < deadline:
             time.sleep(0.2)
     except KeyboardInterrupt:
         print("stopped", file=sys.stderr)
     finally:
-        server.stop()
-    return 0
+        stop(server)
 
 
 def _snapshot(args, scene) -> int:

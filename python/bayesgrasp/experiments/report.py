@@ -138,32 +138,47 @@ def plot_per_attempt(tables: Dict[str, List[dict]], path: Path, title: str) -> P
 
 
 def plot_belief_evolution(snapshots, true_pose, path: Path, title: str = "", attempts: Optional[list] = None) -> Path:
-    """Particles (x, y; yaw as colour) before each attempt and at the end, with the true pose (red
-    cross) and the executed grasp (black arrow) - thesis Figs. 3.3 and 3.5."""
+    """Particles (x, y; marker size = weight) before each attempt and at the end - thesis Figs. 3.3
+    and 3.5. Colour: each particle's yaw error against the true yaw, wrapped to +-180 deg, on a
+    diverging map centred at 0 (white = right yaw), scaled to the initial belief's spread. Legend:
+    the true pose (red cross), its heading (red arrow) and the executed grasp (black triangle);
+    each panel says whether its grasp lifted the object."""
     plt = _mpl()
+    from matplotlib.lines import Line2D
+
     n = len(snapshots)
-    fig, axes = plt.subplots(1, n, figsize=(3.3 * n, 3.5), squeeze=False)
+    fig, axes = plt.subplots(1, n, figsize=(3.3 * n, 3.9), squeeze=False)
     t = np.asarray(true_pose, dtype=float)
     P0 = snapshots[0][0]
     lo = P0[:, :2].min(axis=0) - 0.01
     hi = P0[:, :2].max(axis=0) + 0.01
+    wrap = lambda a: np.degrees((a - t[2] + np.pi) % (2 * np.pi) - np.pi)  # noqa: E731
+    span = max(5.0, float(np.ceil(np.abs(wrap(P0[:, 2])).max() / 5) * 5))
     for i, (ax, (P, w)) in enumerate(zip(axes[0], snapshots)):
-        sc = ax.scatter(100 * P[:, 0], 100 * P[:, 1], c=np.degrees(P[:, 2]), s=4 + 400 * w, cmap="twilight",
-                        vmin=-180, vmax=180, alpha=0.7)
+        sc = ax.scatter(100 * P[:, 0], 100 * P[:, 1], c=wrap(P[:, 2]), s=4 + 400 * w, cmap="coolwarm",
+                        vmin=-span, vmax=span, alpha=0.8, edgecolors="0.4", linewidths=0.2)
         ax.plot(100 * t[0], 100 * t[1], "r+", ms=16, mew=2.5)
         ax.arrow(100 * t[0], 100 * t[1], 2 * np.cos(t[2]), 2 * np.sin(t[2]), color="r", width=0.08)
         label = "final" if i == n - 1 else f"before attempt {i + 1}"
         if attempts is not None and i < len(attempts):
             a = attempts[i]
             ax.plot(100 * a["action"][0], 100 * a["action"][1], "k^", ms=8)
-            label += f"\n{a['kind']}: P(S) {a['predicted_stability']:.2f}, eps {a['epsilon']:.3f}"
+            verdict = {True: "lifted", False: "FAILED (not lifted)"}.get(a.get("lifted"), "lift not tested")
+            label += f"\n{a['kind']}: P(S) {a['predicted_stability']:.2f}, eps {a['epsilon']:.3f}\n{verdict}"
         ax.set_title(label, fontsize=9)
         ax.set_xlim(100 * lo[0], 100 * hi[0])
         ax.set_ylim(100 * lo[1], 100 * hi[1])
         ax.set_aspect("equal")
         ax.set_xlabel("x (cm)")
     axes[0][0].set_ylabel("y (cm)")
-    fig.colorbar(sc, ax=axes[0].tolist(), label="yaw (deg)", shrink=0.8)
+    fig.colorbar(sc, ax=axes[0].tolist(), label="particle yaw - true yaw (deg)", shrink=0.8)
+    handles = [Line2D([], [], ls="", marker="+", color="r", ms=12, mew=2.5, label="true pose"),
+               Line2D([], [], color="r", lw=2, label="true heading"),
+               Line2D([], [], ls="", marker="o", color="0.6", ms=6, label="particle (size = weight)")]
+    if attempts:
+        handles.append(Line2D([], [], ls="", marker="^", color="k", ms=8, label="executed grasp"))
+    fig.legend(handles=handles, loc="lower center", ncol=len(handles), fontsize=8, frameon=False,
+               bbox_to_anchor=(0.45, -0.04))
     if title:
         fig.suptitle(title, fontsize=10)
     fig.savefig(path, dpi=110, bbox_inches="tight")

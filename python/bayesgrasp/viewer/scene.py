@@ -39,7 +39,9 @@ class Step:
     grasp: Optional[dict]
     outcome: str = ""                       # "lifted", "dropped", "planned", ...
     contacts: List[Contact] = field(default_factory=list)
-    models: List[tuple] = field(default_factory=list)   # (name, planar pose (x, y, yaw), weight) overlays
+    models: List[tuple] = field(default_factory=list)   # (name, 4x4 model-to-world or None, weight) overlays
+    belief: Optional[dict] = None          # {"particles": [[x, y, yaw], ...], "weights": [...], "n": N}
+    trace: Optional[dict] = None           # the lift test's trace (io.view_fields.lift_trace_json)
 
 
 @dataclass
@@ -60,6 +62,22 @@ def planar_transform(pose: Sequence[float]) -> np.ndarray:
     T[:2, :2] = [[c, -s], [s, c]]
     T[:2, 3] = x, y
     return T
+
+
+def _planar_models(named: dict, weights: dict) -> List[tuple]:
+    """(name, 4x4, weight) overlays from planar poses (x, y, yaw) by model name."""
+    return [(m, None if named.get(m) is None else planar_transform(named[m]), float(weights[m])) for m in weights]
+
+
+def _registered(models) -> List[tuple]:
+    """(name, 4x4, weight) overlays from registrations (a successful one's transform, else none)."""
+    return [(m["model"], np.asarray(m["transform"], float) if m.get("transform") is not None and m.get("success", True)
+             else None, float(m.get("weight", 0.0))) for m in models]
+
+
+def _cloud(doc) -> Optional[np.ndarray]:
+    c = doc.get("cloud")
+    return None if not c else np.asarray(c, float).reshape(-1, 3)
 
 
 def read_result(path) -> dict:
@@ -105,32 +123,34 @@ def scene_from_result(doc: dict) -> ResultScene:
 
 
 def _grasp(doc) -> ResultScene:
-    step = Step("grasp", doc["grasp"], _verdict(doc.get("lifted")), _contacts(doc.get("contacts")))
+    step = Step("grasp", doc["grasp"], _verdict(doc.get("lifted")), _contacts(doc.get("contacts")),
+                trace=doc.get("lift_trace"))
     return ResultScene("grasp", _object(doc["object"]), np.asarray(doc.get("object_pose") or (0, 0, 0), float), [step],
                        title=f"{doc['object']}: {step.outcome}, epsilon {doc.get('epsilon', 0.0):.3f}")
 
 
 def _plan(doc) -> ResultScene:
-    steps = [Step(f"attempt {k + 1} ({a.get('plan_type', '')})", a["grasp"], _verdict(a.get("lifted")))
-             for k, a in enumerate(doc["attempts"])]
-    return ResultScene("plan", _object(doc["object"]), np.asarray(doc["true_pose"], float), steps,
+    steps = [Step(f"attempt {k + 1} ({a.get('plan_type', '')})", a["grasp"], _verdict(a.get("lifted")),
+                  _contacts(a.get("contacts")), belief=a.get("belief")) for k, a in enumerate(doc["attempts"])]
+    vision = doc.get("vision") or {}
+    return ResultScene("plan", _object(doc["object"]), np.asarray(doc["true_pose"], float), steps, cloud=_cloud(vision),
                        title=f"{doc['object']}: {'success' if doc.get('success') else 'no grasp lifted'}")
 
 
 def _category(doc) -> ResultScene:
     pose = doc.get("object_pose")
-    models = [(m["model"], None, m["weight"]) for m in doc.get("models", [])]
     step = Step(f"{doc['task']} ({doc['method']})", doc["grasp"], _verdict(doc.get("lifted")),
-                _contacts(doc.get("contacts")), models)
+                _contacts(doc.get("contacts")), _registered(doc.get("models", [])))
     return ResultScene("category", _object(doc.get("scene_object")), None if pose is None else np.asarray(pose, float),
-                       [step], title=f"{doc.get('scene_object') or doc.get('scene')}, {doc['task']}: "
+                       [step], cloud=_cloud(doc), title=f"{doc.get('scene_object') or doc.get('scene')}, {doc['task']}: "
                                      f"{'success' if doc.get('success') else doc.get('failure') or 'planned'}")
 
 
 def _fuse(doc) -> ResultScene:
     steps = [Step(f"round {r['round']}", r["grasp"], _verdict(r.get("lifted")),
-                  models=[(m, r["poses"][m], r["weights"][m]) for m in r["weights"]]) for r in doc["rounds"]]
+                  models=_planar_models(r["poses"], r["weights"])) for r in doc["rounds"]]
     return ResultScene("fuse", _object(doc["scene_object"]), np.asarray(doc["object_pose"], float), steps,
+                       cloud=_cloud(doc),
                        title=f"{doc['scene_object']}: vision then touch, "
                              f"{'success' if doc.get('success') else 'no grasp lifted'}")
 
@@ -138,15 +158,16 @@ def _fuse(doc) -> ResultScene:
 def _touch(doc) -> ResultScene:
     """The object at its true pose, the touch, and the model at the fitted estimate (weight 1)."""
     truth, est = doc["true_state"], doc["estimate"]
-    step = Step("touch", doc.get("grasp"), "touched", models=[(doc["object"], est[:3], 1.0)])
+    step = Step("touch", doc.get("grasp"), "touched", models=[(doc["object"], planar_transform(est[:3]), 1.0)])
     return ResultScene("touch", _object(doc["object"]), np.asarray(truth[:3], float), [step],
                        title=f"{doc['object']}: one touch, {doc.get('optimizer', '')} estimate overlaid")
 
 
 def _register(doc) -> ResultScene:
-    models = [(m["model"], None, m.get("phi", 0.0)) for m in doc["models"]]
-    return ResultScene("register", None, None, [Step("registration", None, "", models=models)],
-                       title=f"{doc.get('scene')}: {len(models)} model(s) registered")
+    pose = doc.get("pose")
+    return ResultScene("register", _object(doc.get("scene_object")), None if pose is None else np.asarray(pose, float),
+                       [Step("registration", None, "", models=_registered(doc["models"]))], cloud=_cloud(doc),
+                       title=f"{doc.get('scene')}: {len(doc['models'])} model(s) registered")
 
 
 def _episode(doc) -> ResultScene:

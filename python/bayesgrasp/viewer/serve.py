@@ -3,10 +3,15 @@ toggle per layer. Node names (the tests check them through viser's scene API):
 
 ``/table``, ``/object/<part>``, ``/cloud``, and per step k ``/steps/k/hand/<link>-<i>``,
 ``/steps/k/pregrasp/<link>-<i>``, ``/steps/k/approach``, ``/steps/k/contacts``,
-``/steps/k/normals``, ``/steps/k/models/<name>``.
+``/steps/k/normals``, ``/steps/k/models/<name>``, ``/steps/k/particles`` (one point per particle,
+coloured by weight), ``/steps/k/particle_copies`` (the heaviest as faint copies of the object),
+``/steps/k/lift_trace`` (the object's path in the hand) and ``/steps/k/lift_end`` (the object where
+the lift left it, relative to the hand).
 """
 from __future__ import annotations
 
+import contextlib
+import io
 import sys
 from functools import lru_cache
 from typing import Dict, List, Optional, Tuple
@@ -17,10 +22,26 @@ from ..hand import Hand, builtin_hands
 from ..viz import box_mesh, capsule_mesh
 from .scene import ResultScene, Step, planar_transform
 
-LAYERS = ("object", "hand", "pregrasp", "approach", "contacts", "models", "cloud")
+LAYERS = ("object", "hand", "pregrasp", "approach", "contacts", "models", "particles", "lift trace", "cloud")
+MAX_COPIES = 15       # the heaviest particles drawn as faint copies of the object
 PART_COLOURS = [(230, 150, 60), (70, 140, 220), (90, 180, 90), (200, 80, 160), (160, 160, 60), (90, 200, 200)]
 HAND_COLOUR, PREGRASP_COLOUR, CONTACT_COLOUR = (120, 120, 130), (180, 180, 200), (230, 30, 30)
 TABLE_HALF = 0.25     # m, half side of the drawn table square
+
+
+def weight_colours(w) -> np.ndarray:
+    """(N, 3) uint8 colours for weights (viridis over w / max w: dark = light weight)."""
+    from matplotlib import colormaps
+
+    w = np.asarray(w, float)
+    return (255 * colormaps["viridis"](w / w.max() if w.size and w.max() > 0 else w)[:, :3]).astype(np.uint8)
+
+
+def _wxyz(R) -> np.ndarray:
+    from scipy.spatial.transform import Rotation
+
+    x, y, z, w = Rotation.from_matrix(R).as_quat().T
+    return np.stack([w, x, y, z], axis=-1)
 
 
 def _rgb(weight: float, base=(70, 140, 220)) -> Tuple[int, int, int]:
@@ -44,6 +65,14 @@ def hand_link_meshes(hand: Hand, q, pose) -> List[Tuple[str, np.ndarray, np.ndar
         i = count[s.name] = count.get(s.name, -1) + 1
         out.append((f"{s.name.replace('/', '_')}-{i}", np.asarray(V, float), np.asarray(F, np.int32)))
     return out
+
+
+@lru_cache(maxsize=32)
+def _model_mesh(name: str) -> Tuple[np.ndarray, np.ndarray]:
+    from ..objects import load_object
+
+    m = load_object(name)
+    return np.asarray(m.vertices, float), np.asarray(m.faces, np.int32)
 
 
 @lru_cache(maxsize=8)
@@ -116,16 +145,54 @@ class SceneView:
             self._keep(k, "contacts", add.add_arrows(f"{base}/normals", np.stack([P, P + 0.03 * N], axis=1),
                                                      colors=CONTACT_COLOUR, shaft_radius=0.001, head_radius=0.003,
                                                      head_length=0.006))
-        for name, pose, weight in step.models:
-            if pose is None:
+        for name, T, weight in step.models:
+            if T is None:
                 continue
-            from ..objects import load_object
-
-            m = load_object(name)
-            V = _placed(m.vertices, planar_transform(pose))
-            self._keep(k, "models", add.add_mesh_simple(f"{base}/models/{name.replace('/', '_')}", V,
-                                                        np.asarray(m.faces, np.int32), color=_rgb(weight),
+            m = _model_mesh(name)
+            self._keep(k, "models", add.add_mesh_simple(f"{base}/models/{name.replace('/', '_')}", _placed(m[0], T),
+                                                        m[1], color=_rgb(weight),
                                                         opacity=0.15 + 0.5 * float(np.clip(weight, 0, 1))))
+        if step.belief:
+            self._add_particles(k, step.belief)
+        if step.trace and g is not None:
+            self._add_trace(k, step.trace)
+
+    def _add_particles(self, k: int, belief: dict) -> None:
+        """The belief's particles: a point each (on the table, coloured by weight) and the heaviest
+        as faint copies of the object."""
+        add, base = self.server.scene, f"/steps/{k}"
+        X, w = np.asarray(belief["particles"], float).reshape(-1, 3), np.asarray(belief["weights"], float)
+        if not len(X):
+            return
+        colours = weight_colours(w)
+        P = np.column_stack([X[:, :2], np.full(len(X), 0.002)]).astype(np.float32)
+        self._keep(k, "particles", add.add_point_cloud(f"{base}/particles", P, colors=colours, point_size=0.004,
+                                                       point_shape="circle"))
+        obj = self.scene.object
+        if obj is None:
+            return
+        top = np.argsort(-w, kind="stable")[:MAX_COPIES]
+        R = np.array([planar_transform(x)[:3, :3] for x in X[top]])
+        pos = np.column_stack([X[top, :2], np.zeros(len(top))])
+        self._keep(k, "particles", add.add_batched_meshes_simple(
+            f"{base}/particle_copies", np.asarray(obj.vertices, np.float32), np.asarray(obj.faces, np.int32),
+            batched_wxyzs=_wxyz(R), batched_positions=pos, batched_colors=colours[top],
+            batched_opacities=0.04 + 0.12 * w[top] / w.max(), cast_shadow=False, receive_shadow=False))
+
+    def _add_trace(self, k: int, trace: dict) -> None:
+        """The lift test's trace: the object's path in the hand, and the object where it ended."""
+        add, base = self.server.scene, f"/steps/{k}"
+        path = np.asarray(trace["path"], float).reshape(-1, 3)
+        if len(path) >= 2:
+            seg = np.stack([path[:-1], path[1:]], axis=1).astype(np.float32)
+            self._keep(k, "lift trace", add.add_line_segments(f"{base}/lift_trace", seg, colors=(250, 120, 0),
+                                                              thickness=3.0, thickness_units="screen"))
+        sc = self.scene
+        if sc.object is not None and sc.object_pose is not None and trace.get("slip") is not None:
+            T = np.asarray(trace["slip"], float) @ planar_transform(sc.object_pose)
+            self._keep(k, "lift trace", add.add_mesh_simple(f"{base}/lift_end", _placed(sc.object.vertices, T),
+                                                            np.asarray(sc.object.faces, np.int32), color=(250, 120, 0),
+                                                            opacity=0.3))
 
     def frame_camera(self) -> None:
         """The initial camera: looking at the object (or the grasps) from the front, above."""
@@ -150,6 +217,8 @@ class SceneView:
                                      disabled=n < 2)
         self.label = gui.add_markdown("")
         self.toggles = {layer: gui.add_checkbox(layer, initial_value=layer != "pregrasp") for layer in LAYERS}
+        if self.scene.steps and any(s.belief for s in self.scene.steps):
+            gui.add_markdown("particles: viridis by weight (yellow = heaviest)")
         self.slider.on_update(lambda _: self.show(int(self.slider.value)))
         for t in self.toggles.values():
             t.on_update(lambda _: self.show(int(self.slider.value)))
@@ -173,8 +242,15 @@ def serve(scene: ResultScene, port: int = 8080, host: str = "127.0.0.1", say=Non
     import viser
 
     say = say or (lambda m: print(m, file=sys.stderr))
-    server = viser.ViserServer(host=host, port=port, verbose=False)
+    with contextlib.redirect_stdout(io.StringIO()):      # viser's banner: the caller prints the URL
+        server = viser.ViserServer(host=host, port=port, verbose=False)
     if server.get_port() != port:
         say(f"port {port} is in use; serving on {server.get_port()}")
     server.scene.set_up_direction("+z")
     return server, SceneView(server, scene)
+
+
+def stop(server) -> None:
+    """Stops the server without viser's line on stdout (stdout may be a command's JSON)."""
+    with contextlib.redirect_stdout(io.StringIO()):
+        server.stop()

@@ -8,7 +8,7 @@ import os
 import shutil
 import time
 from pathlib import Path
-from typing import Optional
+from typing import Dict, List, Optional
 
 import numpy as np
 
@@ -38,10 +38,7 @@ def _variance(png: bytes) -> float:
     return float(np.asarray(mpimg.imread(BytesIO(png), format="png"))[..., :3].var())
 
 
-def screenshot(url: str, path, size=(960, 720), timeout: float = 30.0, min_variance: float = 1e-3,
-               settle: float = 1.5) -> Path:
-    """The page at ``url`` as ``path`` (PNG), once it has drawn something (the image's pixel
-    variance above ``min_variance``) and a further ``settle`` seconds have passed."""
+def _driver(size):
     from selenium import webdriver
     from selenium.webdriver.chrome.service import Service
 
@@ -52,34 +49,74 @@ def screenshot(url: str, path, size=(960, 720), timeout: float = 30.0, min_varia
     for a in ("--headless=new", "--no-sandbox", "--disable-dev-shm-usage", "--use-angle=swiftshader",
               "--enable-unsafe-swiftshader", "--ignore-gpu-blocklist", f"--window-size={size[0]},{size[1]}"):
         opts.add_argument(a)
-    d = webdriver.Chrome(service=Service(executable_path=driver), options=opts)
+    return webdriver.Chrome(service=Service(executable_path=driver), options=opts)
+
+
+def _drawn(d, timeout: float, min_variance: float, settle: float) -> bytes:
+    """A screenshot once the page has drawn something (pixel variance above ``min_variance``) and
+    a further ``settle`` seconds have passed."""
+    deadline, png = time.monotonic() + timeout, b""
+    while time.monotonic() < deadline:
+        time.sleep(0.5)
+        png = d.get_screenshot_as_png()
+        if _variance(png) > min_variance:
+            time.sleep(settle)
+            d.execute_script(HIDE_NOTICES)      # the browser's "software WebGL" notice is about the screenshot's
+            return d.get_screenshot_as_png()    # own renderer, not the scene
+    return png
+
+
+HIDE_NOTICES = """document.querySelectorAll('[class*="Notification"]').forEach(e => e.style.display = 'none');"""
+
+
+def _write(png: bytes, path) -> Path:
+    out = Path(path)
+    out.parent.mkdir(parents=True, exist_ok=True)
+    out.write_bytes(png)
+    return out
+
+
+def screenshot(url: str, path, size=(960, 720), timeout: float = 30.0, min_variance: float = 1e-3,
+               settle: float = 1.5) -> Path:
+    """The page at ``url`` as ``path`` (PNG), once it has drawn something."""
+    d = _driver(size)
     try:
         d.get(url)
-        deadline, png = time.monotonic() + timeout, b""
-        while time.monotonic() < deadline:
-            time.sleep(0.5)
-            png = d.get_screenshot_as_png()
-            if _variance(png) > min_variance:
-                time.sleep(settle)
-                png = d.get_screenshot_as_png()
-                break
-        out = Path(path)
-        out.parent.mkdir(parents=True, exist_ok=True)
-        out.write_bytes(png)
-        return out
+        return _write(_drawn(d, timeout, min_variance, settle), path)
     finally:
         d.quit()
 
 
 def snapshot(scene, path, port: int = 8080, size=(960, 720), step: Optional[int] = None, say=None) -> Path:
     """Serves ``scene``, screenshots it (at ``step``, default the last) and stops the server."""
-    from .serve import serve
+    k = len(scene.steps) - 1 if step is None else step
+    return snapshot_steps(scene, {max(k, 0): path}, port=port, size=size, say=say)[0]
+
+
+def snapshot_steps(scene, paths: Dict[int, object], port: int = 8080, size=(960, 720), say=None,
+                   settle: float = 1.5) -> List[Path]:
+    """One PNG per step (``paths``: step -> file) from one server and one browser session: the
+    slider is moved on the server side and the page redraws."""
+    from .serve import serve, stop
 
     server, view = serve(scene, port=port, say=say)
     try:
-        if step is not None:
-            view.slider.value = step
-            view.show(step)
-        return screenshot(f"http://127.0.0.1:{server.get_port()}", path, size=size)
+        d = _driver(size)
+        try:
+            out = []
+            for i, (k, path) in enumerate(sorted(paths.items())):
+                view.slider.value = k
+                view.show(k)
+                if i == 0:
+                    d.get(f"http://127.0.0.1:{server.get_port()}")
+                    png = _drawn(d, 30.0, 1e-3, settle)
+                else:
+                    time.sleep(settle)
+                    d.execute_script(HIDE_NOTICES)
+                    png = d.get_screenshot_as_png()
+                out.append(_write(png, path))
+            return out
+        finally:
+            d.quit()
     finally:
-        server.stop()
+        stop(server)
