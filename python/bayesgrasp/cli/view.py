@@ -14,24 +14,38 @@ from .args import bounded_int
 
 def add(sub) -> None:
     v = sub.add_parser("view", help="a result in 3D in the browser (viser)", description=__doc__)
-    v.add_argument("file", help="a command's --json output, an episode directory's episode.json or `episode show --json`")
+    v.add_argument("file", help="a command's --json output, an episode directory's episode.json, `episode show --json`, "
+                   "or an experiment's results.sqlite (or its directory) with --series/--object/--run")
     v.add_argument("--port", type=bounded_int(1, 65535), default=8080, help="port (the next free one if busy)")
     v.add_argument("--host", default="127.0.0.1", help="address to listen on")
     v.add_argument("--snapshot", default=None, metavar="FILE.png",
                    help="write a screenshot (headless Chromium) instead of serving until Ctrl-C")
     v.add_argument("--step", type=int, default=None, help="with --snapshot: the attempt or round shown (default: last)")
+    v.add_argument("--series", default=None, help="results.sqlite: the stored series, e.g. pub2/stability "
+                   "(default: the only one)")
+    v.add_argument("--object", default=None, help="results.sqlite: the run's object (default: the only one)")
+    v.add_argument("--run", dest="run_index", type=bounded_int(0, 10**9), default=0, help="results.sqlite: the run's index")
+    v.add_argument("--hand", default="barrett_bh8", help="results.sqlite: the hand the experiment ran with")
     v.add_argument("--seconds", type=float, default=None, help="stop after this long (default: until Ctrl-C)")
     v.set_defaults(run=run)
 
 
 def run(args) -> int:
-    from ..viewer import read_result, scene_from_result
-
-    scene = scene_from_result(read_result(args.file))      # refused before a server starts
+    scene = _scene(args)                                    # refused before a server starts
     if args.snapshot:
         return _snapshot(args, scene)
     _serve_until_stopped(scene, args.file, args.port, args.host, args.seconds)
     return 0
+
+
+def _scene(args):
+    """The scene of a result file, or of one run of an experiment's results.sqlite."""
+    from ..viewer import read_result, scene_from_result
+    from ..viewer.runs import read_run, results_file, scene_from_run
+
+    if results_file(args.file).suffix in (".sqlite", ".db"):
+        return scene_from_run(*read_run(args.file, args.series, args.object, args.run_index), hand=args.hand)
+    return scene_from_result(read_result(args.file))
 
 
 def show_result(args, doc: dict) -> None:
