@@ -10,6 +10,7 @@ import json
 
 import numpy as np
 
+from ..planners.category import METHODS
 from . import camera_input
 from .args import (CliError, Renamed, add_category_options, add_context_options, context, floats, output_file, output_format,
                    task_grasps_arg)
@@ -25,8 +26,9 @@ def add(sub) -> None:
                         "simulated stand-in the grasp is executed on (at --object-pose, in the table frame)")
     c.add_argument("--object-pose", "--pose", dest="object_pose", action=Renamed, old=["--pose"], default="0,0,0",
                    metavar="X,Y,YAW", help="its pose on the table (--pose: the old spelling, deprecated)")
-    c.add_argument("--method", default="laplace", choices=["laplace", "regularised", "gaussian", "baseline"],
-                   help="Eq. 4.1's density, or the best-single-grasp baseline")
+    c.add_argument("--method", default="laplace", choices=list(METHODS),
+                   help="Eq. 4.1's density, the best-single-grasp baseline, or part-aware (Eq. 4.1's candidates "
+                        "closed on every registered model and re-ranked by where the fingers land)")
     c.add_argument("--complete", action="store_true", help="use the object's whole surface as the cloud")
     add_category_options(c, "the cloud, the registered models and the hand")
     add_context_options(c)
@@ -65,6 +67,8 @@ def run(args) -> int:
            "cloud": cloud_json(ep.observation.cloud),
            "epsilon": out["epsilon"], "lifted": out["lifted"], "task_ok": out["task_ok"], "success": out["success"],
            "failure": out["failure"], "reason": out["reason"] or None, "contact_parts": out.get("contact_parts", [])}
+    if "part_check" in out:      # part-aware: P(rule | A), P(rule, held | A) and each model's contact parts
+        doc["part_check"] = out["part_check"]
     fmt = output_format(args)
     if fmt == "ros":
         from ..io.grasp_schema import to_ros
@@ -106,6 +110,10 @@ def _print(doc: dict) -> None:
     if doc["reason"]:
         print(f"  no grasp: {doc['reason']}")
         return
+    pc = doc.get("part_check")
+    if pc:
+        print(f"  part check: the rule holds on models of weight {pc['p_rule']:.2f} (and the grasp holds: "
+              f"{pc['p_success']:.2f}); {pc['passing']} of {pc['candidates']} candidates passed on some model")
     if not doc["executed"]:
         x, y, z = (doc["grasp"]["pose"][i][3] for i in range(3))
         print(f"  planned grasp at ({100 * x:.1f}, {100 * y:.1f}, {100 * z:.1f}) cm in the table frame, spread "

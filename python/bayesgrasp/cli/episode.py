@@ -18,7 +18,7 @@ from .args import (CliError, add_context_options, add_format_options, bounded_in
                    task_grasps_arg)
 
 POSE_METHODS = ("stability", "explore")
-CATEGORY_METHODS = ("laplace", "regularised", "gaussian", "baseline", "fusion")
+CATEGORY_METHODS = ("laplace", "regularised", "gaussian", "baseline", "part-aware", "fusion")
 
 
 def add(sub) -> None:

@@ -28,6 +28,9 @@ def add(sub) -> None:
                    help="G(0): planned from the view (Eq. 4.6's task term) or at random above the object")
     f.add_argument("--belief", choices=["map", "particles"], default="map",
                    help="per-model MAP poses (the thesis) or a joint particle belief over (model, pose)")
+    f.add_argument("--task-term", choices=["laplace", "part-aware"], default="laplace",
+                   help="P(T | G): the thesis's Laplace densities at the placed task grasps, or part-aware (also "
+                        "the share of models on which the grasp obeys the task's rule and holds)")
     f.add_argument("--recursive", action="store_true", help="Eq. 4.5 recursive: w_i ~ w_i(t-1) L_i")
     f.add_argument("--noise", type=float, default=0.0, help="joint-angle noise sd (rad) in the likelihood")
     add_category_options(f, "the weights and the models' poses per round")
@@ -49,7 +52,8 @@ def run(args) -> int:
     png = output_file(args.png, "--png")
     view = camera_input.observe(args)
     ctx = context(args)
-    settings = FusionSettings(belief=args.belief, recursive=args.recursive, measurement_noise=args.noise)
+    settings = FusionSettings(belief=args.belief, recursive=args.recursive, measurement_noise=args.noise,
+                              task_term=args.task_term)
     grasps = task_grasps_arg(args)
     trial = FusionTrial(args.scene_object, pose, ctx, task=args.task, settings=settings,
                         exclude=args.exclude if args.exclude is not None else [args.scene_object], seed=args.seed,
@@ -67,10 +71,10 @@ def run(args) -> int:
                        "grasp": hand_grasp_record(hand, rec["hand_pose"], rec["joint_positions"], trial.spread),
                        "epsilon": rec["epsilon"], "lifted": rec["lifted"],
                        "weights": dict(zip(trial.names, rec["weights"])),
-                       "poses": dict(zip(trial.names, rec["poses"])), "underflow": rec["underflow"]})
+                       "poses": dict(zip(trial.names, rec["poses"])), "underflow": rec["underflow"], **({"part": rec["part"]} if "part" in rec else {})})
     success = any(x["lifted"] for x in rounds)
     doc = {"scene_object": args.scene_object, "object_pose": pose, "category": args.category, "task": args.task,
-           "start": args.start, "belief": args.belief, "rounds": rounds, "success": success,
+           "start": args.start, "belief": args.belief, "task_term": args.task_term, "rounds": rounds, "success": success,
            "scene": (args.cloud or args.depth) if view is not None else "simulated view",
            "cloud": cloud_json(trial.episode.observation.cloud)}
     if fmt == "ros":

@@ -173,12 +173,13 @@ def plan_and_execute(ep: CategoryEpisode, category_name: str, task: str, method:
     grasps = demonstrated(ep.models, rule, ctx) if grasps is None else grasps
     grasps = [g for g in grasps if g.task == task]
     s = replace(settings or CategorySettings(method=method), table=rule.table)
-    planner = CategoryPlanner(ctx.hand, grasps, ep.registrations, cloud=ep.observation.cloud, settings=s, seed=seed)
+    planner = CategoryPlanner(ctx.hand, grasps, ep.registrations, cloud=ep.observation.cloud, settings=s, seed=seed,
+                              rule=rule)
     plan = planner.plan()
     out = execute(ep.obj, ep.pose, plan, rule, ctx) if ep.obj is not None else not_executed(plan)
     out.update({"method": method, "task": task, "plan_ok": plan.ok, "objective": plan.objective,
                 "mixture": plan.mixture, "pose": None if not plan.ok else plan.pose.tolist(),
                 "weights": plan.weights, "contributions": plan.contributions, "dominant_model": plan.dominant_model,
                 "start_model": plan.start_model, "evaluations": plan.evaluations, "intrusion": plan.intrusion,
-                "task_grasps": len(grasps)})
+                "task_grasps": len(grasps), **({"part_check": plan.extra} if plan.extra else {})})
     return out

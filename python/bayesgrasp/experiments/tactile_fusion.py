@@ -77,7 +77,7 @@ class FusionTrial:
             raise ValueError("no training model registered to the cloud: there is no vision belief to start from")
         self.names = self.episode.models
         self.models = [ctx.models(m, model_settings) for m in self.names]
-        rule = task_rule(cat, task)
+        rule = self.rule = task_rule(cat, task)
         grasps = demonstrated(self.names, rule, ctx) if grasps is None else grasps
         self.task_grasps = [planar_top_grasps([g for g in grasps if g.model == m]) for m in self.names]
         regs = self.episode.registrations
@@ -95,7 +95,16 @@ class FusionTrial:
         """The trial's random stream, the vision belief and its planner (seeded from the stream)."""
         rng = np.random.default_rng(self.seed)
         belief = self.belief()
-        return rng, belief, FusionPlanner(belief, self.task_grasps, seed=int(rng.integers(2**31)))
+        part = self.part_check if self.settings.task_term == "part-aware" else None
+        return rng, belief, FusionPlanner(belief, self.task_grasps, seed=int(rng.integers(2**31)), part_check=part)
+
+    def part_check(self, grasps: np.ndarray, belief: ModelMixtureBelief) -> np.ndarray:
+        """P(rule, held | G) of top grasps (K, 3) over the models at the belief's poses and weights."""
+        from ..hand import Hand
+        from ..planners.part_check import check_top_grasps
+
+        hand = Hand.load(self.ctx.hand)
+        return check_top_grasps(hand, self.rule, grasps, self.names, belief.poses, belief.weights, self.spread).p_success
 
     def random_grasp(self, rng: np.random.Generator) -> np.ndarray:
         """G(0) at random in the area above the object: its centre +-3 cm, any yaw."""
@@ -136,23 +145,25 @@ class FusionTrial:
     def _record(self, t: int, e: dict, belief: ModelMixtureBelief, plan=None, underflow: bool = False) -> dict:
         return {"round": t, **e, "weights": belief.weights.tolist(), "poses": belief.poses.tolist(),
                 "underflow": underflow, "objective": None if plan is None else plan.objective,
+                **({} if plan is None or plan.part is None else {"part": plan.part}),
                 "stability": None if plan is None else plan.stability, "task": None if plan is None else plan.task}
 
 
 # ---- the experiment ------------------------------------------------------------------------------------
 def fusion_run(experiment: str, obj: str, run_index: int, seed: int, *, ctx: RunContext, mode: str,
-               belief: str) -> dict:
+               belief: str, task_term: str = "laplace") -> dict:
     pose, eye = view(seed)
-    trial = FusionTrial(obj, pose, ctx, settings=FusionSettings(belief=belief), eye_offset=eye, seed=seed % (2**31))
+    trial = FusionTrial(obj, pose, ctx, settings=FusionSettings(belief=belief, task_term=task_term), eye_offset=eye,
+                        seed=seed % (2**31))
     out = trial.run(mode)
     baseline = trial.run("vision", rounds=0) if mode == "random" else None
     out.update({"object": obj, "pose": list(pose), "vision_only": baseline["rounds"][0] if baseline else out["rounds"][0]})
     return out
 
 
-def _make(mode: str, belief: str = "map"):
+def _make(mode: str, belief: str = "map", task_term: str = "laplace"):
     def make(exp: Experiment, method: str, ctx: RunContext):
-        return exp.name, partial(fusion_run, ctx=ctx, mode=mode, belief=belief)
+        return exp.name, partial(fusion_run, ctx=ctx, mode=mode, belief=belief, task_term=task_term)
     return make
 
 
@@ -264,5 +275,7 @@ register(Experiment("pub6", MUGS, 15, "vision then touch: per-model poses and we
                     _make("random"), write_report, ("all",), prepare=prepare))
 register(Experiment("pub6_vision", MUGS, 15, "pub6 with G(0) planned from the camera's view (Eq. 4.6, task term)",
                     _make("vision"), write_report, ("all",), prepare=prepare))
+register(Experiment("pub6_part_aware", MUGS, 15, "pub6 with the part-aware task term (Eq. 4.6 x P(rule, held | G))",
+                    _make("random", task_term="part-aware"), write_report, ("all",), prepare=prepare))
 register(Experiment("pub6_particles", MUGS, 15, "pub6 with a joint particle belief over (model, pose)",
                     _make("random", "particles"), write_report, ("all",), prepare=prepare))

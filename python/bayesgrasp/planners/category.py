@@ -36,11 +36,13 @@ import numpy as np
 
 from .. import _core, optim
 from ..hand import Hand
-from ..models.tasks import TaskGrasp
+from ..models.tasks import TaskGrasp, TaskRule
+from .part_check import check_candidates, choose
 
 _task = _core.task
 
-METHODS = ("laplace", "regularised", "gaussian", "baseline")
+METHODS = ("laplace", "regularised", "gaussian", "baseline", "part-aware")
+THESIS_METHODS = METHODS[:4]
 
 
 @dataclass(frozen=True)
@@ -77,6 +79,14 @@ class CategorySettings:
     table: bool = True              # the table plane z = 0 is an obstacle (False: the object is held off it)
     min_weight: float = 1e-3        # models whose normalised weight is below this are not search starts
     threads: int = 1
+    # part-aware: the search's density, how many candidates are closed on the models (the mapped
+    # task grasps, each start's optimum, and perturbations of the best mapped grasps by these
+    # half-widths, m and rad) and the weight of the normalised J that breaks ties of P(rule, held | A)
+    part_density: str = "laplace"
+    part_candidates: int = 64
+    part_translation: float = 0.015
+    part_rotation: float = float(np.radians(15.0))
+    part_tiebreak: float = 0.1
 
     def __post_init__(self):
         if self.method not in METHODS:
@@ -90,11 +100,20 @@ class CategorySettings:
             raise ValueError(f"psi_min: must lie in [0, 1], got {self.psi_min}")
         if self.pso_particles < 2 or self.pso_iter < 1:
             raise ValueError("pso_particles: at least 2, pso_iter: at least 1")
+        if self.part_density not in THESIS_METHODS[:3]:
+            raise ValueError(f"part_density: one of {', '.join(THESIS_METHODS[:3])}; got {self.part_density!r}")
+        if self.part_candidates < 1:
+            raise ValueError(f"part_candidates: at least 1, got {self.part_candidates}")
+        for name in ("part_translation", "part_rotation", "part_tiebreak"):
+            v = getattr(self, name)
+            if not (np.isfinite(v) and v >= 0):
+                raise ValueError(f"{name}: must be >= 0, got {v}")
 
     def density(self):
         d = _task.PoseDensity()
+        kind = self.part_density if self.method == "part-aware" else self.method
         d.kind = {"laplace": _task.DensityKind.laplace, "regularised": _task.DensityKind.regularised,
-                  "gaussian": _task.DensityKind.gaussian, "baseline": _task.DensityKind.laplace}[self.method]
+                  "gaussian": _task.DensityKind.gaussian, "baseline": _task.DensityKind.laplace}[kind]
         d.translation_scale, d.rotation_scale = self.translation_scale, self.rotation_scale
         d.wide_weight, d.wide_factor = self.wide_weight, self.wide_factor
         d.validate()
@@ -152,9 +171,14 @@ class CategoryPlanner:
     """Eq. 4.1 for one scene: the mixture of the mapped task grasps, searched in C++ batches."""
 
     def __init__(self, hand: Hand, task_grasps: Sequence[TaskGrasp], registrations: Sequence[Registration],
-                 cloud=None, settings: Optional[CategorySettings] = None, seed: int = 0):
+                 cloud=None, settings: Optional[CategorySettings] = None, seed: int = 0,
+                 rule: Optional[TaskRule] = None):
+        """``rule``: the task's rule, needed by the part-aware method (the part check)."""
         self.hand = hand if isinstance(hand, Hand) else Hand.load(hand)
         self.settings = settings or CategorySettings()
+        if self.settings.method == "part-aware" and rule is None:
+            raise ValueError("method part-aware: needs the task's rule (rule=task_rule(category, task))")
+        self.rule = rule
         self.registrations = list(registrations)
         if not self.registrations:
             raise ValueError("registrations: need at least one registered model")
@@ -233,6 +257,7 @@ class CategoryPlanner:
         density = s.density()
         box = np.array([s.search_translation] * 3 + [s.search_rotation] * 3)
         best, best_val, best_start, nfev = None, -np.inf, None, 0
+        optima = []
         rng = np.random.default_rng(self.seed)
         for c in self.starts():
             ref, spread = self.mapped[c], self.grasps[c].spread
@@ -241,10 +266,55 @@ class CategoryPlanner:
             r = optim.pso(lambda X: -self._penalised(ref, X, spread, density), (-box, box),
                           n_particles=s.pso_particles, max_iter=s.pso_iter, seed=int(rng.integers(2**31)), init=init)
             nfev += r.nfev
+            optima.append(_task.poses_from_local(ref, r.x[None, :])[0])
             if -r.fun > best_val:
                 best_val, best_start = -r.fun, c
-                best = _task.poses_from_local(ref, r.x[None, :])[0]
+                best = optima[-1]
+        if s.method == "part-aware":
+            return self._part_aware(optima, rng, nfev)
         return self._result(best, best_val, best_start, nfev)
+
+    # ---- part-aware: Eq. 4.1's candidates re-ranked by where the fingers land ------------------------
+    def candidates(self, optima: Sequence[np.ndarray], rng: np.random.Generator) -> np.ndarray:
+        """(K, 4, 4): each start's optimum, every mapped task grasp, then perturbations of the
+        mapped grasps (heaviest first) up to ``part_candidates``."""
+        s = self.settings
+        fixed = list(optima) + list(self.mapped)
+        n_more = max(0, s.part_candidates - len(fixed))
+        if n_more == 0:
+            return np.asarray(fixed[:max(s.part_candidates, len(optima))])
+        order = np.argsort(-self.component_weight, kind="stable")
+        refs = order[np.arange(n_more) % len(order)]
+        box = np.array([s.part_translation] * 3 + [s.part_rotation] * 3)
+        X = rng.uniform(-box, box, (n_more, 6))
+        more = np.array([_task.poses_from_local(self.mapped[c], X[k:k + 1])[0] for k, c in enumerate(refs)])
+        return np.concatenate([np.asarray(fixed), more])
+
+    def _part_aware(self, optima: Sequence[np.ndarray], rng: np.random.Generator, nfev: int) -> CategoryPlan:
+        """Every candidate closed on every registered model (:mod:`.part_check`); the chosen one
+        maximises P(rule, held | A) + part_tiebreak * J(A) / max J among the candidates that pass
+        on some model (P > 0), and J alone if none passes."""
+        s = self.settings
+        A = self.candidates(optima, rng)
+        v = self.evaluate(A)
+        comp = np.asarray(v.dominant, int)
+        spreads = np.array([self.grasps[c].spread if c >= 0 else self.grasps[0].spread for c in comp], float)
+        J = np.asarray(v.value, float) * np.exp(-self._intrusions(A, spreads) / s.clearance_scale)
+        check = check_candidates(self.hand, self.rule, A, spreads, self.registrations, self.weights, s.threads)
+        k = choose(check.p_success, J, s.part_tiebreak)
+        plan = self._result(A[k], float(J[k]), None, nfev + len(A) * int(np.count_nonzero(self.weights > 0)))
+        plan.extra.update({"p_rule": float(check.p_rule[k]), "p_success": float(check.p_success[k]),
+                           "candidates": int(len(A)), "passing": int(np.count_nonzero(check.p_success > 0)),
+                           "contact_parts_on_models": {r.model: check.parts[k][i]
+                                                       for i, r in enumerate(self.registrations) if self.weights[i] > 0}})
+        return plan
+
+    def _intrusions(self, poses: np.ndarray, spreads: np.ndarray) -> np.ndarray:
+        d = np.zeros(len(poses))
+        for sp in np.unique(spreads):
+            idx = np.flatnonzero(spreads == sp)
+            d[idx] = self.intrusion(poses[idx], float(sp))
+        return d
 
     def _baseline(self) -> CategoryPlan:
         i = int(np.argmax(self.weights))
@@ -257,7 +327,7 @@ class CategoryPlanner:
     def _result(self, pose: np.ndarray, objective: Optional[float], start: Optional[int], nfev: int) -> CategoryPlan:
         v = self.evaluate(pose[None])
         dom = int(v.dominant[0])
-        comp = dom if dom >= 0 else start
+        comp = dom if dom >= 0 else (0 if start is None else start)
         spread = float(self.grasps[comp].spread)
         d = float(self.intrusion(pose[None], spread)[0])
         mix = float(v.value[0])

@@ -29,17 +29,19 @@ weights being the particle weights' sums - with the same interface.
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from typing import List, Optional, Sequence
+from typing import Callable, List, Optional, Sequence
 
 import numpy as np
 
 from .. import _core, optim
 from ..belief import absolute_planar_pose_paired, relative_planar_pose
 from ..models import GraspModels
+from .part_check import choose
 
 _b = _core.belief
 
 BELIEFS = ("map", "particles")
+TASK_TERMS = ("laplace", "part-aware")
 
 #: log of the smallest normal double: every likelihood below it means the measurement is
 #: impossible under every model (the belief is then kept, and the update says so).
@@ -71,10 +73,25 @@ class FusionSettings:
     pso_iter: int = 30
     particles_per_model: int = 200
     threads: int = 1
+    # task_term "part-aware" (beyond the thesis): Eq. 4.6's optimum, the mapped task grasps and
+    # perturbations of them (half-widths m, rad) up to part_candidates, closed on every model at its
+    # pose; the chosen one maximises Eq. 4.6 x P(rule, held | G) and passes the task's rule on some
+    # model whenever one does (planners.part_check.choose)
+    task_term: str = "laplace"
+    part_candidates: int = 48
+    part_translation: float = 0.01
+    part_rotation: float = float(np.radians(20.0))
 
     def __post_init__(self):
         if self.belief not in BELIEFS:
             raise ValueError(f"belief: one of {', '.join(BELIEFS)}; got {self.belief!r}")
+        if self.task_term not in TASK_TERMS:
+            raise ValueError(f"task_term: one of {', '.join(TASK_TERMS)}; got {self.task_term!r}")
+        if self.part_candidates < 1:
+            raise ValueError(f"part_candidates: at least 1, got {self.part_candidates}")
+        for name in ("part_translation", "part_rotation"):
+            if not (np.isfinite(getattr(self, name)) and getattr(self, name) >= 0):
+                raise ValueError(f"{name}: must be >= 0, got {getattr(self, name)}")
         if self.iterations < 1:
             raise ValueError(f"iterations: must be at least 1, got {self.iterations}")
         ps = np.asarray(self.prior_std, dtype=float)
@@ -245,12 +262,18 @@ class FusionPlan:
     round: int
     evaluations: int = 0
     seeds: int = 0
+    part: Optional[float] = None          # part-aware: P(rule, held | G) over the models
 
 
 class FusionPlanner:
     """Eq. 4.6 over a :class:`ModelMixtureBelief` with the models' top task grasps (planar)."""
 
-    def __init__(self, belief: ModelMixtureBelief, task_grasps: Sequence[np.ndarray], seed: int = 0):
+    def __init__(self, belief: ModelMixtureBelief, task_grasps: Sequence[np.ndarray], seed: int = 0,
+                 part_check: Optional[Callable[[np.ndarray, "ModelMixtureBelief"], np.ndarray]] = None):
+        """``part_check(grasps (K, 3), belief)`` -> (K,) P(rule, held | G): needed by task_term part-aware."""
+        if belief.settings.task_term == "part-aware" and part_check is None:
+            raise ValueError("task_term part-aware: needs a part check (see planners.part_check.check_top_grasps)")
+        self.part_check = part_check
         if len(task_grasps) != len(belief.names):
             raise ValueError("task_grasps: need one (K_i, 3) array of planar top task grasps per model")
         self.belief = belief
@@ -301,7 +324,28 @@ class FusionPlanner:
                       max_iter=s.pso_iter, seed=int(self._rng.integers(2**31)), init=init)
         a = np.asarray(r.x, dtype=float)
         a[2] = wrap(a[2])
+        objective, part, nfev = float(-r.fun), None, int(r.nfev)
+        if s.task_term == "part-aware":
+            C = self._candidates(a, seeds, low, high)
+            J = self.objective(C, with_s)
+            p = np.asarray(self.part_check(C, self.belief), float)
+            k = choose(p, J, product=True)
+            a, objective, part, nfev = C[k], float(J[k]), float(p[k]), nfev + len(C)
         self.previous = a.copy()
         st, tk = float(self.belief.stability(a[None])[0]), float(self.task(a[None])[0])
-        return FusionPlan(action=a, objective=float(-r.fun), stability=st, task=tk, round=self.round,
-                          evaluations=int(r.nfev), seeds=n)
+        return FusionPlan(action=a, objective=objective, stability=st, task=tk, round=self.round,
+                          evaluations=nfev, seeds=n, part=part)
+
+    def _candidates(self, optimum: np.ndarray, seeds: np.ndarray, low, high) -> np.ndarray:
+        """Eq. 4.6's optimum, the seeds (the previous grasp, the mapped task grasps) and perturbations
+        of the seeds up to part_candidates (x, y clipped to the search box, yaw wrapped)."""
+        s = self.belief.settings
+        C = np.vstack([optimum[None, :], seeds])[:max(1, s.part_candidates)]
+        more = s.part_candidates - len(C)
+        if more > 0:
+            ref = seeds[np.arange(more) % len(seeds)]
+            d = self._rng.uniform(-1, 1, (more, 3)) * [s.part_translation, s.part_translation, s.part_rotation]
+            C = np.vstack([C, ref + d])
+        C[:, :2] = np.clip(C[:, :2], low[:2], high[:2])
+        C[:, 2] = wrap(C[:, 2])
+        return C

@@ -1,0 +1,146 @@
+"""The part-aware plan's check (issue 29) on oracles that follow from the model's labels: a mug's
+handle grasp (two handle contacts, from the handle's side) passes the handle rule and fails the
+side rule, a body grasp from the far side does the opposite, wherever the registration puts the
+model; the choice never takes a rejected candidate while one passes."""
+import numpy as np
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+from bayesgrasp.hand import Hand
+from bayesgrasp.models.tasks import task_rule
+from bayesgrasp.planners.category import CategoryPlanner, CategorySettings, Registration, TaskGrasp
+from bayesgrasp.planners.part_check import check_candidates, choose, model_world
+
+HAND = Hand.load("barrett_bh8")
+MUG = "mug/1"     # handle along +x, labelled "handle"; the body "body", the rim "rim"
+
+
+def approach(direction, z, roll=0.0):
+    return Hand.approach_pose(np.asarray(direction, float), roll, np.array([0.0, 0.0, z]))
+
+
+HANDLE = approach((-1, 0, 0), 0.06)    # from +x, through the handle into the body
+BODY = approach((1, 0, 0), 0.06)       # from -x, away from the handle
+ACROSS = approach((0, 1, 0), 0.05, np.pi / 2)   # from -y, a side the side task allows; a finger reaches the handle
+
+
+def placed(yaw, t):
+    T = np.eye(4)
+    c, s = np.cos(yaw), np.sin(yaw)
+    T[:2, :2] = [[c, -s], [s, c]]
+    T[:3, 3] = t
+    return T
+
+
+def parts_on_model(pose, roll=0.0):
+    """The contacts' parts of the approach along ``pose``, read directly from the model's world."""
+    w = model_world(MUG, HAND, True)
+    b = w.approach_batch(pose[None, :3, 2], pose[None, :3, 3], roll, spread=0.0, frame="world")
+    return sorted(p for p in b.contact_part if p is not None)
+
+
+def test_the_oracle_grasps_touch_what_they_should():
+    assert parts_on_model(HANDLE).count("handle") >= 2
+    assert set(parts_on_model(BODY)) == {"body"} and len(parts_on_model(BODY)) >= 2
+
+
+@pytest.mark.parametrize("yaw, t", [(0.0, (0, 0, 0)), (2.1, (0.07, -0.04, 0.0)), (-0.8, (-0.05, 0.03, 0.0))])
+def test_handle_and_body_grasps_score_the_rules_one_and_zero_wherever_the_model_is_registered(yaw, t):
+    T = placed(yaw, t)
+    regs = [Registration(MUG, T, phi=0.9), Registration("mug/2", placed(0.3, (0.2, 0.2, 0)), phi=0.0)]
+    A = np.array([T @ HANDLE, T @ BODY])                     # the candidates in the scene
+    handle = check_candidates(HAND, task_rule("mug", "handle"), A, 0.0, regs, [1.0, 0.0])
+    side = check_candidates(HAND, task_rule("mug", "side"), A, 0.0, regs, [1.0, 0.0])
+    np.testing.assert_array_equal(handle.p_rule, [1.0, 0.0])
+    np.testing.assert_array_equal(side.p_rule, [0.0, 1.0])
+    assert sorted(handle.parts[0][0]) == parts_on_model(HANDLE) and sorted(side.parts[1][0]) == parts_on_model(BODY)
+    assert handle.parts[0][1] == [] and not handle.rule_ok[:, 1].any()    # a model of weight 0 is not closed
+    np.testing.assert_array_equal(handle.p_success, handle.p_rule * handle.held[:, 0])
+
+
+def test_a_side_grasp_from_an_allowed_side_that_touches_the_handle_fails_on_its_contacts():
+    side = task_rule("mug", "side")
+    assert side.approach_ok(np.array([ACROSS[:3, 2], BODY[:3, 2]])).all()      # both directions are allowed
+    assert "handle" in parts_on_model(ACROSS, roll=np.pi / 2)
+    T = placed(-2.4, (0.04, 0.06, 0.0))
+    c = check_candidates(HAND, side, np.array([T @ ACROSS, T @ BODY]), 0.0, [Registration(MUG, T, phi=1.0)], [1.0])
+    np.testing.assert_array_equal(c.p_rule, [0.0, 1.0])
+    assert "handle" in c.parts[0][0] and set(c.parts[1][0]) == {"body"}
+
+
+def test_the_weights_add_over_the_models_where_the_rule_holds():
+    T0, T1 = placed(0.0, (0, 0, 0)), placed(np.pi, (0, 0, 0))    # the second copy turned half a turn
+    regs = [Registration(MUG, T0, phi=1.0), Registration(MUG, T1, phi=1.0)]
+    # in the scene: from +x, which is the first copy's handle side and the second copy's far side
+    c = check_candidates(HAND, task_rule("mug", "handle"), HANDLE[None], 0.0, regs, [0.7, 0.3])
+    assert c.rule_ok.tolist() == [[True, False]] and c.p_rule[0] == pytest.approx(0.7)
+    c = check_candidates(HAND, task_rule("mug", "side"), HANDLE[None], 0.0, regs, [0.7, 0.3])
+    assert c.rule_ok.tolist() == [[False, True]] and c.p_rule[0] == pytest.approx(0.3)
+
+
+@settings(max_examples=200, deadline=None)
+@given(st.lists(st.tuples(st.sampled_from([0.0, 0.0, 0.1, 0.5, 1.0]), st.floats(0, 10)), min_size=1, max_size=30))
+def test_the_choice_never_takes_a_rejected_candidate_while_one_passes(rows):
+    p, J = np.array(rows).T
+    k = choose(p, J, tiebreak=0.1)
+    if (p > 0).any():
+        assert p[k] > 0
+        assert p[k] + 0.1 * J[k] / max(J.max(), 1e-300) >= (p + 0.1 * J / max(J.max(), 1e-300))[p > 0].max() - 1e-12
+    else:
+        assert J[k] == J.max()
+
+
+def test_the_part_aware_plan_returns_a_checked_candidate():
+    """One model, its handle grasp and its body grasp as demonstrations of the handle task: the plan
+    must land on one that passes the handle rule on the model (and say so)."""
+    T = placed(0.5, (0.03, 0.01, 0))
+    gs = [TaskGrasp(MUG, "handle", BODY, 0.0, 0.3, True), TaskGrasp(MUG, "handle", HANDLE, 0.0, 0.1, True)]
+    s = CategorySettings(method="part-aware", part_candidates=12, pso_particles=6, pso_iter=3)
+    plan = CategoryPlanner(HAND, gs, [Registration(MUG, T, phi=1.0)], settings=s, seed=1,
+                           rule=task_rule("mug", "handle")).plan()
+    assert plan.ok and plan.extra["passing"] >= 1 and plan.extra["p_rule"] == 1.0
+    assert plan.extra["contact_parts_on_models"][MUG].count("handle") >= 2
+    with pytest.raises(ValueError, match="part-aware: needs the task's rule"):
+        CategoryPlanner(HAND, gs, [Registration(MUG, T, phi=1.0)], settings=s)
+
+
+def test_fusion_part_aware_takes_a_passing_grasp_and_multiplies_eq46():
+    """Eq. 4.6 alone takes the task grasp at (0.02, 0.01, 0.3); a part check that passes only
+    grasps 5 mm or more to its +x moves the choice there, and the round reports P there."""
+    from test_fusion import analytic
+
+    from bayesgrasp.planners.fusion import FusionPlanner, FusionSettings, ModelMixtureBelief
+
+    def part(C, belief):
+        return np.where(C[:, 0] >= 0.025, 0.8, 0.0)
+
+    s = FusionSettings(task_term="part-aware", part_candidates=40, part_translation=0.01)
+    belief = ModelMixtureBelief(["a"], [analytic(True)], [1.0], [[0.02, 0.01, 0.3]], s, seed=2)
+    p = FusionPlanner(belief, [np.array([[0.0, 0.0, 0.0]])], seed=3, part_check=part).plan()
+    assert p.action[0] >= 0.025 and p.part == 0.8
+    assert p.objective == pytest.approx(p.task, rel=1e-9)          # round 1: the task term (x P in the ranking)
+    plain = FusionPlanner(ModelMixtureBelief(["a"], [analytic(True)], [1.0], [[0.02, 0.01, 0.3]], FusionSettings(),
+                                             seed=2), [np.array([[0.0, 0.0, 0.0]])], seed=3).plan()
+    assert plain.action[0] < 0.025 and plain.part is None
+    with pytest.raises(ValueError, match="part-aware: needs a part check"):
+        FusionPlanner(belief, [np.array([[0.0, 0.0, 0.0]])])
+
+
+def test_the_top_grasp_check_reads_the_models_parts_at_their_poses():
+    """A top grasp over the mug's rim from above obeys the top rule wherever the belief puts the
+    model, when the grasp is moved with it; a grasp 30 cm away touches nothing."""
+    from bayesgrasp.belief import absolute_planar_pose
+    from bayesgrasp.planners.part_check import check_top_grasps
+
+    rule = task_rule("mug", "top")
+    w = model_world(MUG, HAND, True)
+    rel = np.array([[x, 0.0, yaw] for x in (-0.03, -0.02, 0.0, 0.02) for yaw in (0.0, 0.8, 1.6)])
+    b = w.grasp_batch(rel, spread=0.0)
+    ok = [rule.contacts_ok([p for p in b.contact_part[b.contacts.offsets[k]:b.contacts.offsets[k + 1]] if p])
+          and not b.collision_at_start[k] for k in range(len(rel))]
+    assert any(ok) and not all(ok)
+    pose = np.array([0.05, -0.02, 1.1])
+    G = np.vstack([absolute_planar_pose(rel, pose[None, :]), [[0.2, 0.2, 0.0]]])
+    c = check_top_grasps(HAND, rule, G, [MUG, "mug/2"], [pose, [0, 0, 0]], [1.0, 0.0], spread=0.0)
+    assert c.rule_ok[:, 0].tolist() == ok + [False] and not c.rule_ok[:, 1].any()
