@@ -233,13 +233,14 @@ class World:
         return self._one(self.grasp_batch([[x, y, yaw]], spread=spread, lift=lift))
 
     def grasp_batch(self, xyyaw, spread: Optional[float] = None, lift: bool = False,
-                    threads: int = 0) -> WorldGraspBatch:
+                    threads: int = 0, quality: bool = True) -> WorldGraspBatch:
         """N top grasps ((N, 3) rows x, y, yaw in the object frame) in C++ threads: the
         simulator's batch plus ``epsilon`` and ``volume`` (0 when the hand started in
-        collision), and ``lifted`` / ``lift_displacement`` when ``lift`` is set (else None)."""
+        collision; NaN without ``quality``, see :meth:`epsilon_of`), and ``lifted`` /
+        ``lift_displacement`` when ``lift`` is set (else None)."""
         world = self.to_world(xyyaw)
         b = self.sim.top_grasp_batch(world, spread=self._spread(spread), standoff=self.standoff, threads=threads)
-        return self._score(b, b.contacts, np.diff(b.contacts.offsets), lift, threads)
+        return self._score(b, b.contacts, np.diff(b.contacts.offsets), lift, threads, quality)
 
     def approach(self, direction, target, roll: float = 0.0, spread: Optional[float] = None,
                  standoff: Optional[float] = None, frame: str = "object", lift: bool = False) -> WorldGrasp:
@@ -255,13 +256,30 @@ class World:
 
     def approach_batch(self, directions, targets, rolls=0.0, spread: Optional[float] = None,
                        standoff: Optional[float] = None, frame: str = "object", lift: bool = False,
-                       threads: int = 0) -> WorldGraspBatch:
+                       threads: int = 0, quality: bool = True) -> WorldGraspBatch:
         """N approaches: ``directions`` and ``targets`` (N, 3), ``rolls`` a number or (N,), in
-        ``frame``, in C++ threads; a WorldGraspBatch (errors name the entry, e.g. ``directions[2]``)."""
+        ``frame``, in C++ threads; a WorldGraspBatch (errors name the entry, e.g. ``directions[2]``).
+        Without ``quality`` epsilon and volume are NaN (:meth:`epsilon_of` computes them for chosen rows)."""
         D, P, r = self._approaches_to_world(directions, targets, rolls, frame, ("directions", "targets"))
         b = self.sim.approach_batch(D, P, r, spread=self._spread(spread), standoff=self._standoff(standoff),
                                     threads=threads)
-        return self._score(b, b.contacts, np.diff(b.contacts.offsets), lift, threads)
+        return self._score(b, b.contacts, np.diff(b.contacts.offsets), lift, threads, quality)
+
+    def epsilon_of(self, batch: WorldGraspBatch, rows, threads: int = 1) -> np.ndarray:
+        """GWS epsilon of the grasps ``rows`` of ``batch`` (made by this world), on their object
+        contacts; 0 where the hand started in collision."""
+        rows = np.asarray(rows, dtype=np.int64).ravel()
+        c, off = batch.contacts, np.asarray(batch.contacts.offsets, dtype=np.int64)
+        idx = np.concatenate([np.arange(off[k], off[k + 1]) for k in rows]) if len(rows) else np.zeros(0, np.int64)
+        on_obj = ~np.asarray(c.on_table, dtype=bool)[idx]
+        sel = idx[on_obj]
+        counts = np.array([np.count_nonzero(~np.asarray(c.on_table[off[k]:off[k + 1]], dtype=bool)) for k in rows],
+                          dtype=np.int64)
+        eps, _ = quality.epsilon_volume_batch(c.point[sel], c.normal[sel], self.com, self.torque_scale, mu=self.mu,
+                                              counts=counts, volume=False, threads=threads)
+        eps = np.array(eps, dtype=float)
+        eps[np.asarray(batch.collision_at_start, dtype=bool)[rows]] = 0.0
+        return eps
 
     def grasp_pose(self, hand_pose, spread: Optional[float] = None, frame: str = "object",
                    lift: bool = False) -> WorldGrasp:
@@ -290,7 +308,7 @@ class World:
     def _standoff(self, standoff: Optional[float]) -> float:
         return self.standoff if standoff is None else float(standoff)
 
-    def _score(self, b, contacts, counts, lift: bool, threads: int) -> WorldGraspBatch:
+    def _score(self, b, contacts, counts, lift: bool, threads: int, with_quality: bool = True) -> WorldGraspBatch:
         """The simulated grasps `b` (a GraspBatch or _BatchOfOne, with its contacts and their
         number per grasp) with epsilon and volume (0 when the hand started in collision), the
         object-frame poses, the contacts' parts and, when `lift` is set, the lift test."""
@@ -300,10 +318,13 @@ class World:
         # Quality on object contacts only, grasp by grasp in one C++ batch call.
         grasp_of = np.repeat(np.arange(len(counts)), counts)
         obj_counts = np.bincount(grasp_of[on_obj], minlength=len(counts))
-        eps, vol = quality.epsilon_volume_batch(c.point[on_obj], c.normal[on_obj], self.com,
-                                                self.torque_scale, mu=self.mu, counts=obj_counts,
-                                                threads=threads)
-        eps, vol = np.array(eps, dtype=float), np.array(vol, dtype=float)
+        if with_quality:
+            eps, vol = quality.epsilon_volume_batch(c.point[on_obj], c.normal[on_obj], self.com,
+                                                    self.torque_scale, mu=self.mu, counts=obj_counts,
+                                                    threads=threads)
+            eps, vol = np.array(eps, dtype=float), np.array(vol, dtype=float)
+        else:
+            eps, vol = np.full(len(counts), np.nan), np.full(len(counts), np.nan)
         start = np.asarray(b.collision_at_start, dtype=bool)
         eps[start], vol[start] = 0.0, 0.0
         lifted = displacement = None

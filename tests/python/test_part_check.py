@@ -10,7 +10,7 @@ from hypothesis import strategies as st
 from bayesgrasp.hand import Hand
 from bayesgrasp.models.tasks import task_rule
 from bayesgrasp.planners.category import CategoryPlanner, CategorySettings, Registration, TaskGrasp
-from bayesgrasp.planners.part_check import check_candidates, choose, model_world
+from bayesgrasp.planners.part_check import PartCheck, check_candidates, choose, choose_lazily, model_world
 
 HAND = Hand.load("barrett_bh8")
 MUG = "mug/1"     # handle along +x, labelled "handle"; the body "body", the rim "rim"
@@ -91,6 +91,21 @@ def test_the_choice_never_takes_a_rejected_candidate_while_one_passes(rows):
         assert J[k] == J.max()
 
 
+@settings(max_examples=200, deadline=None)
+@given(st.integers(1, 40), st.integers(1, 4), st.integers(0, 2**31 - 1), st.booleans())
+def test_the_lazy_choice_is_the_full_choice(K, M, seed, product):
+    """Held computed only where it could change the answer gives what knowing it everywhere gives."""
+    rng = np.random.default_rng(seed)
+    rule = rng.random((K, M)) < 0.5
+    held = rng.random((K, M)) < 0.6
+    w = rng.dirichlet(np.ones(M))
+    J = np.round(rng.random(K), 1) * (rng.random(K) < 0.9)          # ties and zeros on purpose
+    full = choose(((rule & held).astype(float) @ w), J, 0.1, product)
+    lazy = PartCheck(rule, np.zeros((K, M), bool), w, [[[]] * M] * K, np.zeros(K, bool),
+                     lambda rows: held[rows] & rule[rows])
+    assert choose_lazily(lazy, J, 0.1, product, batch=3) == full
+
+
 def test_the_part_aware_plan_returns_a_checked_candidate():
     """One model, its handle grasp and its body grasp as demonstrations of the handle task: the plan
     must land on one that passes the handle rule on the model (and say so)."""
@@ -99,7 +114,7 @@ def test_the_part_aware_plan_returns_a_checked_candidate():
     s = CategorySettings(method="part-aware", part_candidates=12, pso_particles=6, pso_iter=3)
     plan = CategoryPlanner(HAND, gs, [Registration(MUG, T, phi=1.0)], settings=s, seed=1,
                            rule=task_rule("mug", "handle")).plan()
-    assert plan.ok and plan.extra["passing"] >= 1 and plan.extra["p_rule"] == 1.0
+    assert plan.ok and plan.extra["passing_rule"] >= 1 and plan.extra["p_rule"] == 1.0
     assert plan.extra["contact_parts_on_models"][MUG].count("handle") >= 2
     with pytest.raises(ValueError, match="part-aware: needs the task's rule"):
         CategoryPlanner(HAND, gs, [Registration(MUG, T, phi=1.0)], settings=s)
@@ -113,13 +128,14 @@ def test_fusion_part_aware_takes_a_passing_grasp_and_multiplies_eq46():
     from bayesgrasp.planners.fusion import FusionPlanner, FusionSettings, ModelMixtureBelief
 
     def part(C, belief):
-        return np.where(C[:, 0] >= 0.025, 0.8, 0.0)
+        ok = (C[:, 0] >= 0.025)[:, None]
+        return PartCheck(ok, ok.copy(), np.array([0.8]), [[[]] for _ in C])
 
     s = FusionSettings(task_term="part-aware", part_candidates=40, part_translation=0.01)
     belief = ModelMixtureBelief(["a"], [analytic(True)], [1.0], [[0.02, 0.01, 0.3]], s, seed=2)
     p = FusionPlanner(belief, [np.array([[0.0, 0.0, 0.0]])], seed=3, part_check=part).plan()
     assert p.action[0] >= 0.025 and p.part == 0.8
-    assert p.objective == pytest.approx(p.task, rel=1e-9)          # round 1: the task term (x P in the ranking)
+    assert p.objective == pytest.approx(p.task * p.stability, rel=1e-9)   # ranked by Eq. 4.6's product from round 1
     plain = FusionPlanner(ModelMixtureBelief(["a"], [analytic(True)], [1.0], [[0.02, 0.01, 0.3]], FusionSettings(),
                                              seed=2), [np.array([[0.0, 0.0, 0.0]])], seed=3).plan()
     assert plain.action[0] < 0.025 and plain.part is None
@@ -144,3 +160,18 @@ def test_the_top_grasp_check_reads_the_models_parts_at_their_poses():
     G = np.vstack([absolute_planar_pose(rel, pose[None, :]), [[0.2, 0.2, 0.0]]])
     c = check_top_grasps(HAND, rule, G, [MUG, "mug/2"], [pose, [0, 0, 0]], [1.0, 0.0], spread=0.0)
     assert c.rule_ok[:, 0].tolist() == ok + [False] and not c.rule_ok[:, 1].any()
+
+
+def test_epsilon_of_chosen_rows_is_the_batch_epsilon():
+    """A batch closed without quality, its epsilon computed later for some rows, equals the epsilon
+    of the same batch scored at once."""
+    w = model_world(MUG, HAND, True)
+    a = np.linspace(0, 2 * np.pi, 12, endpoint=False)
+    D = -np.c_[np.cos(a), np.sin(a), np.zeros_like(a)]
+    P = np.tile([0.0, 0.0, 0.06], (len(a), 1))
+    full = w.approach_batch(D, P, 0.0, spread=0.0, frame="world")
+    lazy = w.approach_batch(D, P, 0.0, spread=0.0, frame="world", quality=False)
+    start = np.asarray(lazy.collision_at_start, bool)
+    assert np.isnan(lazy.epsilon[~start]).all() and (full.epsilon > 0).any()
+    rows = np.array([7, 0, 3, 11])
+    np.testing.assert_allclose(w.epsilon_of(lazy, rows), full.epsilon[rows], rtol=1e-9, atol=1e-12)

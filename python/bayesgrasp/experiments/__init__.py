@@ -13,6 +13,7 @@ from .runner import ResultStore, RunKey, run_experiment, run_seed
 # the modules that register experiments
 from . import pose_uncertainty  # noqa: E402,F401  (isort: skip)
 from . import category_grasping  # noqa: E402,F401  (isort: skip)
+from . import category_scales  # noqa: E402,F401  (isort: skip)
 from . import tactile_fusion  # noqa: E402,F401  (isort: skip)
 from . import single_touch  # noqa: E402,F401  (isort: skip)
 

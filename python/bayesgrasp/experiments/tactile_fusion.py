@@ -32,6 +32,7 @@ from .category import demonstrated, see, training_models
 from .category_grasping import view, wilson
 from .context import RunContext
 from .registry import Experiment, register
+from .runner import run_seed
 
 MUGS = tuple(f"mug/{i}" for i in range(7))
 ROUNDS = 3
@@ -98,13 +99,15 @@ class FusionTrial:
         part = self.part_check if self.settings.task_term == "part-aware" else None
         return rng, belief, FusionPlanner(belief, self.task_grasps, seed=int(rng.integers(2**31)), part_check=part)
 
-    def part_check(self, grasps: np.ndarray, belief: ModelMixtureBelief) -> np.ndarray:
-        """P(rule, held | G) of top grasps (K, 3) over the models at the belief's poses and weights."""
+    def part_check(self, grasps: np.ndarray, belief: ModelMixtureBelief):
+        """The part check of top grasps (K, 3) over the models at the belief's poses and weights
+        (held left to compute lazily)."""
         from ..hand import Hand
         from ..planners.part_check import check_top_grasps
 
         hand = Hand.load(self.ctx.hand)
-        return check_top_grasps(hand, self.rule, grasps, self.names, belief.poses, belief.weights, self.spread).p_success
+        return check_top_grasps(hand, self.rule, grasps, self.names, belief.poses, belief.weights, self.spread,
+                                resolve=False)
 
     def random_grasp(self, rng: np.random.Generator) -> np.ndarray:
         """G(0) at random in the area above the object: its centre +-3 cm, any yaw."""
@@ -152,6 +155,7 @@ class FusionTrial:
 # ---- the experiment ------------------------------------------------------------------------------------
 def fusion_run(experiment: str, obj: str, run_index: int, seed: int, *, ctx: RunContext, mode: str,
                belief: str, task_term: str = "laplace") -> dict:
+    seed = run_seed(ctx.seed, "pub6", obj, run_index)   # every pub6 variant sees pub6's trials
     pose, eye = view(seed)
     trial = FusionTrial(obj, pose, ctx, settings=FusionSettings(belief=belief, task_term=task_term), eye_offset=eye,
                         seed=seed % (2**31))

@@ -37,7 +37,7 @@ import numpy as np
 from .. import _core, optim
 from ..hand import Hand
 from ..models.tasks import TaskGrasp, TaskRule
-from .part_check import check_candidates, choose
+from .part_check import check_candidates, choose_lazily
 
 _task = _core.task
 
@@ -87,6 +87,7 @@ class CategorySettings:
     part_translation: float = 0.015
     part_rotation: float = float(np.radians(15.0))
     part_tiebreak: float = 0.1
+    part_jitter_yaw: Sequence[float] = ()   # rad: the models also closed turned by these (see part_check)
 
     def __post_init__(self):
         if self.method not in METHODS:
@@ -300,11 +301,13 @@ class CategoryPlanner:
         comp = np.asarray(v.dominant, int)
         spreads = np.array([self.grasps[c].spread if c >= 0 else self.grasps[0].spread for c in comp], float)
         J = np.asarray(v.value, float) * np.exp(-self._intrusions(A, spreads) / s.clearance_scale)
-        check = check_candidates(self.hand, self.rule, A, spreads, self.registrations, self.weights, s.threads)
-        k = choose(check.p_success, J, s.part_tiebreak)
+        check = check_candidates(self.hand, self.rule, A, spreads, self.registrations, self.weights, s.threads,
+                                 resolve=False, jitter_yaw=tuple(s.part_jitter_yaw))
+        k = choose_lazily(check, J, s.part_tiebreak)
         plan = self._result(A[k], float(J[k]), None, nfev + len(A) * int(np.count_nonzero(self.weights > 0)))
         plan.extra.update({"p_rule": float(check.p_rule[k]), "p_success": float(check.p_success[k]),
-                           "candidates": int(len(A)), "passing": int(np.count_nonzero(check.p_success > 0)),
+                           "candidates": int(len(A)), "passing_rule": int(np.count_nonzero(check.p_rule > 0)),
+                           "held_checked": int(np.count_nonzero(check.known)),
                            "contact_parts_on_models": {r.model: check.parts[k][i]
                                                        for i, r in enumerate(self.registrations) if self.weights[i] > 0}})
         return plan

@@ -36,7 +36,7 @@ import numpy as np
 from .. import _core, optim
 from ..belief import absolute_planar_pose_paired, relative_planar_pose
 from ..models import GraspModels
-from .part_check import choose
+from .part_check import choose_lazily
 
 _b = _core.belief
 
@@ -75,8 +75,8 @@ class FusionSettings:
     threads: int = 1
     # task_term "part-aware" (beyond the thesis): Eq. 4.6's optimum, the mapped task grasps and
     # perturbations of them (half-widths m, rad) up to part_candidates, closed on every model at its
-    # pose; the chosen one maximises Eq. 4.6 x P(rule, held | G) and passes the task's rule on some
-    # model whenever one does (planners.part_check.choose)
+    # pose; the chosen one maximises P(S | G) P(T | G) x P(rule, held | G) (stability counts from
+    # round 1 on) and passes the task's rule on some model whenever one does (planners.part_check.choose)
     task_term: str = "laplace"
     part_candidates: int = 48
     part_translation: float = 0.01
@@ -269,8 +269,9 @@ class FusionPlanner:
     """Eq. 4.6 over a :class:`ModelMixtureBelief` with the models' top task grasps (planar)."""
 
     def __init__(self, belief: ModelMixtureBelief, task_grasps: Sequence[np.ndarray], seed: int = 0,
-                 part_check: Optional[Callable[[np.ndarray, "ModelMixtureBelief"], np.ndarray]] = None):
-        """``part_check(grasps (K, 3), belief)`` -> (K,) P(rule, held | G): needed by task_term part-aware."""
+                 part_check: Optional[Callable[[np.ndarray, "ModelMixtureBelief"], object]] = None):
+        """``part_check(grasps (K, 3), belief)`` -> a :class:`~.part_check.PartCheck` of the grasps
+        (held may be left to compute lazily): needed by task_term part-aware."""
         if belief.settings.task_term == "part-aware" and part_check is None:
             raise ValueError("task_term part-aware: needs a part check (see planners.part_check.check_top_grasps)")
         self.part_check = part_check
@@ -327,10 +328,10 @@ class FusionPlanner:
         objective, part, nfev = float(-r.fun), None, int(r.nfev)
         if s.task_term == "part-aware":
             C = self._candidates(a, seeds, low, high)
-            J = self.objective(C, with_s)
-            p = np.asarray(self.part_check(C, self.belief), float)
-            k = choose(p, J, product=True)
-            a, objective, part, nfev = C[k], float(J[k]), float(p[k]), nfev + len(C)
+            J = self.objective(C, True)          # the re-ranking weighs stability from round 1 on
+            check = self.part_check(C, self.belief)
+            k = choose_lazily(check, J, product=True)
+            a, objective, part, nfev = C[k], float(J[k]), float(check.p_success[k]), nfev + len(C)
         self.previous = a.copy()
         st, tk = float(self.belief.stability(a[None])[0]), float(self.task(a[None])[0])
         return FusionPlan(action=a, objective=objective, stability=st, task=tk, round=self.round,

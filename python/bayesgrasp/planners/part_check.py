@@ -16,11 +16,17 @@ and over the models, with their normalised registration weights w_i (phi(delta_i
 
 Model i is closed in its own frame (the candidate mapped by T_i^-1), so a registration that tilts
 the model is followed exactly; the table is the model frame's z = 0 plane when the rule has one.
+
+Two steps, because epsilon (a wrench-space hull per grasp) costs far more than the closing: every
+candidate is closed and its rule read (:func:`check_candidates`); held is then computed only where
+needed (:meth:`PartCheck.resolve`): :func:`choose_lazily` visits the candidates in the order of an
+upper bound of their score (P(rule, held) <= P(rule)) and stops once no unvisited one can win, so it
+returns what :func:`choose` would return with held known everywhere.
 """
 from __future__ import annotations
 
-from dataclasses import dataclass
-from typing import Sequence
+from dataclasses import dataclass, field
+from typing import Callable, Sequence
 
 import numpy as np
 
@@ -28,25 +34,47 @@ from ..hand import Hand
 from ..models.tasks import TaskRule
 
 
-@dataclass(frozen=True)
+@dataclass
 class PartCheck:
-    """Per candidate (rows) and model (columns): ``rule_ok`` and ``held``; ``weights`` (M,) the
-    models' normalised weights; ``parts`` the contacts' parts per candidate and model."""
+    """Per candidate (rows) and model (columns): ``rule_ok`` (the share of the model's placements
+    on which the rule holds: 0 or 1 without jitter) and ``held`` (valid on the rows ``known``); ``weights`` (M,) the models' normalised weights; ``parts`` the contacts' parts per
+    candidate and model; ``held_of(rows)`` -> (len(rows), M) held for rows not known yet."""
 
     rule_ok: np.ndarray
     held: np.ndarray
     weights: np.ndarray
     parts: list
+    known: np.ndarray = None
+    held_of: Callable = field(default=None, repr=False)
+
+    def __post_init__(self):
+        if self.known is None:
+            self.known = np.ones(len(self.rule_ok), bool)
 
     @property
     def p_rule(self) -> np.ndarray:
         """P(rule | A) per candidate."""
-        return self.rule_ok.astype(float) @ self.weights
+        return np.asarray(self.rule_ok, float) @ self.weights
 
     @property
     def p_success(self) -> np.ndarray:
-        """P(rule, held | A) per candidate."""
-        return (self.rule_ok & self.held).astype(float) @ self.weights
+        """P(rule, held | A) per candidate (NaN where held is not known yet)."""
+        p = (np.asarray(self.rule_ok, float) * self.held) @ self.weights
+        return np.where(self.known, p, np.nan)
+
+    def resolve(self, rows=None) -> "PartCheck":
+        """Compute held for ``rows`` (default: all) where not known yet; returns self."""
+        rows = np.arange(len(self.rule_ok)) if rows is None else np.asarray(rows, np.int64).ravel()
+        todo = rows[~self.known[rows]]
+        if len(todo):
+            self.held[todo] = self.held_of(todo)
+            self.known[todo] = True
+        return self
+
+
+def _scores(p, J, top: float, tiebreak: float, product: bool) -> np.ndarray:
+    passing = p * J / top if product else p + tiebreak * J / top
+    return np.where(p > 0, 2.0 + passing, J / top)
 
 
 def choose(p_success, J, tiebreak: float = 0.1, product: bool = False) -> int:
@@ -56,18 +84,39 @@ def choose(p_success, J, tiebreak: float = 0.1, product: bool = False) -> int:
     chosen while one that passes exists."""
     p, J = np.asarray(p_success, float), np.asarray(J, float)
     top = J.max() if len(J) and J.max() > 0 else 1.0
-    passing = p * J / top if product else p + tiebreak * J / top
-    return int(np.argmax(np.where(p > 0, 2.0 + passing, J / top)))
+    return int(np.argmax(_scores(p, J, top, tiebreak, product)))
+
+
+def choose_lazily(check: PartCheck, J, tiebreak: float = 0.1, product: bool = False, batch: int = 4) -> int:
+    """:func:`choose` on ``check``'s P(rule, held | A), computing held only for the candidates that
+    could still win (branch and bound on P(rule, held) <= P(rule)); the same answer, ties included."""
+    J = np.asarray(J, float)
+    top = J.max() if len(J) and J.max() > 0 else 1.0
+    bound = _scores(check.p_rule, J, top, tiebreak, product)
+    order = np.argsort(-bound, kind="stable")
+    for start in range(0, len(order), batch):
+        nxt = order[start]
+        if check.known.all():
+            break
+        known = np.flatnonzero(check.known)
+        if len(known) and _scores(check.p_success[known], J[known], top, tiebreak, product).max() > bound[nxt]:
+            break
+        check.resolve(order[start:start + batch])
+    known = np.flatnonzero(check.known)
+    s = np.full(len(J), -np.inf)
+    s[known] = _scores(check.p_success[known], J[known], top, tiebreak, product)
+    return int(np.argmax(s))
 
 
 _WORLDS: dict = {}
 
 
 def model_world(model: str, hand: Hand, table: bool):
-    """A world holding training model ``model`` at its own frame (built once per process and hand)."""
+    """A world holding training model ``model`` at its own frame (built once per process and hand
+    name: a hand is known by its name, as in the hand files)."""
     from ..world import World
 
-    key = (model, hand.name, id(hand.core), bool(table))
+    key = (model, hand.name, bool(table))
     if key not in _WORLDS:
         if len(_WORLDS) >= 64:
             _WORLDS.clear()
@@ -92,55 +141,112 @@ def _grasp_parts(batch, k: int) -> list:
     return [p for p in batch.contact_part[lo:hi] if p is not None]
 
 
-def check_on_model(world, rule: TaskRule, poses: np.ndarray, spreads: np.ndarray, threads: int = 1):
-    """``poses`` (K, 4, 4) in the model's frame with their ``spreads`` (K,): (rule_ok (K,), held
-    (K,), parts per candidate) of the approach along each pose closed on ``world``'s model."""
+@dataclass
+class _Closings:
+    """One model's closings: per candidate its batch and row (-1: not closed, held is False)."""
+
+    world: object
+    batches: list
+    where: np.ndarray      # (K, 2): batch index, row
+
+    def held(self, rows, threads: int = 1) -> np.ndarray:
+        out = np.zeros(len(rows), bool)
+        for j, b in enumerate(self.batches):
+            sel = np.flatnonzero(self.where[rows, 0] == j)
+            if len(sel):
+                out[sel] = self.world.epsilon_of(b, self.where[rows[sel], 1], threads) > 0.0
+        return out
+
+
+def _read(rule: TaskRule, batches, where, K: int, from_ok) -> tuple:
+    rule_ok, parts = np.zeros(K, bool), [[] for _ in range(K)]
+    for k in range(K):
+        j, row = where[k]
+        if j < 0:
+            continue
+        b = batches[j]
+        parts[k] = _grasp_parts(b, row)
+        rule_ok[k] = bool(from_ok[k] and not b.collision_at_start[row] and not b.stopped_by_table[row]
+                          and rule.contacts_ok(parts[k]))
+    return rule_ok, parts
+
+
+def close_on_model(world, rule: TaskRule, poses: np.ndarray, spreads: np.ndarray, threads: int = 1):
+    """``poses`` (K, 4, 4) in the model's frame with their ``spreads`` (K,): (rule_ok (K,), parts
+    per candidate, the closings) of the approach along each pose closed on ``world``'s model."""
     K = len(poses)
-    rule_ok, held, parts = np.zeros(K, bool), np.zeros(K, bool), [[] for _ in range(K)]
-    # a target under the table (in the model's frame) is no grasp there; the world would refuse it
+    # a direction the rule forbids, or a target under the table (in the model's frame), is not closed
     feasible = rule.approach_ok(poses[:, :3, 2]) & ((poses[:, 2, 3] >= 0.0) | (not rule.table))
     rolls = rolls_of(poses)
+    batches, where = [], np.full((K, 2), -1, np.int64)
     for s in np.unique(spreads):
         idx = np.flatnonzero((spreads == s) & feasible)
         if not len(idx):
             continue
-        b = world.approach_batch(poses[idx, :3, 2], poses[idx, :3, 3], rolls[idx], spread=float(s),
-                                 frame="world", threads=threads)
-        start = np.asarray(b.collision_at_start, bool)
-        table = np.asarray(b.stopped_by_table, bool)
-        for j, k in enumerate(idx):
-            parts[k] = _grasp_parts(b, j)
-            rule_ok[k] = bool(not start[j] and not table[j] and rule.contacts_ok(parts[k]))
-            held[k] = bool(b.epsilon[j] > 0.0)
-    return rule_ok, held, parts
+        batches.append(world.approach_batch(poses[idx, :3, 2], poses[idx, :3, 3], rolls[idx], spread=float(s),
+                                            frame="world", threads=threads, quality=False))
+        where[idx] = np.c_[np.full(len(idx), len(batches) - 1), np.arange(len(idx))]
+    rule_ok, parts = _read(rule, batches, where, K, np.ones(K, bool))
+    return rule_ok, parts, _Closings(world, batches, where)
+
+
+def _combine(K: int, M: int, weights, per_model: dict, threads: int, resolve: bool) -> PartCheck:
+    """A PartCheck from per-model (rule_ok, parts, closings); held computed now if ``resolve``."""
+    rule_ok, parts = np.zeros((K, M)), [[[] for _ in range(M)] for _ in range(K)]
+    for i, (r, p, _) in per_model.items():
+        rule_ok[:, i] = r
+        for k in range(K):
+            parts[k][i] = p[k]
+
+    def held_of(rows):
+        h = np.zeros((len(rows), M), bool)
+        for i, (r, _, closings) in per_model.items():
+            need = np.flatnonzero(r[rows] > 0)      # held matters only where the rule holds
+            if len(need):
+                h[need, i] = closings.held(rows[need], threads)
+        return h
+
+    check = PartCheck(rule_ok, np.zeros((K, M), bool), np.asarray(weights, float), parts, np.zeros(K, bool), held_of)
+    return check.resolve() if resolve else check
+
+
+def _turned(yaw: float) -> np.ndarray:
+    T = np.eye(4)
+    T[:2, :2] = [[np.cos(yaw), -np.sin(yaw)], [np.sin(yaw), np.cos(yaw)]]
+    return T
 
 
 def check_candidates(hand: Hand, rule: TaskRule, poses, spreads, registrations: Sequence, weights,
-                     threads: int = 1) -> PartCheck:
+                     threads: int = 1, resolve: bool = True, jitter_yaw: Sequence[float] = ()) -> PartCheck:
     """Every candidate ``poses`` (K, 4, 4, scene frame) closed on every registered model with
-    weight > 0 (the others count 0): a :class:`PartCheck`."""
+    weight > 0 (the others count 0): a :class:`PartCheck`; held computed for every candidate unless
+    ``resolve`` is False (then :func:`choose_lazily` computes what it needs). Held is only computed
+    where the rule holds (elsewhere it does not change P(rule, held) and is left False).
+
+    ``jitter_yaw`` (rad): the model is also closed turned by each of these about its own vertical
+    axis (T_i Rz(d)), as a registration that got the yaw slightly wrong would place it; rule_ok is
+    then the share of the placements on which the rule holds (held is read at T_i itself)."""
     A = np.asarray(poses, float).reshape(-1, 4, 4)
     S = np.broadcast_to(np.asarray(spreads, float), (len(A),))
     w = np.asarray(weights, float)
     if len(w) != len(registrations):
         raise ValueError(f"weights: one per registration ({len(registrations)}), got {len(w)}")
-    M = len(registrations)
-    rule_ok, held = np.zeros((len(A), M), bool), np.zeros((len(A), M), bool)
-    parts = [[[] for _ in range(M)] for _ in range(len(A))]
+    per_model = {}
     for i, reg in enumerate(registrations):
         if w[i] <= 0 or not reg.success or not len(A):
             continue
-        local = np.linalg.inv(np.asarray(reg.transform, float)) @ A
         world = model_world(reg.model, hand, bool(rule.table))
-        r, h, p = check_on_model(world, rule, local, S, threads)
-        rule_ok[:, i], held[:, i] = r, h
-        for k in range(len(A)):
-            parts[k][i] = p[k]
-    return PartCheck(rule_ok, held, w, parts)
+        T = np.asarray(reg.transform, float)
+        r, parts, closings = close_on_model(world, rule, np.linalg.inv(T) @ A, S, threads)
+        r = r.astype(float)
+        for d in jitter_yaw:
+            r += close_on_model(world, rule, np.linalg.inv(T @ _turned(float(d))) @ A, S, threads)[0]
+        per_model[i] = (r / (1 + len(jitter_yaw)), parts, closings)
+    return _combine(len(A), len(registrations), w, per_model, threads, resolve)
 
 
 def check_top_grasps(hand: Hand, rule: TaskRule, grasps, names: Sequence[str], poses, weights,
-                     spread: float, threads: int = 1) -> PartCheck:
+                     spread: float, threads: int = 1, resolve: bool = True) -> PartCheck:
     """Planar top grasps ``grasps`` (K, 3: x, y, yaw, world) closed on every model ``names[i]`` of
     weight > 0 placed at its planar pose ``poses[i]`` (x, y, yaw): a :class:`PartCheck` (the
     vision-then-touch belief's version of :func:`check_candidates`)."""
@@ -151,18 +257,15 @@ def check_top_grasps(hand: Hand, rule: TaskRule, grasps, names: Sequence[str], p
     w = np.asarray(weights, float)
     if not (len(names) == len(P) == len(w)):
         raise ValueError(f"names, poses, weights: one of each per model, got {len(names)}, {len(P)}, {len(w)}")
-    M = len(names)
-    rule_ok, held = np.zeros((len(G), M), bool), np.zeros((len(G), M), bool)
-    parts = [[[] for _ in range(M)] for _ in range(len(G))]
+    K = len(G)
     from_above = bool(rule.approach_ok(np.array([[0.0, 0.0, -1.0]]))[0])
+    per_model = {}
     for i, name in enumerate(names):
-        if w[i] <= 0 or not len(G):
+        if w[i] <= 0 or not K:
             continue
-        b = model_world(name, hand, bool(rule.table)).grasp_batch(relative_planar_pose(G, P[i][None, :]),
-                                                                   spread=spread, threads=threads)
-        start, table = np.asarray(b.collision_at_start, bool), np.asarray(b.stopped_by_table, bool)
-        for k in range(len(G)):
-            parts[k][i] = _grasp_parts(b, k)
-            rule_ok[k, i] = from_above and not start[k] and not table[k] and rule.contacts_ok(parts[k][i])
-            held[k, i] = bool(b.epsilon[k] > 0.0)
-    return PartCheck(rule_ok, held, w, parts)
+        world = model_world(name, hand, bool(rule.table))
+        b = world.grasp_batch(relative_planar_pose(G, P[i][None, :]), spread=spread, threads=threads, quality=False)
+        where = np.c_[np.zeros(K, np.int64), np.arange(K)]
+        r, p = _read(rule, [b], where, K, np.full(K, from_above))
+        per_model[i] = (r, p, _Closings(world, [b], where))
+    return _combine(K, len(names), w, per_model, threads, resolve)
