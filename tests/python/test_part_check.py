@@ -175,3 +175,4 @@ def test_epsilon_of_chosen_rows_is_the_batch_epsilon():
     assert np.isnan(lazy.epsilon[~start]).all() and (full.epsilon > 0).any()
     rows = np.array([7, 0, 3, 11])
     np.testing.assert_allclose(w.epsilon_of(lazy, rows), full.epsilon[rows], rtol=1e-9, atol=1e-12)
+

@@ -25,6 +25,6 @@ def test_pub6_writes_csv_tables_and_a_plot(tmp_path):
     assert rows["unstable_to_stable"]["ours"] == "1" and rows["success_after_round_3"]["thesis"] == "78"
     rounds = list(csv.DictReader(open(tmp_path / "rounds.csv")))
     assert len(rounds) == 16 and rounds[-1]["top_model"] == "mug/2"          # weights 0.3 / 0.7 in round 3
-    assert len(list(csv.DictReader(open(tmp_path / "targets.csv")))) == 4
+    assert len(list(csv.DictReader(open(tmp_path / "targets.csv")))) == 5
     assert (tmp_path / "cumulative_success.png").stat().st_size > 5000
     assert "cumulative_success.png" in (tmp_path / "summary.md").read_text()

@@ -1,0 +1,17 @@
+"""The part-aware plan and task term through the CLI (issue 29), with test_viewer_results' small
+models and two training mugs."""
+from test_viewer_results import cat_options, cli_json  # noqa: F401  (cat_options: the fixture)
+
+
+def test_the_cli_plans_part_aware_and_fuses_with_the_part_aware_term(capsys, cat_options):
+    """`category --method part-aware` and `fuse --task-term part-aware` end to end (small models,
+    two training mugs): the check's figures are in the output, and the executed grasp's verdict."""
+    doc = cli_json(capsys, "category", "--category", "mug", "--task", "top", "--scene-object", "mug/3",
+                   "--object-pose", "0.01,0.02,0.7", "--method", "part-aware", *cat_options, "--json")
+    pc = doc["part_check"]
+    assert doc["method"] == "part-aware" and 0.0 <= pc["p_success"] <= pc["p_rule"] <= 1.0 + 1e-12
+    assert pc["candidates"] == 64 and set(pc["contact_parts_on_models"]) <= {"mug/1", "mug/2"}
+    assert doc["success"] == (doc["lifted"] and doc["task_ok"])
+    fuse = cli_json(capsys, "fuse", "--category", "mug", "--task", "top", "--scene-object", "mug/3",
+                    "--object-pose", "0.01,0.02,0.7", "--rounds", 1, "--task-term", "part-aware", *cat_options, "--json")
+    assert fuse["task_term"] == "part-aware" and all(0.0 <= r["part"] <= 1.0 for r in fuse["rounds"][1:])
