@@ -139,8 +139,8 @@ def _pose_run(key, r: dict, hand) -> ResultScene:
 
 
 def _category_run(key, r: dict, hand) -> ResultScene:
-    from ..experiments.category import roll_of
     from ..models.tasks import task_rule
+    from ..planners.part_check import rolls_of
     from ..world import World
 
     pose = np.asarray(r["pose"], float)
@@ -155,7 +155,8 @@ def _category_run(key, r: dict, hand) -> ResultScene:
                 continue
             q = np.asarray(out["joint_angles"], float)
             A = np.asarray(out["pose"], float)
-            g = world.approach(A[:3, 2], A[:3, 3], roll_of(A), spread=out["spread"], frame="world", lift=False)
+            g = world.approach(A[:3, 2], A[:3, 3], float(rolls_of(A[None])[0]), spread=out["spread"], frame="world",
+                               lift=False)
             steps.append(Step(label, _record(hand, out["hand_pose"], q, out["spread"]), _verdict(out.get("lifted")),
                               _resimulated_contacts(world, g, out["hand_pose"], q)))
     return ResultScene("run", _object(r["object"]), pose, steps, title=f"{'/'.join(map(str, key))}: category tasks")
