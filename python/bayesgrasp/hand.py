@@ -138,6 +138,15 @@ class Hand:
         return _core.hand.Hand.approach_pose(np.asarray(direction, dtype=float), float(roll),
                                              np.asarray(palm, dtype=float))
 
+    @staticmethod
+    def approach_roll(pose) -> float:
+        """The roll of a 4x4 hand pose about its approach (its +z): the inverse of
+        :meth:`approach_pose`, ``approach_roll(approach_pose(d, r, p)) == r`` (mod 2 pi)."""
+        T = np.asarray(pose, dtype=float)
+        d = T[:3, 2]
+        x0 = Hand.approach_pose(d, 0.0, T[:3, 3])[:3, 0]
+        return float(np.arctan2(np.cross(x0, T[:3, 0]) @ (-d), x0 @ T[:3, 0]))
+
     def link_shapes(self) -> list:
         """Per link, its collision shapes (``_core.hand.Shape``: type, center, half_extents, p0,
         p1, radius) in the link frame."""

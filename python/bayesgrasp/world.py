@@ -269,17 +269,22 @@ class World:
         """GWS epsilon of the grasps ``rows`` of ``batch`` (made by this world), on their object
         contacts; 0 where the hand started in collision."""
         rows = np.asarray(rows, dtype=np.int64).ravel()
-        c, off = batch.contacts, np.asarray(batch.contacts.offsets, dtype=np.int64)
-        idx = np.concatenate([np.arange(off[k], off[k + 1]) for k in rows]) if len(rows) else np.zeros(0, np.int64)
-        on_obj = ~np.asarray(c.on_table, dtype=bool)[idx]
-        sel = idx[on_obj]
-        counts = np.array([np.count_nonzero(~np.asarray(c.on_table[off[k]:off[k + 1]], dtype=bool)) for k in rows],
-                          dtype=np.int64)
-        eps, _ = quality.epsilon_volume_batch(c.point[sel], c.normal[sel], self.com, self.torque_scale, mu=self.mu,
-                                              counts=counts, volume=False, threads=threads)
-        eps = np.array(eps, dtype=float)
-        eps[np.asarray(batch.collision_at_start, dtype=bool)[rows]] = 0.0
-        return eps
+        grasps, back = np.unique(rows, return_inverse=True)
+        c = batch.contacts
+        grasp_of = np.repeat(np.arange(len(batch.epsilon)), np.diff(np.asarray(c.offsets, dtype=np.int64)))
+        keep = ~np.asarray(c.on_table, dtype=bool) & np.isin(grasp_of, grasps)
+        eps, _ = self._quality(c, keep, np.searchsorted(grasps, grasp_of[keep]), len(grasps), threads, volume=False)
+        eps[np.asarray(batch.collision_at_start, dtype=bool)[grasps]] = 0.0
+        return eps[back]
+
+    def _quality(self, contacts, keep, grasp_of, n: int, threads: int, volume: bool = True):
+        """Epsilon and volume of ``n`` grasps from the contacts selected by ``keep`` (the object's),
+        ``grasp_of`` the grasp (0..n-1) of each selected contact, in one C++ batch call."""
+        eps, vol = quality.epsilon_volume_batch(contacts.point[keep], contacts.normal[keep], self.com,
+                                                self.torque_scale, mu=self.mu,
+                                                counts=np.bincount(grasp_of, minlength=n), volume=volume,
+                                                threads=threads)
+        return np.array(eps, dtype=float), np.array(vol, dtype=float)
 
     def grasp_pose(self, hand_pose, spread: Optional[float] = None, frame: str = "object",
                    lift: bool = False) -> WorldGrasp:
@@ -317,12 +322,8 @@ class World:
         counts = np.asarray(counts, dtype=np.int64)
         # Quality on object contacts only, grasp by grasp in one C++ batch call.
         grasp_of = np.repeat(np.arange(len(counts)), counts)
-        obj_counts = np.bincount(grasp_of[on_obj], minlength=len(counts))
         if with_quality:
-            eps, vol = quality.epsilon_volume_batch(c.point[on_obj], c.normal[on_obj], self.com,
-                                                    self.torque_scale, mu=self.mu, counts=obj_counts,
-                                                    threads=threads)
-            eps, vol = np.array(eps, dtype=float), np.array(vol, dtype=float)
+            eps, vol = self._quality(c, on_obj, grasp_of[on_obj], len(counts), threads)
         else:
             eps, vol = np.full(len(counts), np.nan), np.full(len(counts), np.nan)
         start = np.asarray(b.collision_at_start, dtype=bool)

@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from bayesgrasp.cli import main
-from bayesgrasp.experiments.category import (observe, plan_and_execute, register_models, roll_of, see,
+from bayesgrasp.experiments.category import (observe, plan_and_execute, register_models, see,
                                              training_models)
 from bayesgrasp.experiments.context import RunContext
 from bayesgrasp.hand import Hand
@@ -49,7 +49,7 @@ def test_roll_of_inverts_the_approach_pose():
         d = rng.normal(size=3)
         roll = rng.uniform(-np.pi, np.pi)
         T = Hand.approach_pose(d, roll, rng.normal(size=3))
-        assert np.isclose(np.cos(roll_of(T) - roll), 1.0, atol=1e-9)
+        assert np.isclose(np.cos(Hand.approach_roll(T) - roll), 1.0, atol=1e-9)
 
 
 def test_leave_one_out_training_sets():

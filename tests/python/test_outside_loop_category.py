@@ -8,10 +8,10 @@ import numpy as np
 import pytest
 
 from bayesgrasp.cli import main
-from bayesgrasp.experiments.category import roll_of
 from bayesgrasp.experiments.outside_loop import STATE_FILE
 from bayesgrasp.experiments.outside_loop_category import VIEW_FILE, CategoryTaskEpisode, FusionEpisode, open_episode
 from bayesgrasp.experiments.tactile_fusion import top_grasp
+from bayesgrasp.hand import Hand
 from bayesgrasp.io.grasp_schema import validate
 from bayesgrasp.models.task_grasps import TaskGraspSettings, generate_task_grasps, grasp_to_json
 from bayesgrasp.models.tasks import task_rule
@@ -62,8 +62,8 @@ def test_category_task_episode_equals_the_category_command(capsys, tmp_path, opt
     assert nxt["grasp"]["joint_positions"] != inproc["grasp"]["joint_positions"]      # printed open, to approach
     # the stand-in robot approaches along the printed pose, closes and lifts: the category command's execution
     A = np.array(nxt["grasp"]["pose"])
-    g = World.single(SCENE, pose=POSE).approach(A[:3, 2], A[:3, 3], roll_of(A), spread=nxt["grasp"]["spread"],
-                                                frame="world", lift=True)
+    g = World.single(SCENE, pose=POSE).approach(A[:3, 2], A[:3, 3], Hand.approach_roll(A),
+                                                spread=nxt["grasp"]["spread"], frame="world", lift=True)
     assert np.asarray(g.joint_angles).tolist() == inproc["grasp"]["joint_positions"]
     assert bool(g.lifted) == inproc["lifted"]
     end = cli_json(capsys, "episode", "observe", d, "--joints", ",".join(map(repr, np.asarray(g.joint_angles).tolist())),

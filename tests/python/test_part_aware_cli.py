@@ -15,3 +15,12 @@ def test_the_cli_plans_part_aware_and_fuses_with_the_part_aware_term(capsys, cat
     fuse = cli_json(capsys, "fuse", "--category", "mug", "--task", "top", "--scene-object", "mug/3",
                     "--object-pose", "0.01,0.02,0.7", "--rounds", 1, "--task-term", "part-aware", *cat_options, "--json")
     assert fuse["task_term"] == "part-aware" and all(0.0 <= r["part"] <= 1.0 for r in fuse["rounds"][1:])
+
+
+def test_the_text_output_says_what_the_part_check_found(capsys, cat_options):
+    from bayesgrasp.cli import main
+
+    assert main(["category", "--category", "mug", "--task", "top", "--scene-object", "mug/3", "--object-pose",
+                 "0.01,0.02,0.7", "--method", "part-aware", *cat_options]) == 0
+    line = next(x for x in capsys.readouterr().out.splitlines() if "part check:" in x)
+    assert "of 64 candidates obeyed the rule on some model" in line

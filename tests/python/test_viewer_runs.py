@@ -60,7 +60,7 @@ def test_runs_are_listed_and_picked_by_series_object_and_index(store):
     assert list_runs(path) == [("pub2/stability", "mug", 0), ("pub5", "mug/3", 0), ("pub6", "mug/3", 0)]
     key, r = read_run(path.parent, "pub5")              # the directory is enough; the only object and run 0
     assert key == ("pub5", "mug/3", 0) and "tasks" in r
-    with pytest.raises(ResultError, match="several seriess|--series"):
+    with pytest.raises(ResultError, match="several stored, pick one with --series: pub2/stability, pub5, pub6$"):
         read_run(path)
     with pytest.raises(ResultError, match="--object 'cube': not stored; stored: mug"):
         read_run(path, "pub2/stability", "cube")

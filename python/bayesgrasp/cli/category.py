@@ -113,7 +113,8 @@ def _print(doc: dict) -> None:
     pc = doc.get("part_check")
     if pc:
         print(f"  part check: the rule holds on models of weight {pc['p_rule']:.2f} (and the grasp holds: "
-              f"{pc['p_success']:.2f}); {pc['passing']} of {pc['candidates']} candidates passed on some model")
+              f"{pc['p_success']:.2f}); {pc['passing_rule']} of {pc['candidates']} candidates obeyed the rule on "
+              "some model")
     if not doc["executed"]:
         x, y, z = (doc["grasp"]["pose"][i][3] for i in range(3))
         print(f"  planned grasp at ({100 * x:.1f}, {100 * y:.1f}, {100 * z:.1f}) cm in the table frame, spread "

@@ -71,7 +71,8 @@ def run(args) -> int:
                        "grasp": hand_grasp_record(hand, rec["hand_pose"], rec["joint_positions"], trial.spread),
                        "epsilon": rec["epsilon"], "lifted": rec["lifted"],
                        "weights": dict(zip(trial.names, rec["weights"])),
-                       "poses": dict(zip(trial.names, rec["poses"])), "underflow": rec["underflow"], **({"part": rec["part"]} if "part" in rec else {})})
+                       "poses": dict(zip(trial.names, rec["poses"])), "underflow": rec["underflow"],
+                       **({"part": rec["part"]} if "part" in rec else {})})
     success = any(x["lifted"] for x in rounds)
     doc = {"scene_object": args.scene_object, "object_pose": pose, "category": args.category, "task": args.task,
            "start": args.start, "belief": args.belief, "task_term": args.task_term, "rounds": rounds, "success": success,

@@ -17,6 +17,7 @@ from typing import Dict, List, Optional, Sequence, Tuple
 
 import numpy as np
 
+from ..hand import Hand
 from ..models.task_grasps import TaskGraspSettings, task_grasps
 from ..models.tasks import TaskRule, task_rule
 from ..objects import CATEGORY_SIZES, category, load_object
@@ -91,17 +92,6 @@ def demonstrated(models: Sequence[str], rule: TaskRule, ctx: RunContext,
     return task_grasps(models, rule, ctx.hand, settings, cache_dir=cache, say=ctx.progress)
 
 
-def roll_of(pose: np.ndarray) -> float:
-    """The roll of a hand pose about its approach direction (the convention of the hand's
-    approach_pose: the pose is approach_pose(pose's +z, roll, its position))."""
-    from ..hand import Hand
-
-    d = pose[:3, 2]
-    R0 = Hand.approach_pose(d, 0.0, pose[:3, 3])[:3, :3]
-    x0, x = R0[:, 0], pose[:3, 0]
-    return float(np.arctan2(np.cross(x0, x) @ (-d), x0 @ x))
-
-
 def execute(obj, pose, plan: CategoryPlan, rule: TaskRule, ctx: RunContext) -> dict:
     """The planned grasp executed on the object at its true pose: the open hand approaches along
     the planned pose's direction through its position with its roll, closes, is lift-tested;
@@ -111,7 +101,7 @@ def execute(obj, pose, plan: CategoryPlan, rule: TaskRule, ctx: RunContext) -> d
                 "epsilon": 0.0, "force_closure": False, "failure": "no contact"}
     world = World.single(obj, pose=pose, hand=ctx.hand, table=rule.table)
     A = plan.pose
-    g = world.approach(A[:3, 2], A[:3, 3], roll_of(A), spread=plan.spread, frame="world", lift=True)
+    g = world.approach(A[:3, 2], A[:3, 3], Hand.approach_roll(A), spread=plan.spread, frame="world", lift=True)
     parts = [c.part for c in g.contacts if not c.on_table]
     task_ok = bool(rule.contacts_ok(parts)) and not g.collision_at_start
     lifted = bool(g.lifted)

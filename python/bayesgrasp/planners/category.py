@@ -288,7 +288,9 @@ class CategoryPlanner:
         refs = order[np.arange(n_more) % len(order)]
         box = np.array([s.part_translation] * 3 + [s.part_rotation] * 3)
         X = rng.uniform(-box, box, (n_more, 6))
-        more = np.array([_task.poses_from_local(self.mapped[c], X[k:k + 1])[0] for k, c in enumerate(refs)])
+        more = np.empty((n_more, 4, 4))
+        for c in np.unique(refs):
+            more[refs == c] = _task.poses_from_local(self.mapped[c], X[refs == c])
         return np.concatenate([np.asarray(fixed), more])
 
     def _part_aware(self, optima: Sequence[np.ndarray], rng: np.random.Generator, nfev: int) -> CategoryPlan:

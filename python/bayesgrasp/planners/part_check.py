@@ -124,16 +124,6 @@ def model_world(model: str, hand: Hand, table: bool):
     return _WORLDS[key]
 
 
-def rolls_of(poses: np.ndarray) -> np.ndarray:
-    """The roll of each hand pose about its approach (the convention of Hand.approach_pose)."""
-    out = np.empty(len(poses))
-    for k, A in enumerate(poses):
-        d = A[:3, 2]
-        x0 = Hand.approach_pose(d, 0.0, A[:3, 3])[:3, 0]
-        out[k] = np.arctan2(np.cross(x0, A[:3, 0]) @ (-d), x0 @ A[:3, 0])
-    return out
-
-
 def _grasp_parts(batch, k: int) -> list:
     lo, hi = batch.contacts.offsets[k], batch.contacts.offsets[k + 1]
     if batch.contact_part is None:
@@ -177,7 +167,7 @@ def close_on_model(world, rule: TaskRule, poses: np.ndarray, spreads: np.ndarray
     K = len(poses)
     # a direction the rule forbids, or a target under the table (in the model's frame), is not closed
     feasible = rule.approach_ok(poses[:, :3, 2]) & ((poses[:, 2, 3] >= 0.0) | (not rule.table))
-    rolls = rolls_of(poses)
+    rolls = np.array([Hand.approach_roll(A) for A in poses])
     batches, where = [], np.full((K, 2), -1, np.int64)
     for s in np.unique(spreads):
         idx = np.flatnonzero((spreads == s) & feasible)

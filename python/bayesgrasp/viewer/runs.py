@@ -60,7 +60,7 @@ def _one_of(what: str, value, choices: list):
     if value is None:
         if len(choices) == 1:
             return choices[0]
-        raise ResultError(f"several {what}s stored, pick one with --{what}: {', '.join(map(str, choices))}")
+        raise ResultError(f"several stored, pick one with --{what}: {', '.join(map(str, choices))}")
     if value not in choices:
         raise ResultError(f"--{what} {value!r}: not stored; stored: {', '.join(map(str, choices))}")
     return value
@@ -140,7 +140,6 @@ def _pose_run(key, r: dict, hand) -> ResultScene:
 
 def _category_run(key, r: dict, hand) -> ResultScene:
     from ..models.tasks import task_rule
-    from ..planners.part_check import rolls_of
     from ..world import World
 
     pose = np.asarray(r["pose"], float)
@@ -155,7 +154,7 @@ def _category_run(key, r: dict, hand) -> ResultScene:
                 continue
             q = np.asarray(out["joint_angles"], float)
             A = np.asarray(out["pose"], float)
-            g = world.approach(A[:3, 2], A[:3, 3], float(rolls_of(A[None])[0]), spread=out["spread"], frame="world",
+            g = world.approach(A[:3, 2], A[:3, 3], hand.approach_roll(A), spread=out["spread"], frame="world",
                                lift=False)
             steps.append(Step(label, _record(hand, out["hand_pose"], q, out["spread"]), _verdict(out.get("lifted")),
                               _resimulated_contacts(world, g, out["hand_pose"], q)))
