@@ -138,6 +138,17 @@ offset_j + ratio_j * t, clamped to its limits (the coupling), with breakaway.)do
           },
           "(J, 2) lower and upper limits of q (rad).")
       .def_property_readonly(
+          "joint_torques",
+          [](const HandModel& h) {
+            Eigen::VectorXd t = Eigen::VectorXd::Zero(h.num_joints());
+            for (const Finger& f : h.fingers())
+              for (size_t p = 0; p < f.phalanges.size(); ++p)
+                t[f.first_joint + static_cast<int>(p)] = f.phalanges[p].torque;
+            return t;
+          },
+          "(J,) N m: the finger motor's torque limit at each joint while it drives it (the hand file's "
+          "torque_nm; 0 for the spread and where not given).")
+      .def_property_readonly(
           "phalanx_links",
           [](const HandModel& h) {
             std::vector<std::vector<int>> out;

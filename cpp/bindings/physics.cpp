@@ -90,13 +90,21 @@ void bind_options(py::module_& m) {
       .def_readwrite("shake_time", &LiftOptions::shake_time, "shake_time : float\n    s of shaking.")
       .def_readwrite("hold_time", &LiftOptions::hold_time, "hold_time : float\n    s held still at the end.")
       .def_readwrite("finger_torque", &LiftOptions::finger_torque,
-                     "finger_torque : float\n    N m, torque limit of each finger's one motor at the joint it drives "
-                     "(the proximal, the distal after breakaway; coupled phalanges load the same motor).")
+                     "finger_torque : float\n    N m; > 0: the torque limit of each finger's one motor at every joint it "
+                     "drives (the proximal, the distal after breakaway; coupled phalanges load the same motor); 0 "
+                     "(default): each joint's torque from the hand file (torque_nm, the hand's published strength).")
       .def_readwrite("closing_speed", &LiftOptions::closing_speed,
                      "closing_speed : float\n    rad/s, the finger motors' target velocity (closing).")
+      .def_readwrite("drive_inertia", &LiftOptions::drive_inertia,
+                     "drive_inertia : float\n    kg m^2 added to each phalanx about its joint axis (the drive's "
+                     "reflected rotor inertia).")
+      .def_readwrite("worm_backlash", &LiftOptions::worm_backlash,
+                     "worm_backlash : float\n    rad a driven or locked finger joint may open below the largest angle "
+                     "it reached (the worm drive's backlash; 0: a rigid ratchet).")
       .def_readwrite("link_mass", &LiftOptions::link_mass, "link_mass : float\n    kg per phalanx.")
       .def_readwrite("success_distance", &LiftOptions::success_distance,
-                     "success_distance : float\n    m; lifted = the object moved less than this relative to the palm.")
+                     "success_distance : float\n    m; lifted = the object rose at least lift_height minus this, and "
+                     "moved less than this in the palm frame from the end of the lift to the end.")
       .def_readwrite("table", &LiftOptions::table, "table : bool\n    A table plane at z = 0.")
       .def_property(
           "shape", [](const LiftOptions& o) { return shape_name(o.shape); },
@@ -168,11 +176,15 @@ void bind_results(py::module_& m) {
   using R = LiftResult;
   py::class_<R>(m, "LiftResult", "The outcome of one lift test.")
       .def_readonly("lifted", &R::lifted,
-                    "lifted : bool\n    The object moved less than success_distance relative to the palm and the "
-                    "simulation stayed finite.")
+                    "lifted : bool\n    The object came up (height_gain >= lift_height - success_distance), held "
+                    "through the shake and hold (hold_displacement < success_distance), and the simulation stayed "
+                    "finite.")
       .def_readonly("displacement", &R::displacement,
                     "displacement : float\n    m, the object's centre of mass relative to the palm, end vs after "
                     "the squeeze.")
+      .def_readonly("hold_displacement", &R::hold_displacement,
+                    "hold_displacement : float\n    m, the object's centre of mass relative to the palm, end vs the "
+                    "end of the lift (0 if the run stopped before).")
       .def_readonly("rotation", &R::rotation,
                     "rotation : float\n    rad, the object's rotation relative to the palm, end vs after the squeeze.")
       .def_readonly("squeeze_displacement", &R::squeeze_displacement,
@@ -209,6 +221,8 @@ void bind_results(py::module_& m) {
   py::class_<B>(m, "LiftBatch", "N lift tests: each LiftResult field as an (N,) array (read-only views).")
       .def_property_readonly("lifted", view(&R::lifted), "lifted : numpy.ndarray (N,) bool")
       .def_property_readonly("displacement", view(&R::displacement), "displacement : numpy.ndarray (N,) float\n    m.")
+      .def_property_readonly("hold_displacement", view(&R::hold_displacement),
+                             "hold_displacement : numpy.ndarray (N,) float\n    m.")
       .def_property_readonly("rotation", view(&R::rotation), "rotation : numpy.ndarray (N,) float\n    rad.")
       .def_property_readonly("squeeze_displacement", view(&R::squeeze_displacement),
                              "squeeze_displacement : numpy.ndarray (N,) float\n    m.")

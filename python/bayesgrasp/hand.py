@@ -99,6 +99,9 @@ class Hand:
     joint_names = property(lambda self: list(self.core.joint_names), doc="Names of the entries of q.")
     joint_limits = property(lambda self: self.core.joint_limits, doc="(J, 2) joint limits (rad).")
     spread_limits = property(lambda self: tuple(self.core.spread_limits), doc="(lower, upper) spread (rad).")
+    joint_torques = property(lambda self: self.core.joint_torques,
+                             doc="(J,) N m, each finger joint's motor torque limit while driven (the hand file's "
+                                 "torque_nm, its published strength; 0 for the spread).")
     phalanx_links = property(lambda self: self.core.phalanx_links,
                              doc="Per finger, the link indices of its phalanges (base to tip).")
 

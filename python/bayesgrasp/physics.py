@@ -4,10 +4,13 @@ The object becomes a dynamic body (mass from its mesh at ``density``), the palm 
 body, the phalanges hinged bodies squeezed as the Barrett hand does: one torque-limited motor per
 finger on its proximal joint, the distal coupled to it, breakaway when the proximal is stopped by
 the object (the distal closes on alone), worm drives that do not open under load, no travel
-limit (see cpp/bayesgrasp/physics/lift_test.hpp). ``run(..., trace_every=k)`` records a per-step
-trace (:mod:`bayesgrasp.lift_trace`). Script: squeeze 0.15 s, lift 10 cm in 0.4 s, gentle 3-axis shake (1 cm,
-3 Hz, 0.5 s), hold 0.1 s, at a fixed 1/480 s step (deterministic). Success when the object's
-centre of mass moved less than 2 cm relative to the palm (after the squeeze)::
+limit (see cpp/bayesgrasp/physics/lift_test.hpp). The motors' torque limits are the hand file's
+(``torque_nm`` per phalanx, the hand's published strength; ``finger_torque=`` overrides them).
+``run(..., trace_every=k)`` records a per-step trace (:mod:`bayesgrasp.lift_trace`). Script:
+squeeze 0.15 s, lift 10 cm in 0.4 s, gentle 3-axis shake (1 cm, 3 Hz, 0.5 s), hold 0.1 s, at a
+fixed 1/480 s step (deterministic). Success ("lifted") when the object came up with the hand -
+its centre of mass rose at least 10 cm - 2 cm - and stayed in it through the shake and the hold
+(moved less than 2 cm in the palm frame from the end of the lift)::
 
     r = lift_test("python/bayesgrasp/data/hands/barrett_bh8.json", hand_pose, joints, V, F)
     r.lifted, r.displacement                    # a LiftResult
@@ -184,7 +187,7 @@ class LiftTester:
         return self._t.shape
 
     def run(self, hand_pose, joints, trace_every: int = 0) -> LiftResult:
-        """One lift test (lifted, displacement, rotation, squeeze_displacement, height_gain,
+        """One lift test (lifted, displacement, hold_displacement, rotation, squeeze_displacement, height_gain,
         finite, steps, tetrahedra, shape, breakaway). ``trace_every`` > 0: ``result.trace`` records
         every that many steps (see :class:`bayesgrasp.lift_trace.LiftTrace`); 0: None."""
         return self._t.run(np.asarray(hand_pose, dtype=float), np.asarray(joints, dtype=float), c_int(trace_every, "trace_every"))
@@ -207,7 +210,7 @@ def lift_test(hand, hand_pose, joints, vertices, faces, **options) -> LiftResult
         **options: LiftOptions fields, e.g. ``mu=0.5, density=1000.0, table=True``.
 
     Returns:
-        a LiftResult: ``lifted`` (bool), ``displacement`` (m), ``rotation`` (rad),
+        a LiftResult: ``lifted`` (bool), ``displacement`` (m), ``hold_displacement`` (m), ``rotation`` (rad),
         ``squeeze_displacement`` (m), ``height_gain`` (m), ``finite``, ``steps``, ``shape``.
     """
     return LiftTester(hand, vertices, faces, **options).run(hand_pose, joints)

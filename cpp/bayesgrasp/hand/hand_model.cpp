@@ -87,6 +87,8 @@ Phalanx parse_phalanx(const json& j, size_t p, const std::string& where) {
   phalanx.offset = number_or(j, "offset_deg", j.contains("lower_deg") ? number(j, "lower_deg", where) : 0.0, where) * kDeg;
   phalanx.ratio = number_or(j, "ratio", 1.0, where);
   if (phalanx.ratio < 0) fail(where, "ratio must be >= 0");
+  phalanx.torque = number_or(j, "torque_nm", 0.0, where);
+  if (!(phalanx.torque >= 0) || !std::isfinite(phalanx.torque)) fail(where, "torque_nm must be >= 0 and finite");
   phalanx.shapes = shapes(j, where);
   return phalanx;
 }

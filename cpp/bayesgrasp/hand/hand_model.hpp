@@ -48,6 +48,7 @@ struct Phalanx {
   double length = 0.0;  // joint to next joint / fingertip (m)
   double lower = 0.0, upper = 0.0;  // joint limits (rad)
   double offset = 0.0, ratio = 1.0; // coupling: q(t) = offset + ratio * t
+  double torque = 0.0;  // N m: the finger motor's torque limit at this joint while it drives it (0: not given)
   std::vector<Shape> shapes;
   int link = -1;  // index into HandModel::links
 };

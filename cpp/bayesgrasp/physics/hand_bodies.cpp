@@ -120,7 +120,10 @@ HandBodies add_hand(BulletWorld& w, const HandModel& hand, const Iso3& hand_pose
       auto* shape = static_cast<btCompoundShape*>(w.keep(new btCompoundShape()));
       add_shapes(shape, ph.shapes, Iso3::Identity(), o.margin, w);
       const double m = o.link_mass, L = std::max(ph.length, 0.01), r = 0.01;
-      btRigidBody* body = w.add_body(shape, m, Vec3(m * r * r, m * L * L / 3, m * L * L / 3), to_bt(pose), kHand,
+      // Inertia about the link's y (its joint axis, through the centre of mass) plus the drive's
+      // reflected inertia (lift_test.hpp, drive_inertia).
+      btRigidBody* body = w.add_body(shape, m, Vec3(m * r * r, m * L * L / 3 + o.drive_inertia, m * L * L / 3),
+                                     to_bt(pose), kHand,
                                      kObject, o.mu);
       body->setUserIndex(ph.link);
       btRigidBody* parent = hb.link_body[parent_link];

@@ -65,14 +65,18 @@ void run_script(BulletWorld& w, btRigidBody* object, HandBodies& hb, const HandM
   const double dt = o.time_step;
   const long steps = script_steps(o);
   const long squeeze_steps = static_cast<long>(std::ceil(o.squeeze_time / dt - 1e-9));
+  const long lift_end_step = static_cast<long>(std::ceil((o.squeeze_time + o.lift_time) / dt - 1e-9));
   // The object's pose relative to the palm, and the outcome against the reference: the
   // relative pose after the squeeze (the start before it).
   auto relative = [&](const Iso3& palm_pose) { return Iso3(palm_pose.inverse() * from_bt(object->getWorldTransform())); };
   const Iso3 start = relative(hand_pose);
   Iso3 ref = start;
+  Iso3 lifted_pose = start;  // the object in the palm frame at the end of the lift
+  bool after_lift = false;
   auto measure = [&](const Iso3& palm_pose) {
     const Iso3 rel = relative(palm_pose);
     res.displacement = (rel.translation() - ref.translation()).norm();
+    res.hold_displacement = after_lift ? (rel.translation() - lifted_pose.translation()).norm() : 0.0;
     res.rotation = Eigen::AngleAxisd(ref.linear().transpose() * rel.linear()).angle();
     res.height_gain = from_bt(object->getWorldTransform().getOrigin()).z() - com_z;
     res.finite = rel.matrix().allFinite() && std::isfinite(res.displacement);
@@ -115,13 +119,22 @@ void run_script(BulletWorld& w, btRigidBody* object, HandBodies& hb, const HandM
       ref = relative(palm_pose);
       res.squeeze_displacement = (ref.translation() - start.translation()).norm();
     }
+    if (k + 1 == lift_end_step) {
+      lifted_pose = relative(palm_pose);
+      after_lift = true;
+    }
     if ((k + 1) % 24 == 0) {
       measure(palm_pose);
-      if (!res.finite || res.displacement > lost) break;
+      // Lost for good: left behind by the rising palm, or moved off in the hand after the lift.
+      const double lag = palm_pose.translation().z() - hand_pose.translation().z() - res.height_gain;
+      if (!res.finite || lag > lost || res.hold_displacement > lost) break;
     }
   }
   measure(palm_pose);
-  res.lifted = res.finite && res.displacement < o.success_distance;
+  // Came up with the hand (rose at least lift_height - success_distance) and held through the
+  // shake and the hold (moved less than success_distance in the palm frame after the lift).
+  res.lifted = res.finite && res.height_gain >= o.lift_height - o.success_distance &&
+               res.hold_displacement < o.success_distance;
   res.skipped_queries = w.skipped_queries();
   res.breakaway.resize(static_cast<Eigen::Index>(hand.fingers().size()));
   for (Eigen::Index f = 0; f < res.breakaway.size(); ++f) res.breakaway[f] = model.driven(static_cast<int>(f));

@@ -45,7 +45,9 @@ void check_options(const LiftOptions& o) {
   nonneg(o.hold_time, "hold_time");
   nonneg(o.finger_torque, "finger_torque");
   nonneg(o.closing_speed, "closing_speed");
+  nonneg(o.worm_backlash, "worm_backlash");
   pos(o.link_mass, "link_mass");
+  nonneg(o.drive_inertia, "drive_inertia");
   pos(o.success_distance, "success_distance");
   pos(o.tet_depth, "tet_depth");
   nonneg(o.margin, "margin");
@@ -70,6 +72,12 @@ LiftTester::LiftTester(const HandModel& hand, const TriMesh& object, const LiftO
     : impl_(std::make_unique<Impl>()) {
   check_options(options);
   validate_mesh(object);
+  if (!(options.finger_torque > 0))
+    for (const Finger& f : hand.fingers())
+      for (const Phalanx& p : f.phalanges)
+        if (!(p.torque > 0))
+          throw std::invalid_argument("hand '" + hand.name() + "' gives no torque for " + f.name + "/" + p.name +
+                                      " (torque_nm in the hand file); pass finger_torque > 0");
   impl_->hand = hand;
   impl_->opt = options;
   impl_->object = physics::prepare_object(object, options, convex_pieces);
@@ -106,7 +114,8 @@ LiftResult LiftTester::simulate(const Iso3& hand_pose, const Eigen::VectorXd& jo
   physics::BulletWorld w(im.opt);
   btRigidBody* object = physics::add_object(w, im.object, res.shape, im.opt);
   physics::HandBodies hand = physics::add_hand(w, im.hand, hand_pose, joints, poses, im.opt);
-  physics::SqueezeModel squeeze(im.hand, joints, im.opt.closing_speed, im.opt.finger_torque, im.opt.time_step);
+  physics::SqueezeModel squeeze(im.hand, joints, im.opt.closing_speed, im.opt.finger_torque, im.opt.time_step,
+                                  im.opt.worm_backlash);
   physics::run_script(w, object, hand, im.hand, squeeze, hand_pose, im.object.mass.com.z(), im.opt, res, trace);
   return res;
 }

@@ -11,10 +11,11 @@ constexpr double kBeyondCoupling = 1e-3; // rad: a start this far past the closi
 }  // namespace
 
 SqueezeModel::SqueezeModel(const HandModel& hand, const Eigen::VectorXd& joints, double closing_speed,
-                           double finger_torque, double time_step)
+                           double finger_torque, double time_step, double backlash)
     : hand_(hand),
       speed_(closing_speed),
       torque_(finger_torque),
+      backlash_(backlash),
       stall_steps_(std::max(1, static_cast<int>(std::ceil(kStallTime / time_step - 1e-9)))),
       driven_(hand.fingers().size(), 0),
       stall_(hand.fingers().size(), 0),
@@ -81,14 +82,15 @@ void SqueezeModel::set_commands() {
       JointCommand& c = cmd_[k];
       c = JointCommand{};
       c.upper = ph.upper;
-      c.lower = std::min(reached_[k], ph.upper);  // the worm: never open
+      // The worm: never opens by more than its backlash below the largest angle reached.
+      c.lower = std::max(ph.lower, std::min(reached_[k], ph.upper) - backlash_);
       if (j < a) {
         // Locked by the breakaway where it was (the largest angle reached).
-        c.upper = c.lower;
+        c.upper = std::min(reached_[k], ph.upper);
       } else if (j == a) {
         c.driven = true;
         c.velocity = speed_;
-        c.max_torque = torque_;
+        c.max_torque = torque_ > 0 ? torque_ : ph.torque;  // the override, else the hand file's
       } else {
         // Coupled: the transmission holds it to the driven joint, whose worm holds both; its
         // own limits are the hand file's.

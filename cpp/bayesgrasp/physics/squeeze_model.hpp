@@ -2,8 +2,9 @@
 // finger, free of Bullet (hand_bodies applies it to the hinges, lift_script calls it).
 //
 // One motor per finger. It drives one phalanx at a time, the finger's *driven* phalanx a
-// (initially 0, the proximal): a velocity servo towards `closing_speed` with at most
-// `finger_torque` N m at that joint. The phalanges after a are coupled to it by the
+// (initially 0, the proximal): a velocity servo towards `closing_speed` with at most the
+// hand file's torque for that joint (Phalanx::torque, the hand's actuation) or, when
+// `finger_torque` > 0, that override at every joint. The phalanges after a are coupled to it by the
 // transmission (the hand file's closing law q_j = offset_j + ratio_j t): while coupled,
 //     dq_j/dt = (ratio_j / ratio_a) dq_a/dt,   j > a,                                   (S1)
 // a rigid gear, so their loads are carried by the same motor (virtual work: the torque at
@@ -11,14 +12,20 @@
 // driven phalanx is stopped by the object - it touches the object and its joint has turned
 // slower than `kStallFraction` x closing_speed for `kStallTime` s - or it reaches its upper
 // limit, it is locked where it is and the motor drives the next phalanx (a + 1, the distal),
-// still at most `finger_torque`, with the phalanges after it coupled by (S1). The last
+// at most its own joint's torque, with the phalanges after it coupled by (S1). The last
 // phalanx stays driven: the finger then keeps pressing, stalled or not. A stalled finger whose
 // driven phalanx does not touch the object (the distal touches first) does not break away:
 // it presses through the coupling, as the real hand does.
-// Worm drive (not backdrivable): the driven joint does not open - its lower limit is the
-// largest angle it has reached (a ratchet) - and the coupled ones cannot either, held to it by
-// the transmission; upper limits are the hand file's. A locked phalanx has lower = upper = the
-// largest angle it reached. There is no travel limit: a finger follows the object wherever
+// Worm drive (not backdrivable): the driven joint does not open by more than the worm's
+// `backlash` - its lower limit is the largest angle it has reached minus the backlash (a
+// ratchet) - and the coupled ones cannot either, held to it by the transmission; upper limits
+// are the hand file's. A locked phalanx stays between the largest angle it reached and that
+// minus the backlash. Why a backlash: a rigid contact is resolved a little at a time, so a
+// pressing finger is always slightly inside the object; a lock at the deepest angle reached
+// holds that overlap, and pushing it out against the lock makes a force the motor never
+// applied (a BH8 fingertip pressed on a fixed plate at its 1.1 N m: 26 N after 0.25 s and 34 N
+// after 0.4 s, still rising, instead of 20 N; tests/python/test_lift_strength.py). A backlash of 0.01 rad (0.5 mm at a 5 cm
+// fingertip) lets the overlap out while the motor keeps pressing, at the motor's force. There is no travel limit: a finger follows the object wherever
 // it goes, up to its joint limits.
 // Start: the closed grasp may already be past breakaway (the contact simulator froze the
 // proximal and closed the distal further): phalanx a is taken as broken away when a later
@@ -52,9 +59,10 @@ class SqueezeModel {
   static constexpr double kStallTime = 0.01;
 
   /// `joints`: the closed grasp (HandModel layout, within the limits); `closing_speed` rad/s,
-  /// `finger_torque` N m, `time_step` s.
+  /// `finger_torque` N m (> 0: every driven joint's limit; 0: each phalanx's Phalanx::torque),
+  /// `time_step` s, `backlash` rad (the worm's, >= 0).
   SqueezeModel(const HandModel& hand, const Eigen::VectorXd& joints, double closing_speed, double finger_torque,
-               double time_step);
+               double time_step, double backlash = 0.0);
 
   /// One step of the law from the joints' angles and velocities (HandModel layout) and which
   /// hand links touch the object (indexed like HandModel::links()). Returns true when a
@@ -72,7 +80,7 @@ class SqueezeModel {
   bool at_upper(int finger, int phalanx, const Eigen::VectorXd& q) const;
 
   HandModel hand_;
-  double speed_, torque_;
+  double speed_, torque_, backlash_;
   int stall_steps_;
   std::vector<int> driven_, stall_;
   std::vector<double> reached_;  // largest angle reached per joint (the worm lock)
