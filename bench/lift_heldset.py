@@ -8,8 +8,14 @@ at the start):
     above, aimed near the object's centre with random roll, ``--per-category-object`` each.
 Per object one ``.npz`` (no pickle) in ``--out``: the mesh, convex pieces (concave objects), mass
 properties, friction and density, the hand's link shapes and joints, and per grasp the hand pose,
-closed joints, link poses, our verdict, displacement, shape used and breakaway state. With
-``--held-share N`` it also prints the held share of N force-closure top grasps per Pub. II object.
+closed joints, link poses, our verdict (lifted) and its quantities (hold_displacement: moved in
+the palm frame from the end of the lift to the end; height_gain: the centre of mass's world rise),
+displacement (after the squeeze to the end), shape used and breakaway state; the lift options'
+finger_torque (0: the hand file's torque_nm). ``--sweep-torques 0.25,0.5,1,2,3`` also stores our
+verdicts at each torque (every driven joint) and at the hand's own (sweep_torques, sweep_lifted
+(T, N); the last row "hand"), for bench/lift_torque_mujoco.py. ``--objects`` restricts the objects
+(names of both lists; the random picks of the later objects then differ). With ``--held-share N``
+it also prints the held share of N force-closure top grasps per Pub. II object.
 
     BAYESGRASP_CORE_DIR=build/dev/bayesgrasp_core PYTHONPATH=python python bench/lift_heldset.py --out bench/results/heldset
 """
@@ -53,7 +59,7 @@ def force_closure(b):
     return np.flatnonzero((np.asarray(b.epsilon) > 0) & ~np.asarray(b.collision_at_start, bool))
 
 
-def export(w, name, b, idx, source, out):
+def export(w, name, b, idx, source, out, sweep=()):
     tester = w.lift_tester()
     P, J = b.hand_pose[idx], b.joint_angles[idx]
     r = tester.run_batch(P, J, threads=1)
@@ -65,6 +71,11 @@ def export(w, name, b, idx, source, out):
     pieces = []
     if tester.num_pieces > 0:
         pieces = [p @ T[:3, :3].T + T[:3, 3] for p in physics.convex_decomposition(obj.vertices, obj.faces)]
+    sweep_lifted = []  # our verdicts at each torque of the sweep, then at the hand file's (0)
+    for t in (list(sweep) + [0.0]) if sweep else []:
+        st = physics.LiftTester(w.hand.path, w.vertices, w.faces, convex_pieces=pieces or None, mu=w.mu,
+                                density=obj.density, table=w.table, finger_torque=float(t))
+        sweep_lifted.append(np.asarray(st.run_batch(P, J, threads=1).lifted, bool))
     shapes = []  # per link: type (0 box, 1 capsule), center, half_extents, p0, p1, radius
     for li, ss in enumerate(hand.link_shapes()):
         for s in ss:
@@ -80,11 +91,16 @@ def export(w, name, b, idx, source, out):
         V=w.vertices, F=np.asarray(w.faces), num_pieces=np.array(len(pieces)),
         mass=np.array(m.mass), com=np.asarray(m.com), mu=np.array(w.mu), density=np.array(obj.density),
         hand_pose=P, joints=J, link_poses=links, lifted=np.asarray(r.lifted), displacement=np.asarray(r.displacement),
+        hold_displacement=np.asarray(r.hold_displacement), height_gain=np.asarray(r.height_gain),
+        finite=np.asarray(r.finite), finger_torque=np.array(float(physics.make_options().finger_torque)),  # World.lift_tester's
         shape=np.array(r.shape), breakaway=br, epsilon=np.asarray(b.epsilon)[idx],
         link_shapes=np.array(shapes, float), joint_limits=np.asarray(hand.joint_limits),
         finger_links=np.array(fingers, int), link_names=np.array(hand.links),
         hand_json=np.array(open(hand.path).read()),
     )
+    if sweep:
+        data["sweep_torques"] = np.array([float(t) for t in sweep] + [0.0])  # 0: the hand file's
+        data["sweep_lifted"] = np.array(sweep_lifted, bool).reshape(len(sweep) + 1, len(idx))
     for i, p in enumerate(pieces):
         data[f"piece_{i}"] = p
     safe = name.replace("/", "_")
@@ -102,11 +118,24 @@ def main():
                     help="also print the held share of N force-closure top grasps per Pub. II object (a finer grid)")
     ap.add_argument("--held-share-only", action="store_true", help="only the held shares, no export")
     ap.add_argument("--seed", type=int, default=0)
+    ap.add_argument("--objects", default=None,
+                    help="comma-separated objects to export (default: all; e.g. cube,mug/0)")
+    ap.add_argument("--sweep-torques", default="",
+                    help="N m, comma-separated: also store our verdicts at each torque and the hand's (e.g. 0.25,0.5,1,2,3)")
     a = ap.parse_args()
+    sweep = [float(t) for t in a.sweep_torques.split(",") if t.strip()]
+    if any(not (np.isfinite(t) and t > 0) for t in sweep):
+        ap.error("--sweep-torques: torques must be > 0")
+    wanted = None if a.objects is None else [o.strip() for o in a.objects.split(",") if o.strip()]
+    unknown = [o for o in wanted or [] if o not in PUB2 + CATEGORY]
+    if unknown:
+        ap.error(f"--objects: unknown {unknown} (known: {PUB2 + CATEGORY})")
     os.makedirs(a.out, exist_ok=True)
     rng = np.random.default_rng(a.seed)
     total, summary = 0, {}
     for name in PUB2:
+        if wanted is not None and name not in wanted:
+            continue
         t0 = time.time()
         w = World.single(name)
         b = w.grasp_batch(top_grid(w), threads=0)
@@ -121,11 +150,13 @@ def main():
         if a.held_share_only:
             continue
         idx = rng.choice(fc, size=min(a.per_object, len(fc)), replace=False)
-        r = export(w, name, b, idx, "top", a.out)
+        r = export(w, name, b, idx, "top", a.out, sweep)
         total += len(idx)
         print(f"{name}: {len(fc)} force-closure top grasps, exported {len(idx)}, lifted {int(np.sum(r.lifted))} "
               f"({time.time() - t0:.1f} s)", file=sys.stderr, flush=True)
-    for name in [] if a.held_share_only else CATEGORY:
+    for name in [] if a.held_share_only or a.per_category_object <= 0 else CATEGORY:
+        if wanted is not None and name not in wanted:
+            continue
         w = World.single(name)
         d, tg, rolls = approaches(w, 12 * a.per_category_object, rng)
         b = w.approach_batch(d, tg, rolls, threads=0)
@@ -133,7 +164,7 @@ def main():
         idx = fc[: a.per_category_object]
         if len(idx) == 0:
             continue
-        r = export(w, name, b, idx, "approach", a.out)
+        r = export(w, name, b, idx, "approach", a.out, sweep)
         total += len(idx)
         print(f"{name}: {len(fc)} force-closure approaches, exported {len(idx)}, lifted {int(np.sum(r.lifted))}",
               file=sys.stderr, flush=True)

@@ -7,12 +7,21 @@ body with our mesh's mass, centre of mass and inertia, its collision shape the c
 the convex pieces our lift test used for that grasp, the table a plane; friction mu on the
 hand and table_mu on the table (geom priority), condim 3, elliptic cones.
 The squeeze model as in cpp/bayesgrasp/physics/squeeze_model.hpp: one velocity-servo motor
-per finger (target closing_speed, at most finger_torque) on its driven phalanx, the later
+per finger (target closing_speed) on its driven phalanx, at most that joint's torque from the
+hand file (each phalanx's torque_nm; ``--finger-torque T`` > 0: T at every joint), the later
 phalanges coupled by joint equalities (q_j = c + ratio_j / ratio_a q_a), breakaway when the
 driven phalanx touches the object and has stalled for 10 ms or reaches its limit (equality
-off, the phalanx locked by its range), the worm lock as a ratchet on every joint's lower limit.
+off, the phalanx locked by its range), the worm lock as a ratchet with a backlash: a driven
+joint's lower limit max(hand lower, largest angle reached - 0.01 rad), a locked phalanx held in
+[largest reached - 0.01 rad, largest reached], a coupled one within the hand file's limits (held
+by the equality). Each phalanx has the drive's reflected inertia, 1e-3 kg m^2 about its joint
+(the joint's armature).
 Script: squeeze 0.15 s, lift 10 cm in 0.4 s (cosine), 3-axis shake 1 cm 3 Hz 0.5 s, hold 0.1 s;
-verdict: the object's centre of mass moved < 2 cm in the palm frame after the squeeze.
+verdict (lift_test.hpp): lifted = finite, the object's centre of mass rose >= 10 - 2 cm in the
+world (height_gain, end minus start), and moved < 2 cm in the palm frame from the end of the
+lift to the end (hold_displacement). Stopped early when lost: lagging the palm's rise by more
+than 5 cm, or moved more than 5 cm in the palm frame after the lift. ``displacement`` (end vs
+after the squeeze, palm frame) is reported for diagnosis.
 Prints the verdict agreement with ours and writes per-grasp rows (JSON) for the report.
 
     .venv-mj/bin/python bench/lift_mujoco.py bench/results/heldset --out bench/results/lift_mujoco.json
@@ -29,9 +38,27 @@ import mujoco
 
 SQUEEZE, LIFT, SHAKE, HOLD = 0.15, 0.40, 0.5, 0.1
 LIFT_H, SHAKE_A, SHAKE_F = 0.10, 0.01, 3.0
-SUCCESS, LOST = 0.02, 0.05
-TORQUE, SPEED, LINK_MASS = 0.5, 1.0, 0.08
+SUCCESS = 0.02
+LOST = max(0.05, 2.5 * SUCCESS)
+SPEED, LINK_MASS = 1.0, 0.08
+BACKLASH, DRIVE_INERTIA = 0.01, 1e-3  # rad (the worm's), kg m^2 (the drive's, as the joint's armature)
 STALL_FRACTION, STALL_TIME = 0.1, 0.01
+
+
+def joint_torques(hand, finger_torque=0.0):
+    """Per finger, per phalanx: the motor's torque limit at that joint (N m): finger_torque if > 0,
+    else the hand file's torque_nm (squeeze_model.cpp)."""
+    if finger_torque and finger_torque > 0:
+        return [[float(finger_torque)] * len(fi["phalanges"]) for fi in hand["fingers"]]
+    out = []
+    for fi in hand["fingers"]:
+        row = []
+        for ph in fi["phalanges"]:
+            if ph.get("torque_nm") is None:
+                raise ValueError(f"hand file: no torque_nm for {fi['name']}/{ph['name']}; pass --finger-torque")
+            row.append(float(ph["torque_nm"]))
+        out.append(row)
+    return out
 
 
 def palm_offset(t):
@@ -86,8 +113,9 @@ def shape_geoms(rows, T, cls):
     return out
 
 
-def build(z, g, hand, timestep):
+def build(z, g, hand, timestep, finger_torque=0.0):
     """The MJCF of grasp g of the exported object z; returns (xml, meta)."""
+    torques = joint_torques(hand, finger_torque)
     V, F = z["V"], z["F"]
     link_poses, q0 = z["link_poses"][g], z["joints"][g]
     shapes, fingers = z["link_shapes"], z["finger_links"]
@@ -111,11 +139,13 @@ def build(z, g, hand, timestep):
             continue
         palm_geoms += shape_geoms(by_link.get(li, []), Pinv @ link_poses[li], "hand")
     joint_of = {}
+    torque_of = {}
     jf = hand["fingers"]
     k = 1
     for f, links in enumerate(fingers):
         for j, l in enumerate(links):
             joint_of[int(l)] = k
+            torque_of[k] = torques[f][j]
             k += 1
 
     def chain(f, j, parent_T):
@@ -129,11 +159,11 @@ def build(z, g, hand, timestep):
         inner = chain(f, j + 1, T) if j + 1 < len(fingers[f]) else ""
         return (f'<body name="l{l}" pos="{fmt(rel[:3, 3])}" quat="{fmt(quat(rel[:3, :3]))}">'
                 f'<inertial pos="0 0 0" mass="{LINK_MASS}" diaginertia="{fmt([LINK_MASS * 1e-4, LINK_MASS * L * L / 3, LINK_MASS * L * L / 3])}"/>'
-                f'<joint name="j{kq}" type="hinge" axis="0 1 0" limited="true" range="{min(lo, 0):.9g} {max(hi, 1e-6):.9g}" damping="0"/>'
+                f'<joint name="j{kq}" type="hinge" axis="0 1 0" limited="true" range="{min(lo, 0):.9g} {max(hi, 1e-6):.9g}" damping="0" armature="{DRIVE_INERTIA:.9g}"/>'
                 + "".join(shape_geoms(by_link.get(l, []), np.eye(4), "hand")) + inner + "</body>")
 
     fingers_xml = "".join(chain(f, 0, P) for f in range(len(fingers)))
-    acts = "".join(f'<velocity name="a{kq}" joint="j{kq}" kv="1" forcelimited="true" forcerange="{-TORQUE} {TORQUE}"/>'
+    acts = "".join(f'<velocity name="a{kq}" joint="j{kq}" kv="1" forcelimited="true" forcerange="{-torque_of[kq]:.9g} {torque_of[kq]:.9g}"/>'
                    for kq in range(1, k))
     eqs = []
     for f, links in enumerate(fingers):
@@ -168,11 +198,13 @@ def build(z, g, hand, timestep):
 <actuator>{acts}</actuator>
 <equality>{"".join(eqs)}</equality>
 </mujoco>"""
-    return xml, dict(joint_of=joint_of, njoints=k)
+    return xml, dict(joint_of=joint_of, njoints=k, torque_of=torque_of)
 
 
-def replay(z, g, hand, timestep, verbose=False):
-    xml, meta = build(z, g, hand, timestep)
+def replay(z, g, hand, timestep, verbose=False, finger_torque=0.0):
+    """MuJoCo's lift test of grasp g: lifted, displacement, hold_displacement, height_gain, finite,
+    breakaway (finger_torque > 0: every motor's limit; 0: the hand file's)."""
+    xml, meta = build(z, g, hand, timestep, finger_torque)
     m = mujoco.MjModel.from_xml_string(xml)
     d = mujoco.MjData(m)
     fingers = z["finger_links"]
@@ -207,7 +239,8 @@ def replay(z, g, hand, timestep, verbose=False):
             a += 1
         driven.append(a)
     reached = {kq: 0.0 for kq in jid}  # the worm lock (relative to the closed angles)
-    locked = set()
+    base = {kq: m.jnt_range[jid[kq]].copy() for kq in jid}  # the hand file's limits (relative)
+    phalanx = {kq: (f, j) for f in range(nf) for j, kq in enumerate(kj[f])}
     stall = [0] * nf
     stall_steps = max(1, int(np.ceil(STALL_TIME / timestep - 1e-9)))
 
@@ -218,8 +251,6 @@ def replay(z, g, hand, timestep, verbose=False):
             m.actuator_gainprm[aid[kq], 0] = 1e3 if on else 0.0
             m.actuator_biasprm[aid[kq], 2] = -1e3 if on else 0.0
             d.ctrl[aid[kq]] = SPEED if on else 0.0
-            if j < a:
-                locked.add(kq)
         for j in range(1, len(kj[f])):
             for b in range(j):
                 e = m.equality(f"e{f}_{j}_{b}").id
@@ -233,6 +264,7 @@ def replay(z, g, hand, timestep, verbose=False):
         set_drive(f)
     steps = int(np.ceil((SQUEEZE + LIFT + SHAKE + HOLD) / timestep - 1e-9))
     sq_steps = int(np.ceil(SQUEEZE / timestep - 1e-9))
+    lift_steps = int(np.ceil((SQUEEZE + LIFT) / timestep - 1e-9))
     P = z["hand_pose"][g]
     R, p0 = P[:3, :3], P[:3, 3].copy()
     rel = lambda pp: R.T @ (d.xipos[obj_body] - pp)
@@ -240,8 +272,19 @@ def replay(z, g, hand, timestep, verbose=False):
     palm_v = [m.jnt_dofadr[m.joint(n).id] for n in ("px", "py", "pz")]
     mujoco.mj_forward(m, d)
     ref = rel(p0)
-    disp = 0.0
+    lifted_rel = None  # the object in the palm frame at the end of the lift
+    z0 = float(d.xipos[obj_body][2])
     pp = p0
+
+    def measure():
+        r = rel(pp)
+        disp = float(np.linalg.norm(r - ref))
+        hold = float(np.linalg.norm(r - lifted_rel)) if lifted_rel is not None else 0.0
+        gain = float(d.xipos[obj_body][2]) - z0
+        bad = d.warning[mujoco.mjtWarning.mjWARN_BADQACC].number > 0  # MuJoCo reset the state
+        finite = bool(np.all(np.isfinite(d.qpos)) and np.isfinite(disp) and not bad)
+        return disp, hold, gain, finite
+
     for s in range(steps):
         t = (s + 1) * timestep
         # The palm follows the script kinematically: position and velocity set every step
@@ -252,15 +295,22 @@ def replay(z, g, hand, timestep, verbose=False):
         d.qpos[palm_q] = prev
         d.qvel[palm_v] = (nxt - prev) / timestep
         pp = p0 + nxt
-        # Worm lock: lower limit = the largest angle reached; locked phalanges held.
+        # Worm lock with a backlash (squeeze_model.cpp): a driven joint opens at most BACKLASH
+        # below the largest angle reached, a locked one stays in [that - BACKLASH, that], a
+        # coupled one keeps the hand file's limits (the equality holds it to the driven one).
         for kq in jid:
             q = d.qpos[qadr[kq]]
             reached[kq] = max(reached[kq], q)
-            hi = np.radians(0) + m.jnt_range[jid[kq], 1]
-            if kq in locked:
-                m.jnt_range[jid[kq]] = [reached[kq], reached[kq] + 1e-6]
+            lo, hi = base[kq]
+            f, j = phalanx[kq]
+            top = min(reached[kq], hi)
+            if j < driven[f]:
+                low = max(lo, top - BACKLASH)
+                m.jnt_range[jid[kq]] = [low, max(top, low + 1e-6)]
+            elif j == driven[f]:
+                m.jnt_range[jid[kq]] = [min(max(lo, top - BACKLASH), hi - 1e-6), hi]
             else:
-                m.jnt_range[jid[kq], 0] = min(reached[kq], hi - 1e-6)
+                m.jnt_range[jid[kq]] = [lo, hi]
         mujoco.mj_step(m, d)
         # Breakaway: the driven phalanx touches the object and has stalled, or is at its limit.
         n = d.ncon
@@ -295,19 +345,34 @@ def replay(z, g, hand, timestep, verbose=False):
                       file=sys.stderr)
         if s + 1 == sq_steps:
             ref = rel(pp)
+        if s + 1 == lift_steps:
+            lifted_rel = rel(pp)
         if (s + 1) % 24 == 0:
-            disp = float(np.linalg.norm(rel(pp) - ref))
-            if not np.isfinite(disp) or disp > LOST:
+            disp, hold, gain, finite = measure()
+            # Lost for good: left behind by the rising palm, or moved off in the hand after the lift.
+            lag = (pp[2] - p0[2]) - gain
+            if not finite or lag > LOST or hold > LOST:
                 break
-    disp = float(np.linalg.norm(rel(pp) - ref))
-    return dict(lifted=bool(np.isfinite(disp) and disp < SUCCESS), displacement=disp, breakaway=driven)
+    disp, hold, gain, finite = measure()
+    lifted = finite and gain >= LIFT_H - SUCCESS and hold < SUCCESS
+    return dict(lifted=bool(lifted), displacement=disp, hold_displacement=hold, height_gain=gain, finite=finite,
+                breakaway=driven)
+
+
+def near_threshold(hold, gain):
+    """Distance (m) of a verdict's quantities to their thresholds: the hold displacement to
+    SUCCESS, the final lag behind the palm (LIFT_H - height_gain) to SUCCESS; nan-safe (inf)."""
+    d = [abs(hold - SUCCESS), abs(LIFT_H - gain - SUCCESS)]
+    d = [x for x in d if np.isfinite(x)]
+    return min(d) if d else np.inf
 
 
 def cause(r):
-    """A disagreement's likely cause, from the two displacements and breakaway states."""
-    near = min(abs(r["ours_displacement"] - SUCCESS), abs(r["mujoco_displacement"] - SUCCESS))
+    """A disagreement's likely cause, from the two verdicts' quantities and breakaway states."""
+    near = min(near_threshold(r.get("ours_hold_displacement", np.nan), r.get("ours_height_gain", np.nan)),
+               near_threshold(r.get("mujoco_hold_displacement", np.nan), r.get("mujoco_height_gain", np.nan)))
     if near < 0.005:
-        return "marginal (a displacement within 5 mm of 2 cm)"
+        return "marginal (hold displacement or lag within 5 mm of 2 cm)"
     if r["ours_breakaway"] != r["mujoco_breakaway"]:
         return "breakaway differs (squeeze: which phalanx the motor drove)"
     if r["shape"] == "decomposition":
@@ -338,8 +403,30 @@ def summarize(rows):
     for c, rs in sorted(causes.items(), key=lambda kv: -len(kv[1])):
         print(f"  {len(rs):3d}  {c}")
         for r in rs:
-            print(f"         {r['object']:10s} {r['source']:8s} #{r['grasp']:<3d} {r['shape']:13s} ours {r['ours_displacement'] * 100:6.2f} cm "
-                  f"(break {r['ours_breakaway']}), mujoco {r['mujoco_displacement'] * 100:6.2f} cm (break {r['mujoco_breakaway']})")
+            print(f"         {r['object']:10s} {r['source']:8s} #{r['grasp']:<3d} {r['shape']:13s} "
+                  f"ours {r['ours_displacement'] * 100:6.2f} cm hold {r.get('ours_hold_displacement', np.nan) * 100:5.2f} "
+                  f"gain {r.get('ours_height_gain', np.nan) * 100:6.2f} (break {r['ours_breakaway']}), "
+                  f"mujoco {r['mujoco_displacement'] * 100:6.2f} cm hold {r.get('mujoco_hold_displacement', np.nan) * 100:5.2f} "
+                  f"gain {r.get('mujoco_height_gain', np.nan) * 100:6.2f} (break {r['mujoco_breakaway']})")
+
+
+def load(path):
+    """One exported object (bench/lift_heldset.py's .npz) as a dict, and its hand (the JSON)."""
+    with np.load(path, allow_pickle=False) as zf:
+        z = {k: zf[k] for k in zf.files}
+    return z, json.loads(str(z["hand_json"]))
+
+
+def ours(z, key, g):
+    """Our exported value (nan when an older export lacks the field)."""
+    return float(z[key][g]) if key in z else float("nan")
+
+
+def positive_or_zero(text):
+    v = float(text)
+    if not (np.isfinite(v) and v >= 0):
+        raise argparse.ArgumentTypeError(f"expected a torque > 0 (N m) or 0 (the hand file's), got {text}")
+    return v
 
 
 def main():
@@ -348,6 +435,8 @@ def main():
     ap.add_argument("--out", default="bench/results/lift_mujoco.json")
     ap.add_argument("--timestep", type=float, default=0.001)
     ap.add_argument("--max-grasps", type=int, default=0, help="per file (0: all)")
+    ap.add_argument("--finger-torque", type=positive_or_zero, default=0.0,
+                    help="N m, > 0: every motor's torque limit; 0 (default): the hand file's torque_nm per joint")
     ap.add_argument("--summary-only", action="store_true", help="summarize an existing --out file")
     a = ap.parse_args()
     if a.summary_only:
@@ -357,17 +446,18 @@ def main():
     rows = []
     t0 = time.time()
     for path in sorted(glob.glob(os.path.join(a.heldset, "*.npz"))):
-        with np.load(path, allow_pickle=False) as zf:
-            z = {k: zf[k] for k in zf.files}
-        hand = json.loads(str(z["hand_json"]))
+        z, hand = load(path)
         n = len(z["lifted"]) if a.max_grasps <= 0 else min(a.max_grasps, len(z["lifted"]))
         for g in range(n):
-            r = replay(z, g, hand, a.timestep)
+            r = replay(z, g, hand, a.timestep, finger_torque=a.finger_torque)
             rows.append(dict(object=str(z["name"]), source=str(z["source"][g]), grasp=g, shape=str(z["shape"][g]),
                              ours_lifted=bool(z["lifted"][g]), ours_displacement=float(z["displacement"][g]),
+                             ours_hold_displacement=ours(z, "hold_displacement", g),
+                             ours_height_gain=ours(z, "height_gain", g),
                              ours_breakaway=[int(x) for x in z["breakaway"][g]],
                              mujoco_lifted=r["lifted"], mujoco_displacement=r["displacement"],
-                             mujoco_breakaway=[int(x) for x in r["breakaway"]]))
+                             mujoco_hold_displacement=r["hold_displacement"], mujoco_height_gain=r["height_gain"],
+                             mujoco_finite=r["finite"], mujoco_breakaway=[int(x) for x in r["breakaway"]]))
         agree = sum(r["ours_lifted"] == r["mujoco_lifted"] for r in rows)
         print(f"{os.path.basename(path)}: {n} grasps; total {len(rows)}, agree {agree} ({time.time() - t0:.0f} s)",
               file=sys.stderr, flush=True)
