@@ -11,6 +11,12 @@ from ..models.settings import SUCCESS_CRITERIA
 from ..objects import ObjectModel
 
 
+def _plain(v):
+    """A settings value as JSON would give it back (tuples as lists, numpy scalars as numbers)."""
+    import json
+    return json.loads(json.dumps(v, default=lambda o: o.tolist() if hasattr(o, "tolist") else str(o)))
+
+
 def stderr_progress(message: str) -> None:
     """Progress messages go to stderr (stdout stays clean for --json)."""
     print(message, file=sys.stderr, flush=True)
@@ -54,6 +60,26 @@ class RunContext:
         (memoised per process)."""
         settings = settings or self.model_settings or ModelSettings(success=self.success)
         return get_models(obj, self.hand, settings, cache_dir=self.cache_dir, progress=self.progress)
+
+    def result_settings(self) -> dict:
+        """Every setting of this context that changes a run's result, as plain JSON values: the
+        package and cache versions, the hand (its name and a digest of its file), the success
+        criterion, the lift test on or off and the effective model settings. Stored beside an
+        experiment's results; a resume with different values is refused (runner.ResultStore)."""
+        import hashlib
+        from dataclasses import asdict
+        from pathlib import Path
+
+        from .. import __version__
+        from ..hand import Hand
+        from ..models.settings import CACHE_VERSION
+
+        hand = Hand.load(self.hand)
+        text = Path(hand.path).read_bytes() if getattr(hand, "path", None) else hand.name.encode()
+        models = self.model_settings or ModelSettings(success=self.success)
+        return {"bayesgrasp": __version__, "cache_version": CACHE_VERSION, "hand": hand.name,
+                "hand_file_sha256": hashlib.sha256(text).hexdigest()[:16], "success": self.success,
+                "lift": self.lift, "models": {k: _plain(v) for k, v in asdict(models).items()}}
 
     def for_workers(self) -> "RunContext":
         """The same context without the progress callable (worker processes get it pickled)."""

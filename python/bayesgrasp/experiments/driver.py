@@ -25,16 +25,20 @@ def run(name: str, out_dir, ctx: Optional[RunContext] = None, runs: Optional[int
         raise ValueError(f"workers: must be at least 1, got {workers}")
     objects = list(exp.objects if objects is None else objects)
     out = Path(out_dir)
-    if exp.prepare is not None:
-        exp.prepare(exp, objects, ctx)
+    worker_ctx = ctx.for_workers()
+    runs_of = {method: exp.make_run(exp, method, worker_ctx) for method in exp.methods}  # (series, fn)
+    settings = ctx.result_settings()
     store = ResultStore(out / "results.sqlite")
     results: Dict[str, list] = {}
-    worker_ctx = ctx.for_workers()
     try:
-        for method in exp.methods:
-            series, fn = exp.make_run(exp, method, worker_ctx)
+        # Refuse a resume under other settings before building anything.
+        for series, _ in runs_of.values():
+            store.check_settings(series, settings)
+        if exp.prepare is not None:
+            exp.prepare(exp, objects, ctx)
+        for method, (series, fn) in runs_of.items():
             results[method] = run_experiment(series, objects, runs, fn, store, ctx.seed, workers,
-                                             progress=ctx.progress is not None)
+                                             progress=ctx.progress is not None, settings=settings)
     finally:
         store.close()
     summary = exp.report(exp, results, out)

@@ -1,10 +1,12 @@
 """Run-by-run experiment execution with resume, worker processes and a progress bar.
 
-Every run is a pure function of (experiment, object, run index, seed): the runner hands the
-function those four values, stores what it returns (a JSON-serialisable dict) in an SQLite
-file as soon as the run finishes, and skips runs already stored when started again. So an
-interrupted experiment resumes where it stopped and loses nothing, and the same runs could
-be spread over any other engine without touching the planners.
+Every run is a pure function of (experiment, object, run index, seed) and the settings it runs
+under: the runner hands the function those four values, stores what it returns (a
+JSON-serialisable dict) in an SQLite file as soon as the run finishes, and skips runs already
+stored when started again. So an interrupted experiment resumes where it stopped and loses
+nothing, and the same runs could be spread over any other engine without touching the planners.
+The settings (package and cache versions, hand, success criterion, lift test, model settings)
+are stored beside the runs; resuming under other settings is refused with the differences named.
 """
 from __future__ import annotations
 
@@ -47,6 +49,7 @@ class ResultStore:
             self._db.execute(
                 "CREATE TABLE IF NOT EXISTS runs (experiment TEXT, object TEXT, run_index INTEGER,"
                 " seed INTEGER, result TEXT, PRIMARY KEY (experiment, object, run_index, seed))")
+            self._db.execute("CREATE TABLE IF NOT EXISTS settings (experiment TEXT PRIMARY KEY, settings TEXT)")
             self._db.commit()
         except (OSError, sqlite3.Error) as e:
             raise ValueError(f"cannot write results to {self.path}: {e}") from e
@@ -55,6 +58,31 @@ class ResultStore:
         rows = self._db.execute(
             "SELECT experiment, object, run_index, seed FROM runs WHERE experiment = ?", (experiment,))
         return {RunKey(*r) for r in rows}
+
+    def settings(self, experiment: str) -> dict | None:
+        """The settings the experiment's stored runs were made with (None: none recorded)."""
+        row = self._db.execute("SELECT settings FROM settings WHERE experiment = ?", (experiment,)).fetchone()
+        return None if row is None else json.loads(row[0])
+
+    def check_settings(self, experiment: str, settings: dict) -> None:
+        """Records `settings` for the experiment, or refuses (ValueError, nothing changed) when
+        runs are stored under other settings or under none recorded: a resume must not mix runs
+        made differently."""
+        stored = self.settings(experiment)
+        if stored is None:
+            n = self._db.execute("SELECT COUNT(*) FROM runs WHERE experiment = ?", (experiment,)).fetchone()[0]
+            if n:
+                raise ValueError(f"{self.path} holds {n} runs of {experiment} stored without their settings (an "
+                                 f"older bayesgrasp): they cannot be resumed safely; use another --out or delete "
+                                 f"the file to start again")
+            self._db.execute("INSERT INTO settings VALUES (?, ?)", (experiment, json.dumps(settings, sort_keys=True)))
+            self._db.commit()
+            return
+        diff = settings_difference(stored, settings)
+        if diff:
+            raise ValueError(f"{self.path} holds runs of {experiment} made with other settings ("
+                             + "; ".join(diff) + "): resuming would mix them; use another --out, or the same "
+                             "settings, or delete the file to start again")
 
     def add(self, key: RunKey, result: dict) -> None:
         self._db.execute("INSERT OR REPLACE INTO runs VALUES (?, ?, ?, ?, ?)",
@@ -69,6 +97,18 @@ class ResultStore:
 
     def close(self) -> None:
         self._db.close()
+
+
+def settings_difference(stored: dict, now: dict, prefix: str = "") -> list[str]:
+    """'key: stored X, now Y' for every (dotted) key whose value differs, sorted."""
+    out = []
+    for k in sorted(set(stored) | set(now)):
+        a, b = stored.get(k, "(unset)"), now.get(k, "(unset)")
+        if isinstance(a, dict) and isinstance(b, dict):
+            out += settings_difference(a, b, f"{prefix}{k}.")
+        elif a != b:
+            out.append(f"{prefix}{k}: stored {json.dumps(a)}, now {json.dumps(b)}")
+    return out
 
 
 def _die_with_parent(parent_pid: int, interval: float = 0.5) -> None:
@@ -94,15 +134,19 @@ def _call(fn, key: RunKey):
 
 def run_experiment(experiment: str, objects: Iterable[str], runs: int, fn: Callable[[str, str, int, int], dict],
                    store: ResultStore, base_seed: int = 0, workers: int = 1,
-                   progress: bool = True) -> list[tuple[RunKey, dict]]:
+                   progress: bool = True, settings: dict | None = None) -> list[tuple[RunKey, dict]]:
     """Runs ``fn(experiment, object, run_index, seed)`` for every object and run index not
     yet in ``store``, saving each result as soon as it arrives. ``fn`` must be a module-level
-    function (it is sent to worker processes). Returns every stored result of the experiment.
+    function (it is sent to worker processes). ``settings``: what else the results depend on
+    (:meth:`ResultStore.check_settings`: recorded with the first run, a resume with other values
+    is refused). Returns every stored result of the experiment.
     """
     if runs < 1:
         raise ValueError(f"runs must be at least 1, got {runs}")
     if workers < 1:
         raise ValueError(f"workers must be at least 1, got {workers}")
+    if settings is not None:
+        store.check_settings(experiment, settings)
     keys = [RunKey(experiment, o, i, run_seed(base_seed, experiment, o, i))
             for o in objects for i in range(runs)]
     done = store.done(experiment)

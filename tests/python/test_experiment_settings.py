@@ -1,0 +1,84 @@
+"""Issue 17: a resume must not mix runs made under different settings. The settings that change a
+result are stored beside the runs; resuming under other ones is refused with the difference named,
+and nothing is written."""
+import json
+import sqlite3
+
+import pytest
+
+from bayesgrasp.experiments.context import RunContext
+from bayesgrasp.experiments.runner import ResultStore, RunKey, run_experiment, settings_difference
+
+from test_cli import run_cli
+
+
+def _square(experiment, obj, run_index, seed):
+    return {"value": run_index * run_index}
+
+
+def test_settings_are_recorded_and_a_resume_under_others_is_refused(tmp_path):
+    store = ResultStore(tmp_path / "results.sqlite")
+    a = {"lift": True, "models": {"n_train": 400, "success": "lift"}, "hand": "BH8"}
+    run_experiment("e", ["cube"], 2, _square, store, progress=False, settings=a)
+    assert store.settings("e") == a
+    # the same settings resume: one more run computed, the stored two kept
+    assert len(run_experiment("e", ["cube"], 3, _square, store, progress=False, settings=a)) == 3
+    b = {"lift": False, "models": {"n_train": 800, "success": "lift"}, "hand": "BH8"}
+    with pytest.raises(ValueError) as e:
+        run_experiment("e", ["cube"], 4, _square, store, progress=False, settings=b)
+    msg = str(e.value)
+    assert "lift: stored true, now false" in msg and "models.n_train: stored 400, now 800" in msg
+    assert "hand" not in msg and "models.success" not in msg  # only what differs
+    assert len(store.results("e")) == 3 and store.settings("e") == a  # nothing written
+    # another series in the same file has its own settings
+    run_experiment("f", ["cube"], 1, _square, store, progress=False, settings=b)
+    assert store.settings("f") == b
+    store.close()
+
+
+def test_runs_stored_without_settings_are_not_resumed(tmp_path):
+    path = tmp_path / "results.sqlite"
+    db = sqlite3.connect(str(path))  # a file written before settings were stored
+    db.execute("CREATE TABLE runs (experiment TEXT, object TEXT, run_index INTEGER, seed INTEGER, result TEXT,"
+               " PRIMARY KEY (experiment, object, run_index, seed))")
+    db.execute("INSERT INTO runs VALUES ('e', 'cube', 0, 1, ?)", (json.dumps({"value": 0}),))
+    db.commit()
+    db.close()
+    store = ResultStore(path)
+    with pytest.raises(ValueError, match="1 runs of e stored without their settings"):
+        store.check_settings("e", {"lift": True})
+    assert store.settings("e") is None
+    store.add(RunKey("g", "cube", 0, 1), {"value": 0})  # a series without runs... would be refused too
+    with pytest.raises(ValueError):
+        store.check_settings("g", {"lift": True})
+    store.check_settings("h", {"lift": True})  # a new series is fine
+    store.close()
+
+
+def test_the_difference_names_nested_and_missing_keys():
+    d = settings_difference({"a": 1, "m": {"x": [1, 2], "y": "s"}}, {"a": 1, "m": {"x": [1, 3]}, "z": False})
+    assert d == ['m.x: stored [1, 2], now [1, 3]', 'm.y: stored "s", now "(unset)"', 'z: stored "(unset)", now false']
+
+
+def test_result_settings_cover_what_changes_a_result():
+    s = RunContext().result_settings()
+    assert {"bayesgrasp", "cache_version", "hand", "hand_file_sha256", "success", "lift", "models"} <= set(s)
+    assert s == json.loads(json.dumps(s))  # plain JSON
+    other = RunContext(success="epsilon", lift=False).result_settings()
+    diff = settings_difference(s, other)
+    assert any(x.startswith("lift:") for x in diff) and any(x.startswith("success:") for x in diff)
+    assert any(x.startswith("models.success:") for x in diff)
+    robotiq = RunContext(hand="robotiq_3f").result_settings()
+    assert robotiq["hand_file_sha256"] != s["hand_file_sha256"]
+
+
+def test_the_cli_refuses_to_resume_a_no_lift_run_with_the_lift_test(tmp_path):
+    base = ["experiment", "pub2", "--objects", "cube", "--runs", "1", "--out", str(tmp_path / "e"),
+            "--cache", str(tmp_path / "cache"), "--success", "epsilon"]
+    code, out, err = run_cli(*base, "--no-lift")
+    assert code == 0, err
+    before = (tmp_path / "e" / "results.sqlite").read_bytes()
+    code, out, err = run_cli(*base, "--runs", "2")  # the lift test on now
+    assert code != 0
+    assert "other settings" in err and "lift: stored false, now true" in err, err
+    assert (tmp_path / "e" / "results.sqlite").read_bytes() == before
