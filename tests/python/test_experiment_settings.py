@@ -82,3 +82,49 @@ def test_the_cli_refuses_to_resume_a_no_lift_run_with_the_lift_test(tmp_path):
     assert code != 0
     assert "other settings" in err and "lift: stored false, now true" in err, err
     assert (tmp_path / "e" / "results.sqlite").read_bytes() == before
+
+
+# ---- per-attempt rows as SQL tables; `bayesgrasp results` ------------------------------------------
+def _episode(experiment, obj, run_index, seed):
+    return {"success": run_index % 2 == 0, "attempts_used": 2, "true_pose": [0.0, 0.01, 0.2],
+            "attempts": [{"lifted": False, "epsilon": 0.01 * run_index, "hand_pose": [[1, 0], [0, 1]]},
+                         {"lifted": run_index % 2 == 0, "epsilon": None, "new-field": "x"}]}
+
+
+def test_attempts_become_rows_with_real_columns(tmp_path):
+    store = ResultStore(tmp_path / "results.sqlite")
+    run_experiment("e", ["cube", "mug"], 3, _episode, store, progress=False, settings={"lift": True})
+    assert store.flatten() == {"run_rows": 6, "attempts": 12}
+    store.close()
+    db = sqlite3.connect(str(tmp_path / "results.sqlite"))
+    # plain SQL, no JSON functions: the share lifted at the second attempt, per object
+    rows = db.execute("SELECT object, AVG(lifted), COUNT(*) FROM attempts WHERE position = 1 GROUP BY object"
+                      " ORDER BY object").fetchall()
+    assert rows == [("cube", 2 / 3, 3), ("mug", 2 / 3, 3)]
+    assert db.execute("SELECT SUM(success) FROM run_rows").fetchone()[0] == 4  # runs 0 and 2 of each object
+    cols = [r[1] for r in db.execute("PRAGMA table_info(attempts)")]
+    assert cols == ["experiment", "object", "run_index", "seed", "position", "lifted", "epsilon", "hand_pose",
+                    "new_field"]
+    assert json.loads(db.execute("SELECT hand_pose FROM attempts LIMIT 1").fetchone()[0]) == [[1, 0], [0, 1]]
+    run_cols = [r[1] for r in db.execute("PRAGMA table_info(run_rows)")]
+    assert run_cols == ["experiment", "object", "run_index", "seed", "success", "attempts_used", "true_pose"]
+    assert json.loads(db.execute("SELECT true_pose FROM run_rows LIMIT 1").fetchone()[0]) == [0.0, 0.01, 0.2]
+
+
+def test_the_results_command_lists_tables_and_runs_queries_read_only(tmp_path):
+    store = ResultStore(tmp_path / "results.sqlite")
+    run_experiment("e", ["cube"], 2, _episode, store, progress=False, settings={"lift": True})
+    store.close()  # not flattened: the command builds the tables
+    code, out, err = run_cli("results", str(tmp_path))
+    assert code == 0, err
+    assert "attempts (4 rows)" in out and "run_rows (2 rows)" in out and 'settings of e: {"lift": true}' in out
+    code, out, err = run_cli("results", str(tmp_path), "--sql",
+                             "SELECT run_index, position, lifted FROM attempts ORDER BY run_index, position", "--csv")
+    assert code == 0, err
+    assert out.splitlines() == ["run_index,position,lifted", "0,0,0", "0,1,1", "1,0,0", "1,1,0"]
+    code, out, err = run_cli("results", str(tmp_path), "--sql", "DELETE FROM runs")
+    assert code != 0 and "readonly" in err.replace("-", "").lower()
+    code, out, err = run_cli("results", str(tmp_path), "--sql", "SELECT nope FROM attempts")
+    assert code != 0 and "--sql: no such column: nope" in err
+    code, out, err = run_cli("results", str(tmp_path / "missing"))
+    assert code != 0 and "no results.sqlite" in err

@@ -5,6 +5,7 @@ Sub-commands:
   plan        the same loop for any object (built-in or mesh file) at a given true pose
   episode     the same loop with your robot executing: new, observe (joints, lifted), show
   experiment  the thesis's experiments (pub2, baselines, pub4, entropy_order, landscapes)
+  results     an experiment's stored results as SQL tables (--sql QUERY, --csv)
   grasp       close the hand on an object from a top grasp, an approach direction or a hand pose
   category    grasp a new member of a known category for a task (Eq. 4.1)
   fuse        vision then touch: per-model poses and weights from the fingers (Eqs. 4.4-4.6)
@@ -20,11 +21,11 @@ import argparse
 import os
 import sys
 
-from . import category, episode, experiment, fuse, grasp, objects, plan, register, touch, view
+from . import category, episode, experiment, fuse, grasp, objects, plan, register, results, touch, view
 from .. import __version__
 from .args import CliError, join_negative_values
 
-COMMANDS = (grasp, plan, episode, category, fuse, experiment, register, objects, touch, view)
+COMMANDS = (grasp, plan, episode, category, fuse, experiment, results, register, objects, touch, view)
 
 
 class HelpFormatter(argparse.RawDescriptionHelpFormatter):

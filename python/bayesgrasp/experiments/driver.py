@@ -39,6 +39,7 @@ def run(name: str, out_dir, ctx: Optional[RunContext] = None, runs: Optional[int
         for method, (series, fn) in runs_of.items():
             results[method] = run_experiment(series, objects, runs, fn, store, ctx.seed, workers,
                                              progress=ctx.progress is not None, settings=settings)
+        store.flatten()
     finally:
         store.close()
     summary = exp.report(exp, results, out)
