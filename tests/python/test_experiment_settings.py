@@ -128,3 +128,37 @@ def test_the_results_command_lists_tables_and_runs_queries_read_only(tmp_path):
     assert code != 0 and "--sql: no such column: nope" in err
     code, out, err = run_cli("results", str(tmp_path / "missing"))
     assert code != 0 and "no results.sqlite" in err
+
+
+# ---- experiments configured by file ----------------------------------------------------------------
+def test_a_config_file_sets_the_run_and_the_models_and_the_command_line_wins(tmp_path):
+    cfg = tmp_path / "pub2.toml"
+    cfg.write_text('objects = ["cube"]\nruns = 1\nsuccess = "epsilon"\nlift = false\n'
+                   f'cache = "{tmp_path / "cache"}"\n[models]\nn_samples = 300\n')
+    out = tmp_path / "e"
+    code, _, err = run_cli("experiment", "pub2", "--config", str(cfg), "--out", str(out))
+    assert code == 0, err
+    db = sqlite3.connect(str(out / "results.sqlite"))
+    settings = json.loads(db.execute("SELECT settings FROM settings").fetchone()[0])
+    assert settings["lift"] is False and settings["success"] == "epsilon" and settings["models"]["n_samples"] == 300
+    assert db.execute("SELECT COUNT(*) FROM runs").fetchone()[0] == 1
+    # the command line's --set wins over the file's [models]: a different setting, refused by the resume check
+    code, _, err = run_cli("experiment", "pub2", "--config", str(cfg), "--out", str(out), "--set", "models.n_samples=400")
+    assert code != 0 and "models.n_samples: stored 300, now 400" in err
+
+
+@pytest.mark.parametrize("text, message", [
+    ("speed = 3\n", "unknown key 'speed'"),
+    ("runs = \"many\"\n", "runs must be int"),
+    ("lift = 1\n", "lift must be bool"),
+    ("objects = [1, 2]\n", "objects must be a list of names"),
+    ("hand = \"no_such_hand\"\n", "unknown hand 'no_such_hand'"),
+    ("[models]\nno_such_field = 1\n", "--set: expected models.FIELD=VALUE"),
+    ("runs = [\n", "--config"),
+])
+def test_a_bad_config_file_is_refused_in_one_line(tmp_path, text, message):
+    cfg = tmp_path / "bad.toml"
+    cfg.write_text(text)
+    code, _, err = run_cli("experiment", "pub2", "--config", str(cfg), "--out", str(tmp_path / "e"))
+    assert code != 0 and message in err, err
+    assert not (tmp_path / "e" / "results.sqlite").exists()

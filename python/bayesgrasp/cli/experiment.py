@@ -1,9 +1,10 @@
 """``bayesgrasp experiment NAME``: run (or resume) one of the registered experiments."""
 from __future__ import annotations
 
+import argparse
 import time
 
-from .args import CliError, add_context_options, bounded_int, context, out_dir
+from .args import SEED_MAX, CliError, add_context_options, bounded_int, context, hand_name, out_dir
 
 
 def add(sub) -> None:
@@ -16,8 +17,49 @@ def add(sub) -> None:
     e.add_argument("--workers", type=bounded_int(1, 1024), default=1, help="worker processes")
     e.add_argument("--out", default=None, help="output directory (default: out/experiments/NAME)")
     e.add_argument("--objects", nargs="+", default=None, help="objects (default: the experiment's)")
+    e.add_argument("--config", default=None, metavar="FILE.toml",
+                   help="settings from a TOML file: runs, workers, out, objects, hand, success, lift, seed, cache at "
+                        "the top and a [models] table (ModelSettings fields); an option given on the command line "
+                        "(other than its default) and --set win over the file")
     add_context_options(e, lift=True)
     e.set_defaults(run=run)
+
+
+#: The TOML keys --config takes at its top level, with the option each sets and how it is checked.
+CONFIG_KEYS = {"runs": int, "workers": int, "out": str, "objects": list, "hand": str, "success": str,
+               "lift": bool, "seed": int, "cache": str}
+
+
+def apply_config(args, path: str, defaults: dict) -> None:
+    """Fills ``args`` from the TOML file where the command line left an option at its default;
+    [models] FIELD = VALUE becomes --set models.FIELD=VALUE before the command line's own --set."""
+    import tomllib
+
+    try:
+        with open(path, "rb") as f:
+            cfg = tomllib.load(f)
+    except OSError as e:
+        raise CliError(f"--config: cannot read {path}: {e.strerror or e}") from None
+    except tomllib.TOMLDecodeError as e:
+        raise CliError(f"--config: {path}: {e}") from None
+    models = cfg.pop("models", {})
+    if not isinstance(models, dict):
+        raise CliError(f"--config: {path}: models must be a table ([models])")
+    for key, value in cfg.items():
+        kind = CONFIG_KEYS.get(key)
+        if kind is None:
+            raise CliError(f"--config: {path}: unknown key {key!r} (known: {', '.join(CONFIG_KEYS)}, [models])")
+        if not isinstance(value, kind) or (kind is int and isinstance(value, bool)) or \
+                (kind is list and not all(isinstance(v, str) for v in value)):
+            raise CliError(f"--config: {path}: {key} must be {'a list of names' if kind is list else kind.__name__}, "
+                           f"got {value!r}")
+        if key == "lift":
+            if args.no_lift == defaults["no_lift"]:
+                args.no_lift = not value
+        elif getattr(args, key) == defaults[key]:
+            setattr(args, key, value)
+    args.set = [f"models.{k}={'none' if v is None else str(v).lower() if isinstance(v, bool) else v}"
+                for k, v in models.items()] + list(args.set)
 
 
 def run(args) -> int:
@@ -33,6 +75,18 @@ def run(args) -> int:
         get_experiment(args.name)
     except ValueError as e:
         raise CliError(str(e)) from None
+    if args.config:
+        apply_config(args, args.config, {"runs": None, "workers": 1, "out": None, "objects": None,
+                                         "hand": "barrett_bh8", "success": "lift", "no_lift": False, "seed": 0,
+                                         "cache": None})
+        if (args.runs is not None and args.runs < 1) or args.workers < 1 or not 0 <= args.seed <= SEED_MAX:
+            raise CliError(f"--config: {args.config}: runs and workers must be at least 1, seed in [0, 2^63 - 1]")
+        if args.success not in ("lift", "epsilon"):
+            raise CliError(f"--config: {args.config}: success must be 'lift' or 'epsilon', got {args.success!r}")
+        try:
+            hand_name(args.hand)
+        except argparse.ArgumentTypeError as e:
+            raise CliError(f"--config: {args.config}: {e}") from None
     for o in args.objects or ():
         load_object(o)  # a clear error for an unknown object
     out = out_dir(args.out or f"out/experiments/{args.name}")
