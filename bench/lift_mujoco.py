@@ -41,6 +41,9 @@ LIFT_H, SHAKE_A, SHAKE_F = 0.10, 0.01, 3.0
 SUCCESS = 0.02
 LOST = max(0.05, 2.5 * SUCCESS)
 SPEED, LINK_MASS = 1.0, 0.08
+#: The solref time constant (s) of the hand's and the object's geoms; None: MuJoCo's default (0.02 s,
+#: soft: a fingertip pressed with tens of newtons sinks millimetres in). Set by --contact-solref.
+CONTACT_SOLREF = None
 BACKLASH, DRIVE_INERTIA = 0.01, 1e-3  # rad (the worm's), kg m^2 (the drive's, as the joint's armature)
 STALL_FRACTION, STALL_TIME = 0.1, 0.01
 
@@ -171,14 +174,15 @@ def build(z, g, hand, timestep, finger_torque=0.0):
             for a in range(j):
                 eqs.append(f'<joint name="e{f}_{j}_{a}" joint1="j{joint_of[int(links[j])]}" '
                            f'joint2="j{joint_of[int(links[a])]}" polycoef="0 1 0 0 0" active="false"/>')
+    solref = "" if CONTACT_SOLREF is None else f' solref="{CONTACT_SOLREF:.9g} 1"'
     xml = f"""<mujoco>
 <compiler angle="radian"/>
 <option timestep="{timestep}" gravity="0 0 -9.81" cone="elliptic" impratio="10" integrator="implicitfast"/>
 <default>
   <joint solreflimit="{2 * timestep} 1" solimplimit="0.99 0.999 0.0001"/>
   <equality solref="{2 * timestep} 1" solimp="0.99 0.999 0.0001"/>
-  <default class="obj"><geom contype="1" conaffinity="6" condim="3" friction="{mu} 0.005 0.0001" priority="0"/></default>
-  <default class="hand"><geom contype="2" conaffinity="0" condim="3" friction="{mu} 0.005 0.0001" priority="1"/></default>
+  <default class="obj"><geom contype="1" conaffinity="6" condim="3" friction="{mu} 0.005 0.0001" priority="0"{solref}/></default>
+  <default class="hand"><geom contype="2" conaffinity="0" condim="3" friction="{mu} 0.005 0.0001" priority="1"{solref}/></default>
 </default>
 <asset>{assets}</asset>
 <worldbody>

@@ -49,6 +49,8 @@ def main():
     ap.add_argument("--torques", default="0.25,0.5,1,2,3", help="N m, comma-separated (the hand's own are added)")
     ap.add_argument("--max-grasps", type=int, default=0, help="per file (0: all)")
     ap.add_argument("--timestep", type=float, default=0.001)
+    ap.add_argument("--contact-solref", type=float, default=None, metavar="S",
+                    help="contacts' solref time constant in s (default: MuJoCo's 0.02; e.g. 0.002 = 2 steps, stiff)")
     ap.add_argument("--out", default=None, help="JSON file for the counts and per-grasp verdicts")
     a = ap.parse_args()
     try:
@@ -58,6 +60,10 @@ def main():
     if any(not (np.isfinite(t) and t > 0) for t in torques):
         ap.error("--torques: torques must be > 0")
     columns = torques + ["hand"]
+    if a.contact_solref is not None:
+        if not a.contact_solref > 0:
+            ap.error("--contact-solref: must be > 0")
+        lm.CONTACT_SOLREF = a.contact_solref
     paths = files_of(a.heldset)
     if not paths:
         ap.error("no .npz files found")
