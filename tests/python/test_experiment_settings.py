@@ -48,7 +48,7 @@ def test_runs_stored_without_settings_are_not_resumed(tmp_path):
     with pytest.raises(ValueError, match="1 runs of e stored without their settings"):
         store.check_settings("e", {"lift": True})
     assert store.settings("e") is None
-    store.add(RunKey("g", "cube", 0, 1), {"value": 0})  # a series without runs... would be refused too
+    store.add(RunKey("g", "cube", 0, 1), {"value": 0})  # runs added without settings are refused too
     with pytest.raises(ValueError):
         store.check_settings("g", {"lift": True})
     store.check_settings("h", {"lift": True})  # a new series is fine
