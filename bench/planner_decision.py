@@ -6,6 +6,8 @@ timed with one thread:
   * stability: Eq. 3.1, PSO (32 x 30) over the tabulated P(S | A, O) (our default);
   * explore:   the exploration planner's whole decision (the stability search, then Eq. 3.2's
                PSO over the expected posterior weight entropy, 16 x 12, 50 measurement samples);
+  * stability_both / explore_both: the same decisions searching both grasp families (top and
+               side, each with its own models and table; the best wins);
   * peer:      the same stability search evaluating the FITC GP itself at every
                (candidate, particle) pair instead of the table (what a direct implementation
                does), fewer repetitions.
@@ -19,6 +21,7 @@ import time
 
 import numpy as np
 
+from bayesgrasp.models import ModelSettings
 from bayesgrasp.planners import ExplorationPlanner, PlannerSettings, StabilityPlanner, get_models
 from bayesgrasp.experiments import EpisodeSettings, RunContext, run_episode
 
@@ -28,17 +31,19 @@ OBJECTS = ("cube", "cylinder", "mug", "mug2", "pitcher")
 class GPStability(StabilityPlanner):
     """The stability planner with the GP evaluated at every pair (no table)."""
 
-    def maximise_stability(self, poses, weights):
+    def maximise_stability(self, poses, weights, family=None):
         from bayesgrasp import optim
         from bayesgrasp.models import relative_top_grasps
 
         s = self.settings
+        family = self._family(family)
+        models = self.family_models[family]
         low, high = self.action_bounds(poses)
         w = np.asarray(weights, dtype=float)
-        init = np.clip(self._seed_actions(poses, w, s.pso_particles), low, high)
+        init = np.clip(self._seed_actions(poses, w, s.pso_particles, family), low, high)
 
         def negative(X):
-            return -(self.models.stability_probability(relative_top_grasps(X, poses)) @ w)
+            return -(models.stability_probability(relative_top_grasps(X, poses)) @ w)
 
         r = optim.pso(negative, (low, high), n_particles=s.pso_particles, max_iter=s.pso_iter,
                       seed=int(self._rng.integers(2**31)), init=init)
@@ -61,10 +66,12 @@ def main():
     ap.add_argument("--cache", default=None)
     a = ap.parse_args()
     rng = np.random.default_rng(0)
-    rows = {"stability": [], "explore": [], "peer_gp": [], "stability_same_as_peer": []}
+    rows = {"stability": [], "explore": [], "stability_both": [], "explore_both": [], "peer_gp": [],
+            "stability_same_as_peer": []}
     table_err = []
     for obj in OBJECTS:
         models = get_models(obj, cache_dir=a.cache)
+        both = {"top": models, "side": get_models(obj, settings=ModelSettings(family="side"), cache_dir=a.cache)}
         tab = models.table()
         rel = np.column_stack([rng.uniform(-0.06, 0.06, 20000), rng.uniform(-0.06, 0.06, 20000),
                                rng.uniform(-np.pi, np.pi, 20000)])
@@ -83,6 +90,11 @@ def main():
                 rows["stability"].append(t)
                 t, _ = timed(ExplorationPlanner, models, est, r, observe)
                 rows["explore"].append(t)
+                observe_top = None if observe is None else (*observe, "top")
+                t, _ = timed(StabilityPlanner, both, est, r, observe_top)
+                rows["stability_both"].append(t)
+                t, _ = timed(ExplorationPlanner, both, est, r, observe_top)
+                rows["explore_both"].append(t)
             if r < max(2, a.reps // 5):
                 t, _ = timed(GPStability, models, est, r)
                 rows["peer_gp"].append(t)

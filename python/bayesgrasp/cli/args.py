@@ -106,6 +106,13 @@ def add_context_options(p: argparse.ArgumentParser, lift: bool = False, seed: bo
         p.add_argument("--no-lift", action="store_true", help="skip the physical lift tests (faster)")
 
 
+def add_families_option(p: argparse.ArgumentParser) -> None:
+    """--families: the grasp families the planners choose from."""
+    p.add_argument("--families", default="top", metavar="top|side|top,side",
+                   help="grasp families to plan over: top (palm down, the thesis's), side (a horizontal approach; "
+                        "height, roll and spread chosen per object), or both (default: top)")
+
+
 def add_category_options(p: argparse.ArgumentParser, png_help: str) -> None:
     """What `category` and `fuse` share: leave-one-out, demonstrated grasps from a file, JSON, PNG."""
     p.add_argument("--exclude", nargs="*", default=None, metavar="NAME",
@@ -140,7 +147,18 @@ def context(args: argparse.Namespace, progress: bool = True):
     return RunContext(hand=getattr(args, "hand", "barrett_bh8"), cache_dir=getattr(args, "cache", None),
                       success=success, lift=lift, seed=getattr(args, "seed", 0),
                       progress=stderr_progress if progress else None,
-                      model_settings=model_settings(getattr(args, "set", []), success))
+                      model_settings=model_settings(getattr(args, "set", []), success),
+                      families=families_arg(getattr(args, "families", "top")))
+
+
+def families_arg(text):
+    """--families as a tuple of family names (a CliError naming the option otherwise)."""
+    from ..models import parse_families
+
+    try:
+        return parse_families(text)
+    except ValueError as e:
+        raise CliError(f"--{e}") from None
 
 
 def model_settings(assignments, success: str):

@@ -4,7 +4,7 @@ from __future__ import annotations
 import argparse
 import time
 
-from .args import SEED_MAX, CliError, add_context_options, bounded_int, context, hand_name, out_dir
+from .args import SEED_MAX, CliError, add_context_options, add_families_option, bounded_int, context, hand_name, out_dir
 
 
 def add(sub) -> None:
@@ -18,16 +18,18 @@ def add(sub) -> None:
     e.add_argument("--out", default=None, help="output directory (default: out/experiments/NAME)")
     e.add_argument("--objects", nargs="+", default=None, help="objects (default: the experiment's)")
     e.add_argument("--config", default=None, metavar="FILE.toml",
-                   help="settings from a TOML file: runs, workers, out, objects, hand, success, lift, seed, cache at "
+                   help="settings from a TOML file: runs, workers, out, objects, hand, success, lift, seed, cache, "
+                        "families at "
                         "the top and a [models] table (ModelSettings fields); an option given on the command line "
                         "(other than its default) and --set win over the file")
     add_context_options(e, lift=True)
+    add_families_option(e)
     e.set_defaults(run=run)
 
 
 #: The TOML keys --config takes at its top level, with the option each sets and how it is checked.
 CONFIG_KEYS = {"runs": int, "workers": int, "out": str, "objects": list, "hand": str, "success": str,
-               "lift": bool, "seed": int, "cache": str}
+               "lift": bool, "seed": int, "cache": str, "families": str}
 
 
 def apply_config(args, path: str, defaults: dict) -> None:
@@ -78,6 +80,7 @@ def run(args) -> int:
     if args.config:
         apply_config(args, args.config, {"runs": None, "workers": 1, "out": None, "objects": None,
                                          "hand": "barrett_bh8", "success": "lift", "no_lift": False, "seed": 0,
+                                         "families": "top",
                                          "cache": None})
         if (args.runs is not None and args.runs < 1) or args.workers < 1 or not 0 <= args.seed <= SEED_MAX:
             raise CliError(f"--config: {args.config}: runs and workers must be at least 1, seed in [0, 2^63 - 1]")

@@ -8,8 +8,8 @@ from pathlib import Path
 import numpy as np
 
 from . import camera_input
-from .args import (CliError, add_context_options, add_format_options, add_view_option, bounded_int, context, floats, out_dir,
-                   output_file, output_format)
+from .args import (CliError, add_context_options, add_families_option, add_format_options, add_view_option, bounded_int,
+                   context, floats, out_dir, output_file, output_format)
 
 METHODS = ["stability", "explore", "ml_pose", "open_loop"]
 
@@ -23,6 +23,7 @@ def add(sub) -> None:
     d.add_argument("--method", default="explore", choices=METHODS, help="stability: the most stable grasp (Eq. 3.1); explore: informative grasps while none is likely to hold (Eq. 3.2); ml_pose: the most stable grasp at the most likely pose; open_loop: the most stable grasp at the estimate, no update")
     d.add_argument("--out", default="out/demo", help="directory for the PNG and results")
     add_context_options(d)
+    add_families_option(d)
     d.set_defaults(run=demo)
 
     p = sub.add_parser("plan", help="run the planning loop on an object at a hidden true pose",
@@ -42,6 +43,7 @@ def add(sub) -> None:
     add_format_options(p)
     add_view_option(p)
     add_context_options(p)
+    add_families_option(p)
     camera_input.add(p)
     p.set_defaults(run=plan)
 
@@ -52,7 +54,7 @@ def _print_attempt(a: dict) -> None:
     verdict = "SUCCESS" if a["success"] else "failed"
     x, y, yaw = a["action"]
     b = a["belief_before"]
-    print(f"  attempt {a['attempt']}: {a['kind']:<9} grasp ({100 * x:6.1f} cm, {100 * y:6.1f} cm, "
+    print(f"  attempt {a['attempt']}: {a['kind']:<9} {a['family']} grasp ({100 * x:6.1f} cm, {100 * y:6.1f} cm, "
           f"{np.degrees(yaw):6.1f} deg)  predicted P(S) {a['predicted_stability']:.2f}{ent}  "
           f"[belief: error {100 * b['position_error']:.1f} cm, entropy {b['kde_entropy']:.2f}]  "
           f"-> epsilon {a['epsilon']:.3f} ({'stable' if a['stable'] else 'not stable'}){lift}: {verdict}  "
@@ -73,7 +75,7 @@ def _loop(args, pose, attempts: int = 4, estimate=None, noise: float = 0.0, quie
     ctx = context(args)
     obj = args.object if obj is None else obj
     World.single(obj, pose=pose, hand=ctx.hand)  # a clear error for an unknown object or a pose off the table
-    models = ctx.models(obj)
+    models = ctx.family_models(obj)
     planner = PlannerSettings() if half_width is None else replace(PlannerSettings(), half_width=tuple(half_width))
     episode = EpisodeSettings(method=args.method, attempts=attempts, measurement_noise=noise, planner=planner)
     return run_episode(obj, pose, episode, ctx, seed=args.seed, estimate=estimate, models=models,
@@ -137,8 +139,7 @@ def _attempt_grasps(r: dict, hand_name: str) -> list:
     from ..io.grasp_schema import hand_grasp_record
 
     hand = Hand.load(hand_name)
-    spread = r["planner"].models.spread
-    return [hand_grasp_record(hand, a["hand_pose"], a["joint_positions"], spread) for a in r["attempts"]]
+    return [hand_grasp_record(hand, a["hand_pose"], a["joint_positions"], a["variant"]["spread"]) for a in r["attempts"]]
 
 
 def _contacts(args, pose, r: dict, obj) -> list:
@@ -146,10 +147,12 @@ def _contacts(args, pose, r: dict, obj) -> list:
     (the same world, grasp and spread, so the same closing; checked against the attempt's pose)."""
     from ..world import World
 
+    from ..models import Variant
+
     world = World.single(obj, pose=pose, hand=context(args).hand)
     out = []
     for a in r["attempts"]:
-        g = world.grasp(*a["relative_grasp"], spread=r["planner"].models.spread, lift=False)
+        g = Variant(**a["variant"]).grasp(world, a["relative_grasp"], lift=False)
         same = np.allclose(g.hand_pose, a["hand_pose"], atol=1e-9)
         out.append([c for c in g.to_dict()["contacts"] if not c["on_table"]] if same else [])
     return out
@@ -163,7 +166,9 @@ def _plan_json(args, pose, r: dict, obj=None) -> dict:
     grasps = _attempt_grasps(r, args.hand)
     return {"object": args.object, "method": args.method, "true_pose": pose, "estimate": r["estimate"],
             "success_criterion": args.success, "success": r["success"],
-            "attempts": [{"plan_type": a["kind"], "top_grasp": a["action"], "grasp": g, "predicted_stability": a["predicted_stability"],
+            "attempts": [{"plan_type": a["kind"], "family": a["family"], "variant": a["variant"],
+                          "top_grasp": a["action"] if a["family"] == "top" else None,
+                          "action": a["action"], "grasp": g, "predicted_stability": a["predicted_stability"],
                           "expected_entropy": a["expected_entropy"], "entropy": a["belief_before"]["kde_entropy"],
                           "epsilon": a["epsilon"], "stable": a["stable"], "lifted": a["lifted"],
                           "success": a["success"], "outcome": "success" if a["success"] else "failure",

@@ -6,7 +6,7 @@ import sys
 from dataclasses import dataclass, field, replace
 from typing import Callable, Optional, Union
 
-from ..models import GraspModels, ModelSettings, get_models
+from ..models import GraspModels, ModelSettings, get_models, parse_families
 from ..models.settings import SUCCESS_CRITERIA
 from ..objects import ObjectModel
 
@@ -30,7 +30,8 @@ class RunContext:
     test (required by success "lift"; with "epsilon" it runs on stable grasps); threads: C++
     threads for batches (0 = all cores); seed: the base seed; progress: a callable taking a message
     (None: silent; not sent to worker processes); model_settings: how the grasp models are built
-    (None: the defaults for the success criterion)."""
+    (None: the defaults for the success criterion); families: the grasp families the planners
+    choose from ("top", as in the thesis, and "side"; :mod:`bayesgrasp.models.families`)."""
 
     hand: str = "barrett_bh8"
     cache_dir: Optional[str] = None
@@ -40,8 +41,13 @@ class RunContext:
     seed: int = 0
     progress: Optional[Callable[[str], None]] = field(default=None, compare=False)
     model_settings: Optional[ModelSettings] = None   # None: ModelSettings(success=self.success)
+    families: tuple = ("top",)
 
     def __post_init__(self):
+        try:
+            object.__setattr__(self, "families", parse_families(self.families))
+        except ValueError as e:
+            raise ValueError(str(e)) from None
         if self.success not in SUCCESS_CRITERIA:
             raise ValueError(f"success: one of {', '.join(SUCCESS_CRITERIA)}; got {self.success!r}")
         if self.success == "lift" and not self.lift:
@@ -61,6 +67,11 @@ class RunContext:
         settings = settings or self.model_settings or ModelSettings(success=self.success)
         return get_models(obj, self.hand, settings, cache_dir=self.cache_dir, progress=self.progress)
 
+    def family_models(self, obj: Union[str, ObjectModel], settings: Optional[ModelSettings] = None) -> dict:
+        """{family: GraspModels} for every family of this context (the same settings otherwise)."""
+        settings = settings or self.model_settings or ModelSettings(success=self.success)
+        return {f: self.models(obj, replace(settings, family=f)) for f in self.families}
+
     def result_settings(self) -> dict:
         """Every setting of this context that changes a run's result, as plain JSON values: the
         package and cache versions, the hand (its name and a digest of its file), the success
@@ -79,7 +90,8 @@ class RunContext:
         models = self.model_settings or ModelSettings(success=self.success)
         return {"bayesgrasp": __version__, "cache_version": CACHE_VERSION, "hand": hand.name,
                 "hand_file_sha256": hashlib.sha256(text).hexdigest()[:16], "success": self.success,
-                "lift": self.lift, "models": {k: _plain(v) for k, v in asdict(models).items()}}
+                "lift": self.lift, "families": list(self.families),
+                "models": {k: _plain(v) for k, v in asdict(models).items()}}
 
     def for_workers(self) -> "RunContext":
         """The same context without the progress callable (worker processes get it pickled)."""

@@ -68,18 +68,19 @@ def initial_estimate(true_pose: np.ndarray, settings: PlannerSettings, rng: np.r
 
 def execute(world: World, models: GraspModels, action: np.ndarray, true_pose: np.ndarray,
             ctx: RunContext) -> Execution:
-    """The world top grasp ``action`` executed on the object at its true pose and scored: with
-    success "lift" every grasp is lift-tested and success means lifted; with "epsilon" success
-    means epsilon above the models' eps_stable, and the lift test (if ``ctx.lift``) runs on
-    stable grasps only."""
+    """The world grasp ``action`` of the models' family executed on the object at its true pose
+    and scored: with success "lift" every grasp is lift-tested and success means lifted; with
+    "epsilon" success means epsilon above the models' eps_stable, and the lift test (if
+    ``ctx.lift``) runs on stable grasps only."""
     rel = relative_top_grasps(action, true_pose)[0, 0]
     by_lift = ctx.success == "lift"
-    g = world.grasp_batch(rel[None, :], spread=models.spread, lift=by_lift)
+    variant = models.variant
+    g = variant.simulate(world, rel[None, :], lift=by_lift)
     eps = float(g.epsilon[0])
     stable = eps > models.settings.eps_stable
     lifted = bool(g.lifted[0]) if by_lift else None
     if not by_lift and ctx.lift and stable:
-        lifted = bool(world.grasp_batch(rel[None, :], spread=models.spread, lift=True).lifted[0])
+        lifted = bool(variant.simulate(world, rel[None, :], lift=True).lifted[0])
     return Execution(rel, eps, bool(stable), lifted, bool(lifted) if by_lift else bool(stable),
                      bool(g.collision_at_start[0]), np.asarray(g.joint_angles[0], dtype=float),
                      np.asarray(g.hand_pose[0], dtype=float))
@@ -93,8 +94,9 @@ def read_fingers(execution: Execution, models: GraspModels, noise: float, rng: n
     return q
 
 
-def _attempt_record(k: int, plan, ex: Execution, q: np.ndarray, before: dict) -> dict:
-    return {"attempt": k + 1, "kind": plan.kind, "action": plan.action.tolist(),
+def _attempt_record(k: int, plan, ex: Execution, q: np.ndarray, before: dict, models: GraspModels) -> dict:
+    return {"attempt": k + 1, "kind": plan.kind, "family": plan.family, "variant": models.variant.as_dict(),
+            "action": plan.action.tolist(),
             "relative_grasp": ex.relative_grasp.tolist(), "predicted_stability": float(plan.predicted_stability),
             "objective": float(plan.objective), "expected_entropy": plan.expected_entropy,
             "plan_seconds": plan.seconds, "evaluations": plan.evaluations, "epsilon": ex.epsilon,
@@ -113,11 +115,13 @@ def _check_pose(true_pose) -> np.ndarray:
 
 def run_episode(obj: Union[str, ObjectModel], true_pose: Sequence[float], episode: Optional[EpisodeSettings] = None,
                 ctx: Optional[RunContext] = None, seed: int = 0, estimate: Optional[Sequence[float]] = None,
-                models: Optional[GraspModels] = None, keep_planner: bool = False,
+                models=None, keep_planner: bool = False,
                 on_attempt: Optional[Callable[[dict], None]] = None) -> dict:
     """One run of the loop on ``obj`` whose hidden true pose is ``true_pose`` (x, y, yaw).
 
-    The estimate defaults to :func:`initial_estimate`. Returns a JSON-ready dict: success,
+    ``models``: one family's GraspModels or {family: GraspModels} (default: the context's
+    families, :meth:`RunContext.family_models`). The estimate defaults to
+    :func:`initial_estimate`. Returns a JSON-ready dict: success,
     attempts (one dict per attempt), the initial and final belief summaries; with ``keep_planner``
     also "planner" (the Planner object, not JSON) and "snapshots" (the particles and weights
     before each attempt and at the end).
@@ -127,7 +131,7 @@ def run_episode(obj: Union[str, ObjectModel], true_pose: Sequence[float], episod
     obj_model = load_object(obj) if isinstance(obj, str) else obj
     true_pose = _check_pose(true_pose)
     world = World.single(obj_model, pose=true_pose, hand=ctx.hand)  # raises if off the table
-    models = models or ctx.models(obj if isinstance(obj, str) else obj_model, episode.models)
+    models = models or ctx.family_models(obj if isinstance(obj, str) else obj_model, episode.models)
     rng = np.random.default_rng(seed)
     estimate = initial_estimate(true_pose, episode.planner, rng) if estimate is None else estimate
     estimate = np.asarray(estimate, dtype=float)
@@ -139,12 +143,13 @@ def run_episode(obj: Union[str, ObjectModel], true_pose: Sequence[float], episod
         if keep_planner:
             snapshots.append((planner.belief.particles, planner.belief.weights))
         plan = planner.plan()
-        ex = execute(world, models, plan.action, true_pose, ctx)
-        q = read_fingers(ex, models, episode.measurement_noise, rng)
-        rec = _attempt_record(k, plan, ex, q, before)
+        executed = planner.family_models[plan.family]
+        ex = execute(world, executed, plan.action, true_pose, ctx)
+        q = read_fingers(ex, executed, episode.measurement_noise, rng)
+        rec = _attempt_record(k, plan, ex, q, before, executed)
         stop = ex.success and episode.stop_when_stable
         if not stop:
-            planner.observe(plan.action, q, stable=ex.success)
+            planner.observe(plan.action, q, stable=ex.success, family=plan.family)
             rec["belief_after"] = planner.summary(true_pose)
         attempts.append(rec)
         if on_attempt is not None:

@@ -173,9 +173,9 @@ def landscapes_run(experiment: str, obj: str, run_index: int, seed: int, *, ctx:
 
 # ---- the registered experiments ---------------------------------------------------------------------
 def prepare_models(exp: Experiment, objects: List[str], ctx: RunContext) -> None:
-    """Every object's grasp models, built (or loaded) once in this process."""
+    """Every object's grasp models (each family's), built (or loaded) once in this process."""
     for o in objects:
-        ctx.models(o)
+        ctx.family_models(o)
 
 
 def _episodes(exp: Experiment, method: str, ctx: RunContext):

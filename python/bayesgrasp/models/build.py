@@ -18,9 +18,10 @@ from .. import gp as _gp
 from ..cache import atomic_write, atomic_write_text, cache_root, load_checked
 from ..objects import ObjectModel, load_object
 from ..world import World
-from .grasp_models import DEFAULT_CALIBRATION, GraspModels, features
+from .families import Variant
+from .grasp_models import DEFAULT_CALIBRATION, GraspModels
 from .settings import CACHE_VERSION, ModelSettings
-from .training import choose_spread, fit_calibration, simulate_training_data, success_labels
+from .training import choose_spread, choose_variant, fit_calibration, side_variants, simulate_training_data, success_labels
 
 Say = Callable[[str], None]
 
@@ -37,7 +38,10 @@ def cache_key(obj: ObjectModel, hand_text: str, settings: ModelSettings) -> str:
     h.update(np.ascontiguousarray(obj.vertices, dtype=np.float64).tobytes())
     h.update(np.ascontiguousarray(obj.faces, dtype=np.int64).tobytes())
     h.update(hand_text.encode())
-    h.update(json.dumps(asdict(settings), sort_keys=True).encode())
+    fields = asdict(settings)
+    if fields["family"] == "top":  # top models keep the keys they had before there were families
+        del fields["family"]
+    h.update(json.dumps(fields, sort_keys=True).encode())
     return h.hexdigest()[:20]
 
 
@@ -73,7 +77,7 @@ def _fit(X, Y, settings: ModelSettings, n: int) -> _gp.SparseGP:
                         noise=1e-2).fit(X, Y)
 
 
-def _calibrate(models: GraspModels, world: World, settings: ModelSettings, spread: float, say: Say) -> tuple:
+def _calibrate(models: GraspModels, world: World, settings: ModelSettings, spread: Variant, say: Say) -> tuple:
     """The logistic calibration of P(S) on the outcomes of held-out simulated grasps (the
     probit-like default when there are too few)."""
     if settings.n_calibration <= 0:
@@ -86,43 +90,63 @@ def _calibrate(models: GraspModels, world: World, settings: ModelSettings, sprea
     return fit_calibration(models.stability_z(rel_c), success_labels(world, settings, rel_c, eps_c, spread))
 
 
-def _fit_stability(world: World, settings: ModelSettings, rel, eps, spread: float, say: Say):
+def _fit_stability(world: World, settings: ModelSettings, rel, eps, variant: Variant, say: Say):
     """The stability GP and the outcomes it was fitted on: lift outcomes (0/1) of the first
     n_lift_samples training grasps, or the epsilon of all of them."""
     if settings.success == "lift":
         n = min(settings.scaled(settings.n_lift_samples, settings.grasp_box(world.object)), len(rel))
         say(f"models for {world.object.name}: lift tests of {n} training grasps")
-        lifted = success_labels(world, settings, rel[:n], eps[:n], spread)
-        return _fit(features(rel[:n]), lifted.astype(float), settings, n), lifted
-    return _fit(features(rel), np.maximum(eps, 0.0), settings, len(rel)), eps > settings.eps_stable
+        lifted = success_labels(world, settings, rel[:n], eps[:n], variant)
+        return _fit(variant.features(rel[:n]), lifted.astype(float), settings, n), lifted
+    return _fit(variant.features(rel), np.maximum(eps, 0.0), settings, len(rel)), eps > settings.eps_stable
+
+
+def _choose_variant(world: World, settings: ModelSettings, say: Say):
+    """The family's hand settings: (Variant, pilot table or None). Top grasps: the given spread,
+    else the spread pilot; side grasps: the pilot over spread, height and roll."""
+    name = world.object.name
+    if settings.family == "top":
+        if settings.spread is not None:
+            return Variant("top", float(settings.spread)), None
+        say(f"models for {name}: choosing the finger spread (pilot of {settings.n_pilot} grasps per spread)")
+        spread, pilot = choose_spread(world, settings, say)
+        return Variant("top", float(spread)), pilot
+    candidates = side_variants(world, settings)
+    say(f"models for {name}: choosing the side grasps' spread, height and roll (pilot of {settings.n_pilot} "
+        f"grasps for each of {len(candidates)})")
+    best, table = choose_variant(world, settings, candidates, say)
+    return best, [dict(v.as_dict(), fraction=f, lifted=l, tested=t) for v, (f, l, t) in zip(candidates, table)]
 
 
 def _train(world: World, settings: ModelSettings, key: str, say: Say) -> GraspModels:
-    """Spread pilot (when the spread is not given), training grasps, the two FITC fits, calibration."""
+    """Pilot (spread; for side grasps also height and roll), training grasps, the two FITC fits,
+    calibration."""
     name = world.object.name
-    spread, pilot = settings.spread, None
-    if spread is None:
-        say(f"models for {name}: choosing the finger spread (pilot of {settings.n_pilot} grasps per spread)")
-        spread, pilot = choose_spread(world, settings, say)
-    say(f"models for {name}: simulating {settings.n_samples} grasps at spread {np.degrees(spread):.0f} deg")
-    rel, q, eps = simulate_training_data(world, settings, spread=spread)
+    variant, pilot = _choose_variant(world, settings, say)
+    spread = variant.spread
+    where = "" if variant.family == "top" else \
+        f" from the side at {100 * variant.height:.1f} cm, roll {np.degrees(variant.roll):.0f} deg,"
+    say(f"models for {name}: simulating {settings.n_samples} {variant.family} grasps{where} at spread "
+        f"{np.degrees(spread):.0f} deg")
+    rel, q, eps = simulate_training_data(world, settings, spread=variant)
     if len(rel) < 10:
-        raise ValueError(f"{name}: only {len(rel)} collision-free grasps in the sampled range")
+        raise ValueError(f"{name}: only {len(rel)} collision-free {variant.family} grasps in the sampled range")
     joint_index = np.arange(1, q.shape[1])     # every phalanx joint (the spread is fixed)
-    X = features(rel)
+    X = variant.features(rel)
     say(f"models for {name}: fitting FITC GPs on {len(rel)} grasps")
     measurement = _fit(X, q[:, joint_index], settings, len(rel))
-    stability, outcomes = _fit_stability(world, settings, rel, eps, spread, say)
+    stability, outcomes = _fit_stability(world, settings, rel, eps, variant, say)
     models = GraspModels(measurement, stability, settings, joint_index,
-                         {"spread": float(spread), "grasp_box": settings.grasp_box(world.object).tolist()})
-    calibration = _calibrate(models, world, settings, spread, say)
+                         {"spread": float(spread), "grasp_box": settings.grasp_box(world.object).tolist(),
+                          "variant": variant.as_dict()})
+    calibration = _calibrate(models, world, settings, variant, say)
     models.info = {"key": key, "object": name, "calibration": list(calibration), "hand": world.hand.name,
                    "settings": asdict(settings), "samples": int(len(rel)),
                    "force_closure_fraction": float(np.mean(eps > 0)),
                    "stable_fraction": float(np.mean(eps > settings.eps_stable)),
                    "success_fraction": float(np.mean(outcomes)),
                    "joint_index": joint_index.tolist(), "spread": float(spread), "spread_pilot": pilot,
-                   "grasp_box": settings.grasp_box(world.object).tolist()}
+                   "grasp_box": settings.grasp_box(world.object).tolist(), "variant": variant.as_dict()}
     return models
 
 

@@ -1,7 +1,8 @@
-"""Measurement and stability models for top grasps, learnt from simulated grasps (thesis §3.2).
+"""Measurement and stability models for one grasp family, learnt from simulated grasps (thesis §3.2).
 
-The models take the grasp relative to the object: a top grasp at (x, y, yaw) in the object's
-frame. Inputs to the GPs are (x, y, cos yaw, sin yaw), so that yaw wraps. Two sparse (FITC) GPs
+The models take the grasp relative to the object: (x, y, yaw) in the object's frame. Inputs to
+the GPs are, for top grasps, (x, y, cos yaw, sin yaw), so that yaw wraps; for side grasps the
+approach line's offset and azimuth (:class:`.families.Variant`). Two sparse (FITC) GPs
 are fitted on simulated grasps of the object with the hand (:mod:`.build`):
 
 * measurement model P(M|A,O): the hand's phalanx joint angles after closing (one output per
@@ -20,6 +21,7 @@ from scipy.special import expit
 
 from .. import gp as _gp
 from ..belief import relative_planar_pose
+from .families import Variant
 from .settings import ModelSettings
 from .table import ModelTable
 
@@ -36,9 +38,8 @@ def relative_top_grasps(grasps, object_poses) -> np.ndarray:
 
 
 def features(rel) -> np.ndarray:
-    """(..., 3) relative grasps -> (..., 4) GP inputs (x, y, cos yaw, sin yaw)."""
-    rel = np.asarray(rel, dtype=float)
-    return np.concatenate([rel[..., :2], np.cos(rel[..., 2:3]), np.sin(rel[..., 2:3])], axis=-1)
+    """(..., 3) relative top grasps -> (..., 4) GP inputs (x, y, cos yaw, sin yaw)."""
+    return Variant("top").features(rel)
 
 
 def _mean_var(model: _gp.SparseGP, X: np.ndarray, include_noise: bool):
@@ -58,10 +59,23 @@ class GraspModels:
         self.loaded_from_cache = False  # set by the model builder
         self._tables: dict = {}
 
+    @property
+    def family(self) -> str:
+        return self.settings.family
+
+    @property
+    def variant(self) -> Variant:
+        """The family and the hand settings of every grasp these models describe."""
+        v = dict(self.info.get("variant") or {"family": self.family, "spread": self.spread})
+        return Variant(**v)
+
+    def _features(self, rel: np.ndarray) -> np.ndarray:
+        return self.variant.features(rel).reshape(-1, self.variant.n_features)
+
     def predict_measurement(self, rel):
         """Mean and variance (incl. noise) of the joint angles at relative grasps (..., 3)."""
         rel = np.asarray(rel, dtype=float)
-        mean, var = _mean_var(self.measurement, features(rel).reshape(-1, 4), include_noise=True)
+        mean, var = _mean_var(self.measurement, self._features(rel), include_noise=True)
         shape = rel.shape[:-1] + (len(self.joint_index),)
         return mean.reshape(shape), var.reshape(shape)
 
@@ -69,7 +83,7 @@ class GraspModels:
         """log P(M = measurement | A, O) at relative grasps (..., 3): a sum over joints."""
         rel = np.asarray(rel, dtype=float)
         m = np.asarray(measurement, dtype=float)
-        X = features(rel).reshape(-1, 4)
+        X = self._features(rel)
         Y = np.broadcast_to(m, (len(X), m.shape[-1]))
         return self.measurement.log_predictive_density(X, Y).reshape(rel.shape[:-1])
 
@@ -78,7 +92,7 @@ class GraspModels:
         The observation noise is left out: it is mostly the simulator's discontinuity, not
         uncertainty about the grasp."""
         rel = np.asarray(rel, dtype=float)
-        mean, var = _mean_var(self.stability, features(rel).reshape(-1, 4), include_noise=False)
+        mean, var = _mean_var(self.stability, self._features(rel), include_noise=False)
         z = (mean[:, 0] - self.settings.stability_threshold) / np.sqrt(np.maximum(var[:, 0], 1e-12))
         return z.reshape(rel.shape[:-1])
 

@@ -23,8 +23,9 @@ MAX_SAMPLE_SCALE = 2.5
 #: Grid nodes of highest P(S) a ModelTable keeps (the planners' PSO seeds).
 N_BEST = 64
 
-#: Candidate finger spreads (rad) when ModelSettings.spread is None.
+#: Candidate finger spreads (rad) when ModelSettings.spread is None: top grasps, side grasps.
 AUTO_SPREADS = tuple(float(np.radians(d)) for d in (0.0, 30.0, 45.0, 60.0, 90.0))
+SIDE_SPREADS = (0.0, float(np.pi / 2))
 
 
 @dataclass(frozen=True)
@@ -52,6 +53,8 @@ class ModelSettings:
     seed: int = 0
     success: str = "lift"
     n_lift_samples: int = 1000    # training grasps lift-tested for the stability model (success "lift")
+    # The grasp family the models describe (models.families): "top" (the thesis's) or "side".
+    family: str = "top"
 
     def __post_init__(self):
         if self.n_samples < 10:
@@ -66,6 +69,9 @@ class ModelSettings:
             raise ValueError("n_pilot: need at least 10 grasps and n_pilot_lifts at least 1")
         if self.success not in SUCCESS_CRITERIA:
             raise ValueError(f"success: one of {', '.join(SUCCESS_CRITERIA)}; got {self.success!r}")
+        from .families import FAMILIES
+        if self.family not in FAMILIES:
+            raise ValueError(f"family: one of {', '.join(FAMILIES)}; got {self.family!r}")
         if not 10 <= self.n_lift_samples:
             raise ValueError(f"n_lift_samples: need at least 10, got {self.n_lift_samples}")
 

@@ -1,5 +1,6 @@
-"""Training data for the grasp models, from the simulator: random relative top grasps, their
-outcomes (joint angles, epsilon, and the lift test), the finger-spread pilot and the logistic
+"""Training data for the grasp models, from the simulator: random relative grasps of a family
+(:mod:`.families`), their outcomes (joint angles, epsilon, and the lift test), the pilot that
+chooses the finger spread (and, for side grasps, the height and roll) and the logistic
 calibration of P(S)."""
 from __future__ import annotations
 
@@ -10,7 +11,8 @@ from scipy.optimize import minimize
 from scipy.special import expit
 
 from ..world import World
-from .settings import AUTO_SPREADS, ModelSettings
+from .families import SIDE_HEIGHT_FRACTIONS, SIDE_ROLLS, Variant
+from .settings import AUTO_SPREADS, SIDE_SPREADS, ModelSettings
 
 
 def random_relative_grasps(rng: np.random.Generator, n: int, box) -> np.ndarray:
@@ -21,55 +23,82 @@ def random_relative_grasps(rng: np.random.Generator, n: int, box) -> np.ndarray:
                             rng.uniform(-np.pi, np.pi, n)])
 
 
+def as_variant(settings: ModelSettings, spread) -> Variant:
+    """A Variant as given, or the settings' family at the given spread (None: the settings')."""
+    if isinstance(spread, Variant):
+        return spread
+    spread = settings.spread if spread is None else spread
+    return Variant(settings.family, float(np.pi / 2 if spread is None else spread))
+
+
 def simulate_training_data(world: World, settings: ModelSettings, seed_offset: int = 0, n: Optional[int] = None,
-                           spread: Optional[float] = None):
+                           spread=None):
     """Relative grasps (n, 3), joint angles (n, J) and epsilon (n,) from the simulator, in the
     settings' grasp box for the object (n scaled with the box, see ModelSettings.scaled); grasps
-    whose open hand started in collision are dropped."""
+    whose open hand started in collision are dropped. ``spread``: a number (the settings' family)
+    or a :class:`Variant`."""
+    variant = as_variant(settings, spread)
     rng = np.random.default_rng([settings.seed, seed_offset])
     box = settings.grasp_box(world.object)
     n = settings.scaled(settings.n_samples if n is None else int(n), box)
-    rel = random_relative_grasps(rng, n, box)
-    spread = settings.spread if spread is None else spread
-    b = world.grasp_batch(rel, spread=spread, threads=0)
+    rel = variant.sample(rng, n, box)
+    b = variant.simulate(world, rel)
     ok = ~np.asarray(b.collision_at_start, dtype=bool)
     return rel[ok], np.asarray(b.joint_angles)[ok], np.asarray(b.epsilon)[ok]
 
 
-def lift_outcomes(world: World, rel: np.ndarray, spread: float) -> np.ndarray:
-    """(n,) bool: each relative grasp held in the lift test. A grasp whose hand touches nothing of
-    the object cannot hold it and is not simulated."""
+def lift_outcomes(world: World, rel: np.ndarray, spread) -> np.ndarray:
+    """(n,) bool: each relative grasp (of the family of ``spread``, a number for top grasps or a
+    Variant) held in the lift test. A grasp whose hand touches nothing of the object cannot hold
+    it and is not simulated."""
+    variant = spread if isinstance(spread, Variant) else Variant("top", float(spread))
     rel = np.atleast_2d(np.asarray(rel, dtype=float))
-    b = world.grasp_batch(rel, spread=spread, threads=0)
+    b = variant.simulate(world, rel, quality=False)
     touches = np.asarray(b.link_contact, dtype=bool).any(axis=1) & ~np.asarray(b.collision_at_start, bool)
     lifted = np.zeros(len(rel), dtype=bool)
     idx = np.flatnonzero(touches)
     if len(idx):
-        lifted[idx] = np.asarray(world.grasp_batch(rel[idx], spread=spread, lift=True, threads=0).lifted, bool)
+        lifted[idx] = np.asarray(variant.simulate(world, rel[idx], lift=True, quality=False).lifted, bool)
     return lifted
 
 
-def success_labels(world: World, settings: ModelSettings, rel: np.ndarray, eps: np.ndarray, spread: float) -> np.ndarray:
+def success_labels(world: World, settings: ModelSettings, rel: np.ndarray, eps: np.ndarray, spread) -> np.ndarray:
     """S for each grasp under the settings' success criterion (lift test or epsilon)."""
     if settings.success == "lift":
-        return lift_outcomes(world, rel, spread)
+        return lift_outcomes(world, rel, as_variant(settings, spread))
     return np.asarray(eps) > settings.eps_stable
 
 
 def choose_spread(world: World, settings: ModelSettings, say=lambda m: None) -> tuple:
-    """The pilot behind ModelSettings.spread = None: for each spread in AUTO_SPREADS, simulate
-    n_pilot random relative top grasps and score how often a random grasp succeeds.
+    """The top family's pilot (ModelSettings.spread = None): :func:`choose_variant` over the
+    spreads in AUTO_SPREADS. Returns (best spread, {degrees: (fraction, lifted, tested)})."""
+    variants = [Variant("top", sp) for sp in AUTO_SPREADS]
+    best, table = choose_variant(world, settings, variants, say)
+    return best.spread, {round(float(np.degrees(v.spread))): row for v, row in zip(variants, table)}
+
+
+def side_variants(world: World, settings: ModelSettings) -> list:
+    """The side family's pilot candidates: SIDE_SPREADS (or the settings' spread) x
+    SIDE_HEIGHT_FRACTIONS of the object's height x SIDE_ROLLS."""
+    top = float(np.asarray(world.object.bounds, dtype=float)[1, 2])
+    spreads = SIDE_SPREADS if settings.spread is None else (settings.spread,)
+    return [Variant("side", sp, round(f * top, 4), r) for sp in spreads for f in SIDE_HEIGHT_FRACTIONS
+            for r in SIDE_ROLLS]
+
+
+def choose_variant(world: World, settings: ModelSettings, variants, say=lambda m: None) -> tuple:
+    """The pilot: for each candidate Variant, simulate n_pilot random relative grasps and score
+    how often a random grasp succeeds.
 
     With success "lift": the first n_pilot_lifts collision-free grasps that touch the object are
     lift-tested; score = touching fraction x lifted fraction. With "epsilon": up to n_pilot_lifts
     of the stable grasps are lift-tested; score = stable fraction x lifted fraction. Returns
-    (best spread, {degrees: (fraction, lifted, tested)}); with no grasp lifted at any spread, the
-    spread with the largest fraction."""
-    rng = np.random.default_rng([settings.seed, 7])
-    rel = random_relative_grasps(rng, settings.n_pilot, settings.grasp_box(world.object))
-    table, scores = {}, []
-    for sp in AUTO_SPREADS:
-        b = world.grasp_batch(rel, spread=sp, threads=0)
+    (best Variant, [(fraction, lifted, tested) per candidate]); with no grasp lifted by any
+    candidate, the one with the largest fraction."""
+    table, scores = [], []
+    for v in variants:
+        rel = v.sample(np.random.default_rng([settings.seed, 7]), settings.n_pilot, settings.grasp_box(world.object))
+        b = v.simulate(world, rel, quality=settings.success != "lift")
         free = ~np.asarray(b.collision_at_start, dtype=bool)
         if settings.success == "lift":
             ok = free & np.asarray(b.link_contact, dtype=bool).any(axis=1)
@@ -78,13 +107,15 @@ def choose_spread(world: World, settings: ModelSettings, say=lambda m: None) -> 
             ok = free & (np.asarray(b.epsilon) > settings.eps_stable)
             what = "stable"
         idx = np.flatnonzero(ok)[:settings.n_pilot_lifts]
-        lifted = int(np.sum(world.grasp_batch(rel[idx], spread=sp, lift=True, threads=0).lifted)) if len(idx) else 0
+        lifted = int(np.sum(v.simulate(world, rel[idx], lift=True, quality=False).lifted)) if len(idx) else 0
         frac = float(np.mean(ok))
-        table[round(float(np.degrees(sp)))] = (frac, lifted, int(len(idx)))
+        table.append((frac, lifted, int(len(idx))))
         scores.append((frac * (lifted / len(idx) if len(idx) else 0.0), frac))
-        say(f"  spread {np.degrees(sp):3.0f} deg: {100 * frac:.0f}% {what}, {lifted}/{len(idx)} of those tested lifted")
+        where = "" if v.family == "top" else f", height {100 * v.height:.1f} cm, roll {np.degrees(v.roll):.0f} deg"
+        say(f"  spread {np.degrees(v.spread):3.0f} deg{where}: {100 * frac:.0f}% {what}, "
+            f"{lifted}/{len(idx)} of those tested lifted")
     best = max(range(len(scores)), key=lambda i: scores[i])
-    return AUTO_SPREADS[best], table
+    return variants[best], table
 
 
 def fit_calibration(z, stable) -> tuple:

@@ -1,14 +1,19 @@
 """What every planner for known objects under pose uncertainty shares (thesis §3.2-3.3).
 
 The unknown is the object's planar pose O = (x, y, yaw) on the table; the belief is a
-:class:`~bayesgrasp.belief.ParticleBelief` over it; an action is a top grasp A = (x, y, yaw) in
-the world frame; the measurement M is the hand's phalanx joint angles after closing; S is
-whether the grasp is stable. Every planner has the same interface::
+:class:`~bayesgrasp.belief.ParticleBelief` over it; an action is a grasp family (top, as in the
+thesis, or side; :mod:`bayesgrasp.models.families`) and its A = (x, y, yaw) in the world frame;
+the measurement M is the hand's phalanx joint angles after closing; S is whether the grasp is
+stable. Every planner has the same interface::
 
     planner = StabilityPlanner(models, estimate=(0.01, -0.02, 0.3), seed=0)
-    plan = planner.plan()                      # Plan: action, kind, predicted stability, ...
-    planner.observe(plan.action, joint_angles, stable=False)
+    plan = planner.plan()                      # Plan: family, action, kind, predicted stability, ...
+    planner.observe(plan.action, joint_angles, stable=False, family=plan.family)
     planner.belief, planner.history
+
+``models`` is one family's :class:`~bayesgrasp.models.GraspModels`, or a mapping from family
+name to models: the planners then search every family and keep the best, and the belief update
+takes the executed family's models.
 
 ``observe`` is the Bayes update of the thesis: reweight the particles by the GP measurement
 likelihood P(M | A, O) (and, as an option, by P(S = observed | A, O)), resample, then move every
@@ -20,13 +25,13 @@ from __future__ import annotations
 import time
 import warnings
 from dataclasses import dataclass, replace
-from typing import List, Optional, Sequence
+from typing import List, Mapping, Optional, Sequence, Union
 
 import numpy as np
 
 from .. import optim
 from ..belief import ParticleBelief, absolute_planar_pose_paired, relative_planar_pose
-from ..models import GraspModels
+from ..models import FAMILIES, GraspModels
 
 
 @dataclass(frozen=True)
@@ -95,7 +100,8 @@ class Plan:
     """A planned grasp. ``kind`` is "stability" or "explore"; ``predicted_stability`` the
     belief-weighted P(S) of the action (Eq. 3.1's integral), ``objective`` what the planner's
     own search maximised (equal for the stability planner), ``expected_entropy`` Eq. 3.2's value
-    for exploration plans (else None), ``seconds`` the wall time of the decision."""
+    for exploration plans (else None), ``seconds`` the wall time of the decision, ``family``
+    the grasp family of the action."""
 
     action: np.ndarray
     kind: str
@@ -104,6 +110,7 @@ class Plan:
     expected_entropy: Optional[float] = None
     seconds: float = 0.0
     evaluations: int = 0
+    family: str = "top"
 
 
 @dataclass
@@ -111,6 +118,25 @@ class Observation:
     action: np.ndarray
     measurement: np.ndarray
     stable: bool
+    family: str = "top"
+
+
+def family_models(models: Union[GraspModels, Mapping[str, GraspModels]]) -> dict:
+    """One family's models or a mapping family -> models, as a dict in FAMILIES order; the
+    families must measure the same joints."""
+    if isinstance(models, GraspModels):
+        return {models.family: models}
+    out = {f: models[f] for f in FAMILIES if f in models}
+    if not out or len(out) != len(models):
+        raise ValueError(f"models: a GraspModels or a mapping from families ({', '.join(FAMILIES)}) to GraspModels; "
+                         f"got keys {list(models)}")
+    for f, m in out.items():
+        if not isinstance(m, GraspModels) or m.family != f:
+            raise ValueError(f"models[{f!r}]: expected the {f} family's GraspModels")
+    joints = {tuple(m.joint_index) for m in out.values()}
+    if len(joints) > 1:
+        raise ValueError("models: the families measure different joints")
+    return out
 
 
 class MeasurementWarning(UserWarning):
@@ -140,9 +166,12 @@ class Planner:
 
     method = "base"
 
-    def __init__(self, models: GraspModels, estimate: Sequence[float], settings: Optional[PlannerSettings] = None,
-                 seed: int = 0, table_bounds: Optional[Sequence[float]] = None):
-        self.models = models
+    def __init__(self, models: Union[GraspModels, Mapping[str, GraspModels]], estimate: Sequence[float],
+                 settings: Optional[PlannerSettings] = None, seed: int = 0,
+                 table_bounds: Optional[Sequence[float]] = None):
+        self.family_models = family_models(models)
+        self.families = tuple(self.family_models)
+        self.models = self.family_models[self.families[0]]   # the first family's (every family: family_models)
         self.settings = settings or PlannerSettings()
         est = np.asarray(estimate, dtype=float).ravel()
         if est.shape != (3,) or not np.all(np.isfinite(est)):
@@ -160,7 +189,8 @@ class Planner:
                                  wrap_angle(est[2] + self._rng.uniform(-hw[2], hw[2], n))])
         self._yaw_lo, self._yaw_hw = est[2], hw[2]
         self.belief = ParticleBelief(parts, low, high, wraps=[False, False, True], seed=self.seed)
-        self.table = models.table()
+        self.tables = {f: m.table() for f, m in self.family_models.items()}
+        self.table = self.tables[self.families[0]]
         self.observations: List[Observation] = []
         self.history: List[dict] = []
         self._plans = 0
@@ -171,13 +201,22 @@ class Planner:
         d = np.abs(wrap_angle(poses[:, 2] - self._yaw_lo))
         return np.where(d <= self._yaw_hw, 0.0, -np.inf)
 
+    def _family(self, family: Optional[str]) -> str:
+        """A family this planner has models for (None: the first)."""
+        if family is None:
+            return self.families[0]
+        if family not in self.family_models:
+            raise ValueError(f"family: this planner has models for {', '.join(self.families)}; got {family!r}")
+        return family
+
     def log_likelihood(self, poses: np.ndarray, obs: Observation) -> np.ndarray:
-        """log P(M = m, S = s | A = a, O = pose) for every pose (N, 3)."""
+        """log P(M = m, S = s | A = a, O = pose) for every pose (N, 3), with the models of the
+        observation's family."""
         rel = relative_planar_pose(obs.action[None, :], poses)
-        ll = self.models.log_likelihood(rel, obs.measurement)
+        ll = self.family_models[obs.family].log_likelihood(rel, obs.measurement)
         if self.settings.use_outcome:
             f = self.settings.outcome_floor
-            ps = np.clip(self.table.stability(rel), f, 1.0 - f)
+            ps = np.clip(self.tables[obs.family].stability(rel), f, 1.0 - f)
             ll = ll + np.log(ps if obs.stable else 1.0 - ps)
         return ll
 
@@ -201,9 +240,13 @@ class Planner:
     def _plan(self) -> Plan:
         raise NotImplementedError
 
-    def observe(self, action, measurement, stable: bool) -> None:
-        """Bayes update after executing ``action`` (world top grasp) and reading ``measurement``
-        (the phalanx joint angles the models predict) and whether the grasp was stable."""
+    def observe(self, action, measurement, stable: bool, family: Optional[str] = None) -> None:
+        """Bayes update after executing ``action`` (a world grasp (x, y, yaw) of ``family``; None:
+        the planner's only family) and reading ``measurement`` (the phalanx joint angles the
+        models predict) and whether the grasp was stable."""
+        if family is None and len(self.families) > 1:
+            raise ValueError(f"family: which family was executed ({', '.join(self.families)})?")
+        family = self._family(family)
         a = np.asarray(action, dtype=float).ravel()
         m = np.asarray(measurement, dtype=float).ravel()
         if a.shape != (3,) or not np.all(np.isfinite(a)):
@@ -215,10 +258,10 @@ class Planner:
             warnings.warn(f"measurement: joint angles {m.tolist()} lie beyond +-{MAX_JOINT_ANGLE:.2f} rad, outside "
                           "any joint's range (degrees instead of radians?); the belief will collapse onto the "
                           "few poses least unlikely under it", MeasurementWarning, stacklevel=2)
-        obs = Observation(a, m, stable)
+        obs = Observation(a, m, stable, family)
         self.observations.append(obs)
         self._update(obs)
-        self.history.append({"action": a.tolist(), "measurement": m.tolist(), "stable": stable,
+        self.history.append({"family": family, "action": a.tolist(), "measurement": m.tolist(), "stable": stable,
                              "mean": self.belief.mean().tolist(), "ess": float(self.belief.ess())})
 
     def _update(self, obs: Observation) -> None:
@@ -237,31 +280,46 @@ class Planner:
         high = np.array([P[:, 0].max() + m, P[:, 1].max() + m, np.pi])
         return low, high
 
-    def _seed_actions(self, poses: np.ndarray, weights: np.ndarray, k: int) -> np.ndarray:
+    def _seed_actions(self, poses: np.ndarray, weights: np.ndarray, k: int, family: Optional[str] = None) -> np.ndarray:
         """k starting grasps: the model's best relative grasps placed at weighted-random particles."""
-        best = self.table.best_relative_grasps(64)
+        best = self.tables[self._family(family)].best_relative_grasps(64)
         j = self._rng.choice(len(poses), size=k, p=weights / weights.sum())
         rel = best[self._rng.integers(0, len(best), k)]
         return absolute_planar_pose_paired(rel, poses[j])
 
-    def maximise_stability(self, poses: np.ndarray, weights: np.ndarray):
-        """PSO over (x, y, yaw) of sum_j w_j P(S | A, O_j) (Eq. 3.1). Returns (action, value, nfev)."""
+    def maximise_stability(self, poses: np.ndarray, weights: np.ndarray, family: Optional[str] = None):
+        """PSO over (x, y, yaw) of sum_j w_j P(S | A, O_j) (Eq. 3.1) for one family (None: the
+        first). Returns (action, value, nfev)."""
         s = self.settings
+        family = self._family(family)
+        table = self.tables[family]
         low, high = self.action_bounds(poses)
         w = np.asarray(weights, dtype=float)
-        init = np.clip(self._seed_actions(poses, w, s.pso_particles), low, high)
+        init = np.clip(self._seed_actions(poses, w, s.pso_particles, family), low, high)
 
         def negative(X):
-            return -self.table.expected_stability(X, poses, w, s.threads)
+            return -table.expected_stability(X, poses, w, s.threads)
 
         r = optim.pso(negative, (low, high), n_particles=s.pso_particles, max_iter=s.pso_iter,
                       seed=int(self._rng.integers(2**31)), init=init)
         return r.x, -r.fun, r.nfev
 
-    def expected_stability(self, action) -> float:
-        """The belief-weighted P(S) of one action."""
-        return float(self.table.expected_stability(np.asarray(action, float)[None, :], self.belief.particles,
-                                                   self.belief.weights, self.settings.threads)[0])
+    def most_stable(self, poses: np.ndarray, weights: np.ndarray):
+        """Eq. 3.1 over every family: (family, action, value, total nfev) of the best; ties go
+        to the earlier family (top first)."""
+        best, total = None, 0
+        for f in self.families:
+            a, v, n = self.maximise_stability(poses, weights, f)
+            total += n
+            if best is None or v > best[2]:
+                best = (f, a, v)
+        return best[0], best[1], best[2], total
+
+    def expected_stability(self, action, family: Optional[str] = None) -> float:
+        """The belief-weighted P(S) of one action of ``family`` (None: the first)."""
+        table = self.tables[self._family(family)]
+        return float(table.expected_stability(np.asarray(action, float)[None, :], self.belief.particles,
+                                              self.belief.weights, self.settings.threads)[0])
 
     # ---- summaries ------------------------------------------------------------------------------
     def mode(self) -> np.ndarray:

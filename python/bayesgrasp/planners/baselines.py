@@ -19,9 +19,9 @@ class MLPosePlanner(Planner):
 
     def _plan(self) -> Plan:
         pose = self.mode()
-        a, v, n = self.maximise_stability(pose[None, :], np.ones(1))
-        return Plan(action=a, kind="stability", predicted_stability=self.expected_stability(a), objective=v,
-                    evaluations=n)
+        f, a, v, n = self.most_stable(pose[None, :], np.ones(1))
+        return Plan(action=a, kind="stability", predicted_stability=self.expected_stability(a, f), objective=v,
+                    evaluations=n, family=f)
 
 
 class OpenLoopPlanner(StabilityPlanner):

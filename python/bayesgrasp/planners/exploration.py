@@ -81,40 +81,50 @@ class ExplorationPlanner(Planner):
 
     def _plan(self) -> Plan:
         b = self.belief
-        a, v, n = self.maximise_stability(b.particles, b.weights)
+        f, a, v, n = self.most_stable(b.particles, b.weights)
         if v >= self.settings.explore_threshold:
-            return Plan(action=a, kind="stability", predicted_stability=v, objective=v, evaluations=n)
-        e, _, n2 = self.minimise_entropy(init_best=a)
-        h = float(self.expected_entropy(e[None, :], seed=self.seed + 7919 * self._plans)[0][0])
-        return Plan(action=e, kind="explore", predicted_stability=self.expected_stability(e), objective=-h,
-                    expected_entropy=h, evaluations=n + n2)
+            return Plan(action=a, kind="stability", predicted_stability=v, objective=v, evaluations=n, family=f)
+        best = None
+        for g in self.families:   # the most informative grasp of each family; the lowest objective wins
+            e, obj, n2 = self.minimise_entropy(init_best=a if g == f else None, family=g)
+            n += n2
+            if best is None or obj < best[2]:
+                best = (g, e, obj)
+        g, e, _ = best
+        h = float(self.expected_entropy(e[None, :], seed=self.seed + 7919 * self._plans, family=g)[0][0])
+        return Plan(action=e, kind="explore", predicted_stability=self.expected_stability(e, g), objective=-h,
+                    expected_entropy=h, evaluations=n, family=g)
 
     def expected_entropy(self, actions, n_samples: Optional[int] = None, seed: Optional[int] = None,
-                         method: Optional[str] = None):
-        """Expected posterior entropy (Eq. 3.2) of actions (A, 3) under the current belief:
-        (entropy (A,), standard error (A,))."""
+                         method: Optional[str] = None, family: Optional[str] = None):
+        """Expected posterior entropy (Eq. 3.2) of actions (A, 3) of ``family`` (None: the
+        first) under the current belief: (entropy (A,), standard error (A,))."""
         s = self.settings
+        table = self.tables[self._family(family)]
         A = np.atleast_2d(np.asarray(actions, dtype=float))
         n_samples = s.entropy_samples if n_samples is None else int(n_samples)
         seed = self.seed + 7919 * self._plans if seed is None else int(seed)
         method = s.entropy if method is None else method
         b = self.belief
         if method == "weight":
-            return self.table.expected_posterior_entropy(A, b.particles, b.log_weights, n_samples, seed, s.threads)
+            return table.expected_posterior_entropy(A, b.particles, b.log_weights, n_samples, seed, s.threads)
         if method != "kernel":
             raise ValueError(f"method: 'weight' or 'kernel', got {method!r}")
         K = kernel_matrix(b.particles, b.weights)
         hs, ses = [], []
         for start in range(0, len(A), 64):
-            mean, var = self.table.measurement_pairs(A[start:start + 64], b.particles, s.threads)
+            mean, var = table.measurement_pairs(A[start:start + 64], b.particles, s.threads)
             h, se = expected_kernel_entropy(mean, var, b.log_weights, K, n_samples, seed)
             hs.append(h)
             ses.append(se)
         return np.concatenate(hs), np.concatenate(ses)
 
-    def minimise_entropy(self, init_best=None):
-        """PSO over (x, y, yaw) of the expected posterior entropy. Returns (action, entropy, nfev)."""
+    def minimise_entropy(self, init_best=None, family: Optional[str] = None):
+        """PSO over (x, y, yaw) of ``family``'s grasps (None: the first) of the expected posterior
+        entropy minus explore_stability_weight x P(S). Returns (action, objective, nfev)."""
         s = self.settings
+        family = self._family(family)
+        table = self.tables[family]
         low, high = self.action_bounds()
         seed = self.seed + 7919 * self._plans   # one common-random-number seed for the whole search
         k = s.explore_pso_particles
@@ -126,9 +136,9 @@ class ExplorationPlanner(Planner):
         b = self.belief
 
         def objective(X):
-            h = self.expected_entropy(X, seed=seed)[0]
+            h = self.expected_entropy(X, seed=seed, family=family)[0]
             if lam != 0.0:
-                h = h - lam * self.table.expected_stability(X, b.particles, b.weights, s.threads)
+                h = h - lam * table.expected_stability(X, b.particles, b.weights, s.threads)
             return h
 
         r = optim.pso(objective, (low, high), n_particles=k, max_iter=s.explore_pso_iter,

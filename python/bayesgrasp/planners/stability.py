@@ -1,5 +1,6 @@
 """Stability maximisation (thesis §3.2, Pub. II, Eq. 3.1): the grasp that maximises the
-expected stability sum_j w_j P(S | A, O_j) over the particle belief, found by PSO."""
+expected stability sum_j w_j P(S | A, O_j) over the particle belief, found by PSO (in every grasp
+family the planner has models for)."""
 from __future__ import annotations
 
 from .base import Plan, Planner
@@ -12,5 +13,5 @@ class StabilityPlanner(Planner):
 
     def _plan(self) -> Plan:
         b = self.belief
-        a, v, n = self.maximise_stability(b.particles, b.weights)
-        return Plan(action=a, kind="stability", predicted_stability=v, objective=v, evaluations=n)
+        f, a, v, n = self.most_stable(b.particles, b.weights)
+        return Plan(action=a, kind="stability", predicted_stability=v, objective=v, evaluations=n, family=f)
