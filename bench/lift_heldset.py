@@ -16,6 +16,12 @@ verdicts at each torque (every driven joint) and at the hand's own (sweep_torque
 (T, N); the last row "hand"), for bench/lift_torque_mujoco.py. ``--objects`` restricts the objects
 (names of both lists; the random picks of the later objects then differ). With ``--held-share N``
 it also prints the held share of N force-closure top grasps per Pub. II object.
+``--executed DIR,...`` adds the grasps the planners executed in stored experiments (each DIR an
+experiment's output with its results.sqlite): ``pub2`` attempts per grasp family (sources
+``executed_top`` / ``executed_side``, re-closed from the attempt's relative grasp and variant)
+and category task grasps of mugs and bottles (``executed_category``, re-closed along the stored
+hand pose in the object's frame); force-closure ones only, at most ``--per-executed`` per object
+and source, and our re-closed verdict is checked against the stored one.
 
     BAYESGRASP_CORE_DIR=build/dev/bayesgrasp_core PYTHONPATH=python python bench/lift_heldset.py --out bench/results/heldset
 """
@@ -25,9 +31,14 @@ import os
 import sys
 import time
 
+import sqlite3
+from types import SimpleNamespace
+
 import numpy as np
 
 from bayesgrasp import physics
+from bayesgrasp.hand import Hand
+from bayesgrasp.models import Variant
 from bayesgrasp.world import World
 
 PUB2 = ["cube", "cylinder", "mug", "mug2", "pitcher"]
@@ -57,6 +68,56 @@ def approaches(w, n, rng):
 
 def force_closure(b):
     return np.flatnonzero((np.asarray(b.epsilon) > 0) & ~np.asarray(b.collision_at_start, bool))
+
+
+def _stored_runs(result_dir):
+    db = sqlite3.connect(f"file:{os.path.join(result_dir, 'results.sqlite')}?mode=ro", uri=True)
+    try:
+        return [(e, o, json.loads(t)) for e, o, t in db.execute("SELECT experiment, object, result FROM runs")]
+    finally:
+        db.close()
+
+
+def executed_grasps(result_dirs):
+    """{(object, source): [(kind, data, stored lifted)]}: pub2 attempts ("rel", (relative grasp,
+    variant dict)) and category task grasps of table-standing objects ("pose", (4x4 hand pose in
+    the object's frame, spread)), from stored runs."""
+    out = {}
+    for d in result_dirs:
+        for exp, obj, r in _stored_runs(d):
+            for a in r.get("attempts", []):
+                if "variant" in a and a.get("lifted") is not None:
+                    out.setdefault((obj, f"executed_{a['family']}"), []).append(
+                        ("rel", (a["relative_grasp"], a["variant"]), bool(a["lifted"])))
+            if "tasks" in r and obj.split("/")[0] in ("mug", "bottle"):
+                T = World.single(obj, pose=tuple(r["pose"])).scene.object_pose(0)
+                for methods in r["tasks"].values():
+                    for g in methods.values():
+                        if g.get("executed") and g.get("lifted") is not None:
+                            H = np.linalg.solve(T, np.asarray(g["hand_pose"], float))
+                            out.setdefault((obj, "executed_category"), []).append(("pose", (H, g["spread"]),
+                                                                                   bool(g["lifted"])))
+    return out
+
+
+def reclose(w, items):
+    """The stored grasps closed again in ``w`` (object at pose 0): a batch-like namespace with
+    hand_pose, joint_angles, epsilon, collision_at_start, lifted (ours, re-tested)."""
+    T0 = w.scene.object_pose(w.object_index)
+    rows = []
+    for kind, data, _ in items:
+        if kind == "rel":
+            rel, variant = data
+            g = Variant(**variant).grasp(w, rel, lift=True)
+        else:
+            H = T0 @ data[0]
+            g = w.approach(H[:3, 2], H[:3, 3], Hand.approach_roll(H), spread=data[1], frame="world", lift=True)
+        rows.append(g)
+    return SimpleNamespace(hand_pose=np.array([g.hand_pose for g in rows]),
+                           joint_angles=np.array([g.joint_angles for g in rows]),
+                           epsilon=np.array([g.epsilon for g in rows]),
+                           collision_at_start=np.array([g.collision_at_start for g in rows], bool),
+                           lifted=np.array([bool(g.lifted) for g in rows]))
 
 
 def export(w, name, b, idx, source, out, sweep=()):
@@ -120,6 +181,9 @@ def main():
     ap.add_argument("--seed", type=int, default=0)
     ap.add_argument("--objects", default=None,
                     help="comma-separated objects to export (default: all; e.g. cube,mug/0)")
+    ap.add_argument("--executed", default="",
+                    help="comma-separated experiment output directories whose executed grasps to add")
+    ap.add_argument("--per-executed", type=int, default=40, help="executed grasps per object and source at most")
     ap.add_argument("--sweep-torques", default="",
                     help="N m, comma-separated: also store our verdicts at each torque and the hand's (e.g. 0.25,0.5,1,2,3)")
     a = ap.parse_args()
@@ -167,6 +231,20 @@ def main():
         r = export(w, name, b, idx, "approach", a.out, sweep)
         total += len(idx)
         print(f"{name}: {len(fc)} force-closure approaches, exported {len(idx)}, lifted {int(np.sum(r.lifted))}",
+              file=sys.stderr, flush=True)
+    executed = executed_grasps([d for d in a.executed.split(",") if d.strip()]) if a.executed else {}
+    for (name, source), items in sorted(executed.items()):
+        w = World.single(name)
+        b = reclose(w, items)
+        stored = np.array([it[2] for it in items])
+        fc = force_closure(b)
+        idx = rng.choice(fc, size=min(a.per_executed, len(fc)), replace=False) if len(fc) else fc
+        if len(idx) == 0:
+            continue
+        r = export(w, name, b, idx, source, a.out, sweep)
+        total += len(idx)
+        print(f"{name} {source}: {len(items)} executed, {len(fc)} force closure, exported {len(idx)}, lifted "
+              f"{int(np.sum(r.lifted))}; re-closed verdict = stored on {int(np.sum(b.lifted == stored))}/{len(items)}",
               file=sys.stderr, flush=True)
     print(f"exported {total} grasps to {a.out}", file=sys.stderr)
     if summary:

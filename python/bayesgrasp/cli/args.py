@@ -99,9 +99,10 @@ def add_context_options(p: argparse.ArgumentParser, lift: bool = False, seed: bo
                                                  "$BAYESGRASP_CACHE defaulting to ~/.cache/bayesgrasp)")
     if seed:
         p.add_argument("--seed", type=bounded_int(0, SEED_MAX), default=0, help="seed of every random draw (same seed, same result)")
-    p.add_argument("--set", action="append", default=[], metavar="models.FIELD=VALUE",
-                   help="override a grasp-model setting (bayesgrasp.models.ModelSettings), e.g. models.n_samples=500; "
-                        "repeatable")
+    p.add_argument("--set", action="append", default=[], metavar="GROUP.FIELD=VALUE",
+                   help="override a setting: models.FIELD (bayesgrasp.models.ModelSettings, e.g. models.n_samples=500), "
+                        "planner.FIELD (bayesgrasp.planners.PlannerSettings, e.g. planner.n_particles=1000) "
+                        "or episode.measurement_noise (rad); repeatable")
     if lift:
         p.add_argument("--no-lift", action="store_true", help="skip the physical lift tests (faster)")
 
@@ -148,7 +149,9 @@ def context(args: argparse.Namespace, progress: bool = True):
                       success=success, lift=lift, seed=getattr(args, "seed", 0),
                       progress=stderr_progress if progress else None,
                       model_settings=model_settings(getattr(args, "set", []), success),
-                      families=families_arg(getattr(args, "families", "top")))
+                      families=families_arg(getattr(args, "families", "top")),
+                      planner=planner_settings(getattr(args, "set", [])),
+                      measurement_noise=measurement_noise(getattr(args, "set", [])))
 
 
 def families_arg(text):
@@ -161,40 +164,88 @@ def families_arg(text):
         raise CliError(f"--{e}") from None
 
 
-def model_settings(assignments, success: str):
-    """ModelSettings from ``models.FIELD=VALUE`` overrides (None when there are none); values are
-    read as the field's type (int, float, bool, or None for the spread)."""
+#: --set's groups: the dataclass each sets (planner and episode settings reach the experiments only).
+SET_GROUPS = ("models", "planner", "episode")
+
+
+def _set_classes():
+    from ..experiments.context import EpisodeOverrides
+    from ..models import ModelSettings
+    from ..planners import PlannerSettings
+
+    return {"models": ModelSettings, "planner": PlannerSettings, "episode": EpisodeOverrides}
+
+
+def _read_value(default, text: str, name: str):
+    """``text`` read as the type of the field's ``default`` (bool, int, float, a tuple of
+    floats "a,b,c", None for an optional number, or a string)."""
+    if text.lower() == "none" and (default is None or name == "spread"):
+        return None
+    if isinstance(default, bool):
+        return {"true": True, "false": False}[text.lower()]
+    if isinstance(default, int):
+        return int(text)
+    if isinstance(default, float) or default is None:
+        return float(text)
+    if isinstance(default, (tuple, list)):
+        return tuple(float(v) for v in text.split(","))
+    return text
+
+
+def parse_set(assignments) -> dict:
+    """``GROUP.FIELD=VALUE`` overrides (--set) as {group: {field: value}}, each value read as its
+    field's type; a CliError names a wrong group, field or value."""
     import dataclasses
 
-    from ..models import ModelSettings
-
-    if not assignments:
-        return None
-    fields = {f.name for f in dataclasses.fields(ModelSettings)}
-    values = {"success": success}
+    classes = _set_classes()
+    out: dict = {}
     for a in assignments:
         key, sep, text = a.partition("=")
         group, _, name = key.partition(".")
-        if not sep or group != "models" or name not in fields:
-            raise CliError(f"--set: expected models.FIELD=VALUE with FIELD one of {', '.join(sorted(fields))}; got {a!r}")
-        default = getattr(ModelSettings(), name)
+        cls = classes.get(group)
+        fields = {f.name for f in dataclasses.fields(cls)} if cls else set()
+        if not sep or name not in fields:
+            known = "; ".join(f"{g}: {', '.join(sorted(f.name for f in dataclasses.fields(c)))}"
+                              for g, c in classes.items())
+            raise CliError(f"--set: expected models.FIELD=VALUE, planner.FIELD=VALUE or episode.FIELD=VALUE with "
+                           f"FIELD one of ({known}); got {a!r}")
+        default = getattr(cls(), name)
         try:
-            if text.lower() == "none" and name == "spread":
-                values[name] = None
-            elif isinstance(default, bool):
-                values[name] = {"true": True, "false": False}[text.lower()]
-            elif isinstance(default, int):
-                values[name] = int(text)
-            elif isinstance(default, float) or default is None:
-                values[name] = float(text)
-            else:
-                values[name] = text
+            out.setdefault(group, {})[name] = _read_value(default, text, name)
         except (ValueError, KeyError):
             raise CliError(f"--set: {key}: cannot read {text!r} as {type(default).__name__}") from None
+    return out
+
+
+def model_settings(assignments, success: str):
+    """ModelSettings from the ``models.FIELD=VALUE`` overrides (None when there are none)."""
+    from ..models import ModelSettings
+
+    values = parse_set(assignments).get("models")
+    if not values:
+        return None
     try:
-        return ModelSettings(**values)
+        return ModelSettings(**{"success": success, **values})
     except ValueError as e:
         raise CliError(f"--set: {e}") from None
+
+
+def planner_settings(assignments):
+    """PlannerSettings from the ``planner.FIELD=VALUE`` overrides (None when there are none)."""
+    from ..planners import PlannerSettings
+
+    values = parse_set(assignments).get("planner")
+    if not values:
+        return None
+    try:
+        return PlannerSettings(**values)
+    except ValueError as e:
+        raise CliError(f"--set: planner.{e}") from None
+
+
+def measurement_noise(assignments) -> float:
+    """episode.measurement_noise from the overrides (0 when not given)."""
+    return float(parse_set(assignments).get("episode", {}).get("measurement_noise", 0.0))
 
 
 FORMATS = ("text", "json", "ros")

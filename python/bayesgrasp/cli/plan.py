@@ -67,7 +67,6 @@ def _loop(args, pose, attempts: int = 4, estimate=None, noise: float = 0.0, quie
     from dataclasses import replace
 
     from ..experiments.episode import EpisodeSettings, run_episode
-    from ..planners.base import PlannerSettings
     from ..world import World
 
     if attempts < 1:
@@ -76,8 +75,10 @@ def _loop(args, pose, attempts: int = 4, estimate=None, noise: float = 0.0, quie
     obj = args.object if obj is None else obj
     World.single(obj, pose=pose, hand=ctx.hand)  # a clear error for an unknown object or a pose off the table
     models = ctx.family_models(obj)
-    planner = PlannerSettings() if half_width is None else replace(PlannerSettings(), half_width=tuple(half_width))
-    episode = EpisodeSettings(method=args.method, attempts=attempts, measurement_noise=noise, planner=planner)
+    planner = ctx.planner_settings()
+    planner = planner if half_width is None else replace(planner, half_width=tuple(half_width))
+    episode = EpisodeSettings(method=args.method, attempts=attempts, measurement_noise=noise or ctx.measurement_noise,
+                              planner=planner)
     return run_episode(obj, pose, episode, ctx, seed=args.seed, estimate=estimate, models=models,
                        keep_planner=True, on_attempt=None if quiet else _print_attempt)
 

@@ -2,6 +2,7 @@
 CLI or the experiment driver) and passed down instead of threading each setting by hand."""
 from __future__ import annotations
 
+import math
 import sys
 from dataclasses import dataclass, field, replace
 from typing import Callable, Optional, Union
@@ -9,6 +10,7 @@ from typing import Callable, Optional, Union
 from ..models import GraspModels, ModelSettings, get_models, parse_families
 from ..models.settings import SUCCESS_CRITERIA
 from ..objects import ObjectModel
+from ..planners import PlannerSettings
 
 
 def _plain(v):
@@ -23,6 +25,13 @@ def stderr_progress(message: str) -> None:
 
 
 @dataclass(frozen=True)
+class EpisodeOverrides:
+    """The episode settings an experiment takes from its caller (``--set episode.FIELD=VALUE``)."""
+
+    measurement_noise: float = 0.0
+
+
+@dataclass(frozen=True)
 class RunContext:
     """hand: hand name or file; cache_dir: the model cache (None: $BAYESGRASP_CACHE/models);
     success: what a successful grasp is, "lift" (held in the physical lift test) or "epsilon"
@@ -31,7 +40,9 @@ class RunContext:
     threads for batches (0 = all cores); seed: the base seed; progress: a callable taking a message
     (None: silent; not sent to worker processes); model_settings: how the grasp models are built
     (None: the defaults for the success criterion); families: the grasp families the planners
-    choose from ("top", as in the thesis, and "side"; :mod:`bayesgrasp.models.families`)."""
+    choose from ("top", as in the thesis, and "side"; :mod:`bayesgrasp.models.families`);
+    planner: the planners' settings (None: the defaults); measurement_noise: std (rad) of the
+    Gaussian noise on the measured joint angles in the closed-loop experiments."""
 
     hand: str = "barrett_bh8"
     cache_dir: Optional[str] = None
@@ -42,8 +53,15 @@ class RunContext:
     progress: Optional[Callable[[str], None]] = field(default=None, compare=False)
     model_settings: Optional[ModelSettings] = None   # None: ModelSettings(success=self.success)
     families: tuple = ("top",)
+    planner: Optional[PlannerSettings] = None
+    measurement_noise: float = 0.0
 
     def __post_init__(self):
+        if self.planner is not None and not isinstance(self.planner, PlannerSettings):
+            raise ValueError(f"planner: a PlannerSettings or None, got {type(self.planner).__name__}")
+        if not (isinstance(self.measurement_noise, (int, float)) and math.isfinite(self.measurement_noise)
+                and self.measurement_noise >= 0):
+            raise ValueError(f"measurement_noise: must be >= 0 (rad), got {self.measurement_noise!r}")
         try:
             object.__setattr__(self, "families", parse_families(self.families))
         except ValueError as e:
@@ -72,6 +90,10 @@ class RunContext:
         settings = settings or self.model_settings or ModelSettings(success=self.success)
         return {f: self.models(obj, replace(settings, family=f)) for f in self.families}
 
+    def planner_settings(self) -> PlannerSettings:
+        """The planners' settings of this context (the defaults when none were given)."""
+        return self.planner or PlannerSettings()
+
     def result_settings(self) -> dict:
         """Every setting of this context that changes a run's result, as plain JSON values: the
         package and cache versions, the hand (its name and a digest of its file), the success
@@ -91,7 +113,9 @@ class RunContext:
         return {"bayesgrasp": __version__, "cache_version": CACHE_VERSION, "hand": hand.name,
                 "hand_file_sha256": hashlib.sha256(text).hexdigest()[:16], "success": self.success,
                 "lift": self.lift, "families": list(self.families),
-                "models": {k: _plain(v) for k, v in asdict(models).items()}}
+                "models": {k: _plain(v) for k, v in asdict(models).items()},
+                "planner": {k: _plain(v) for k, v in asdict(self.planner_settings()).items()},
+                "measurement_noise": float(self.measurement_noise)}
 
     def for_workers(self) -> "RunContext":
         """The same context without the progress callable (worker processes get it pickled)."""

@@ -1,21 +1,50 @@
 """Running an experiment: build what the runs share once (models, task grasps), run every
 (method, object, run) not yet stored, write the report. Any registered experiment
-(:mod:`.registry`) runs this way."""
+(:mod:`.registry`) runs this way, on any engine (:mod:`.engines`)."""
 from __future__ import annotations
 
+import time
+from functools import partial
 from pathlib import Path
 from typing import Dict, Optional, Sequence
 
 from .context import RunContext
+from .engines import LocalEngine
 from .registry import get_experiment
-from .runner import ResultStore, run_experiment
+from .runner import ResultStore, Series, run_all
+
+
+def _prepare_object(obj: str, name: str, ctx: RunContext) -> float:
+    """Engine task: experiment ``name``'s shared inputs of one object (its models) built or
+    loaded into the cache; returns the seconds it took."""
+    from . import get_experiment as registered  # importing the package registers every experiment
+
+    t0 = time.perf_counter()
+    exp = registered(name)
+    exp.prepare_object(exp, obj, ctx)
+    return time.perf_counter() - t0
+
+
+def prepare(exp, objects: Sequence[str], ctx: RunContext, engine) -> None:
+    """What the runs share, built once: per object as engine tasks (in parallel; each writes the
+    model cache the runs then read) when the experiment has ``prepare_object``, then its
+    ``prepare`` in this process."""
+    if exp.prepare_object is not None:
+        local = isinstance(engine, LocalEngine) and engine.workers == 1
+        task = partial(_prepare_object, name=exp.name, ctx=ctx if local else ctx.for_workers())
+        for obj, seconds in engine.map(task, list(objects)):
+            if ctx.progress is not None:
+                ctx.progress(f"{exp.name}: {obj} prepared ({seconds:.0f} s)")
+    if exp.prepare is not None:
+        exp.prepare(exp, list(objects), ctx)
 
 
 def run(name: str, out_dir, ctx: Optional[RunContext] = None, runs: Optional[int] = None, workers: int = 1,
-        objects: Optional[Sequence[str]] = None) -> dict:
+        objects: Optional[Sequence[str]] = None, engine=None) -> dict:
     """Runs (or resumes) experiment ``name`` into ``out_dir`` and writes its tables and plots.
-    Returns the summary dict (also written as summary.json). Progress (model building, the
-    progress bar) is shown when ``ctx.progress`` is set."""
+    ``engine``: where the runs go (default: ``workers`` local processes). Returns the summary
+    dict (also written as summary.json). Progress (model building, the progress bar) is shown
+    when ``ctx.progress`` is set."""
     exp = get_experiment(name)
     ctx = ctx or RunContext()
     runs = exp.runs if runs is None else int(runs)
@@ -23,22 +52,21 @@ def run(name: str, out_dir, ctx: Optional[RunContext] = None, runs: Optional[int
         raise ValueError(f"runs: must be at least 1, got {runs}")
     if workers < 1:
         raise ValueError(f"workers: must be at least 1, got {workers}")
+    engine = engine or LocalEngine(workers)
     objects = list(exp.objects if objects is None else objects)
     out = Path(out_dir)
     worker_ctx = ctx.for_workers()
     runs_of = {method: exp.make_run(exp, method, worker_ctx) for method in exp.methods}  # (series, fn)
     settings = ctx.result_settings()
     store = ResultStore(out / "results.sqlite")
-    results: Dict[str, list] = {}
     try:
         # Refuse a resume under other settings before building anything.
         for series, _ in runs_of.values():
             store.check_settings(series, settings)
-        if exp.prepare is not None:
-            exp.prepare(exp, objects, ctx)
-        for method, (series, fn) in runs_of.items():
-            results[method] = run_experiment(series, objects, runs, fn, store, ctx.seed, workers,
-                                             progress=ctx.progress is not None, settings=settings)
+        prepare(exp, objects, ctx, engine)
+        done = run_all([Series(series, tuple(objects), runs, fn) for series, fn in runs_of.values()], store,
+                       ctx.seed, engine, progress=ctx.progress is not None, settings=settings)
+        results: Dict[str, list] = {method: done[series] for method, (series, _) in runs_of.items()}
         store.flatten()
     finally:
         store.close()

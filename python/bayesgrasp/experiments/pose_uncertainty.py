@@ -58,7 +58,8 @@ def episode_run(experiment: str, obj: str, run_index: int, seed: int, *, base: s
                 stop_when_stable: bool, ctx: RunContext) -> dict:
     """One closed-loop episode on the run's true pose (the same problem for every method)."""
     pose = true_pose(base, obj, run_index, ctx.seed)
-    episode = EpisodeSettings(method=method, stop_when_stable=stop_when_stable)
+    episode = EpisodeSettings(method=method, stop_when_stable=stop_when_stable,
+                              measurement_noise=ctx.measurement_noise, planner=ctx.planner_settings())
     return _strip(run_episode(obj, pose, episode, ctx, seed=run_seed(ctx.seed, base, obj, run_index)))
 
 
@@ -70,7 +71,7 @@ def _initial_planner(name: str, obj: str, run_index: int, ctx: RunContext, seed:
     pose = true_pose(name, obj, run_index, ctx.seed)
     models = models or ctx.models(obj)
     rng = np.random.default_rng(seed)
-    s = settings or PlannerSettings()
+    s = settings or ctx.planner_settings()
     est = pose + rng.uniform(-np.asarray(s.half_width), np.asarray(s.half_width))
     return pose, models, make_planner("explore", models, est, s, seed=int(rng.integers(2**31))), rng, s
 
@@ -172,10 +173,9 @@ def landscapes_run(experiment: str, obj: str, run_index: int, seed: int, *, ctx:
 
 
 # ---- the registered experiments ---------------------------------------------------------------------
-def prepare_models(exp: Experiment, objects: List[str], ctx: RunContext) -> None:
-    """Every object's grasp models (each family's), built (or loaded) once in this process."""
-    for o in objects:
-        ctx.family_models(o)
+def prepare_models(exp: Experiment, obj: str, ctx: RunContext) -> None:
+    """One object's grasp models (each family's), built (or loaded) into the cache once."""
+    ctx.family_models(obj)
 
 
 def _episodes(exp: Experiment, method: str, ctx: RunContext):
@@ -195,7 +195,8 @@ def belief_figures(exp: Experiment, objects: List[str], ctx: RunContext, out: Pa
     lines = []
     for o in objects:
         pose = true_pose(exp.name, o, 0, ctx.seed)
-        episode = EpisodeSettings(method=method, stop_when_stable=(exp.name != "pub4"))
+        episode = EpisodeSettings(method=method, stop_when_stable=(exp.name != "pub4"),
+                                  measurement_noise=ctx.measurement_noise, planner=ctx.planner_settings())
         r = run_episode(o, pose, episode, ctx,
                         seed=run_seed(ctx.seed, exp.name, o, 0), keep_planner=True)
         p = report.plot_belief_evolution(r["snapshots"], pose, out / f"belief_{o}.png",
@@ -206,14 +207,14 @@ def belief_figures(exp: Experiment, objects: List[str], ctx: RunContext, out: Pa
 
 
 register(Experiment("pub2", FIVE, 100, "stability maximisation (Pub. II)", _episodes, report.write_episodes,
-                    ("stability",), belief_figures, prepare_models))
+                    ("stability",), belief_figures, prepare_object=prepare_models))
 register(Experiment("baselines", FIVE, 30, "all planners and the two baselines", _episodes, report.write_episodes,
-                    METHODS, prepare=prepare_models))
+                    METHODS, prepare_object=prepare_models))
 register(Experiment("pub4", ("cube", "mug", "cylinder"), 30,
                     "exploration vs stability only, 4 grasps per run (Pub. IV)", _episodes, report.write_episodes,
-                    ("explore", "stability"), belief_figures, prepare_models))
+                    ("explore", "stability"), belief_figures, prepare_object=prepare_models))
 register(Experiment("entropy_order", ("cube", "mug"), 30,
                     "predicted vs realised entropy order of three grasps (Fig. 3.6)", _explore_runs(entropy_order_run),
-                    report.write_entropy_order, ("explore",), prepare=prepare_models))
+                    report.write_entropy_order, ("explore",), prepare_object=prepare_models))
 register(Experiment("landscapes", ("mug", "cube"), 3, "weight vs kernel entropy landscapes; 1,000 vs 10,000 samples",
-                    _explore_runs(landscapes_run), report.write_landscapes, ("explore",), prepare=prepare_models))
+                    _explore_runs(landscapes_run), report.write_landscapes, ("explore",), prepare_object=prepare_models))

@@ -22,9 +22,11 @@ class Experiment:
     * ``make_run(experiment, method, ctx)`` -> (series key in the result store, RunFunction);
     * ``report(experiment, results, out)`` -> summary dict; ``results`` maps method -> [(RunKey, dict)];
       writes summary.md, summary.json, tables and plots into ``out``;
+    * ``prepare_object(experiment, object, ctx)`` (optional): what the runs of one object share
+      (its models), built before the runs as an engine task per object (in parallel), into the
+      disk cache the runs then read;
     * ``prepare(experiment, objects, ctx)`` (optional): what the runs share, built once in the
-      driver's process before them (models, task grasps: their disk cache is then shared by the
-      workers);
+      driver's process before them (task grasps: their disk cache is then shared by the workers);
     * ``finish(experiment, objects, ctx, out)`` (optional): extra figures after the report.
     """
 
@@ -37,6 +39,7 @@ class Experiment:
     methods: Sequence[str] = ("stability",)
     finish: Optional[Callable[["Experiment", List[str], "RunContext", Path], None]] = None
     prepare: Optional[Callable[["Experiment", List[str], "RunContext"], None]] = None
+    prepare_object: Optional[Callable[["Experiment", str, "RunContext"], None]] = None
 
 
 EXPERIMENTS: Dict[str, Experiment] = {}

@@ -47,6 +47,7 @@ def episode_table(results: list, attempts: int = ATTEMPTS) -> List[dict]:
                 "force_closure": float(np.mean([any(a["force_closure"] for a in r["attempts"][:k]) for r in runs])),
                 "success_at_attempt": float(np.mean([_success(a) for a in made])) if made else float("nan"),
                 "explore_fraction": float(np.mean([a["kind"] == "explore" for a in made])) if made else float("nan"),
+                "side_fraction": float(np.mean([a.get("family", "top") == "side" for a in made])) if made else float("nan"),
                 "predicted_stability": float(np.mean([a["predicted_stability"] for a in made])) if made else float("nan"),
                 "epsilon": float(np.mean([a["epsilon"] for a in made])) if made else float("nan"),
                 "position_error_cm": 100 * float(np.mean([after(r)["position_error"] for r in runs])),
@@ -97,7 +98,7 @@ def _write_csv(rows: List[dict], path: Path) -> None:
 
 
 EPISODE_COLS = ("object", "attempt", "runs", "success", "lifted", "stable", "force_closure", "success_at_attempt",
-                "explore_fraction", "predicted_stability", "epsilon", "position_error_cm", "yaw_error_deg", "entropy",
+                "explore_fraction", "side_fraction", "predicted_stability", "epsilon", "position_error_cm", "yaw_error_deg", "entropy",
                 "plan_ms_median")
 
 
@@ -292,7 +293,7 @@ def write_episodes(exp, results: Dict[str, list], out: Path) -> dict:
            "criterion (default: held in the lift test; with --success epsilon: epsilon above the models' "
            "eps_stable, 0.01); lifted - held in the lift test by attempt k (with --success epsilon it runs on "
            "stable grasps only); stable - epsilon above eps_stable by attempt k; force_closure - epsilon > 0 by "
-           "attempt k; success_at_attempt, explore_fraction, "
+           "attempt k; success_at_attempt, explore_fraction, side_fraction (the share of side grasps), "
            "predicted_stability (the belief-weighted P(S) of the executed grasp), epsilon - over the runs "
            "that made attempt k; position_error_cm, yaw_error_deg, entropy (KDE, nats) - the belief after "
            "attempt k (carried forward once a run stopped); plan_ms_median - wall time of one decision.", ""]

@@ -4,7 +4,8 @@ Every run is a pure function of (experiment, object, run index, seed) and the se
 under: the runner hands the function those four values, stores what it returns (a
 JSON-serialisable dict) in an SQLite file as soon as the run finishes, and skips runs already
 stored when started again. So an interrupted experiment resumes where it stopped and loses
-nothing, and the same runs could be spread over any other engine without touching the planners.
+nothing, and the same runs go to any engine (:mod:`.engines`: local processes or Ray tasks)
+without touching the planners.
 The settings (package and cache versions, hand, success criterion, lift test, model settings)
 are stored beside the runs; resuming under other settings is refused with the differences named.
 """
@@ -12,14 +13,11 @@ from __future__ import annotations
 
 import hashlib
 import json
-import multiprocessing
-import os
 import sqlite3
 import sys
-from concurrent.futures import FIRST_COMPLETED, ProcessPoolExecutor, wait
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Callable, Iterable
+from typing import Callable, Dict, Iterable, Optional, Sequence
 
 from tqdm import tqdm
 
@@ -117,76 +115,82 @@ def settings_difference(stored: dict, now: dict, prefix: str = "") -> list[str]:
     return out
 
 
-def _die_with_parent(parent_pid: int, interval: float = 0.5) -> None:
-    """Worker initializer: a daemon thread ends this worker once its parent is gone (a parent
-    killed by SIGKILL cannot tell its pool to stop, and the workers would run on indefinitely;
-    when the last of them ends, multiprocessing's resource tracker sees its pipe close and ends
-    too)."""
-    import threading
-    import time
-
-    def watch():
-        while True:
-            if os.getppid() != parent_pid:
-                os._exit(1)
-            time.sleep(interval)
-
-    threading.Thread(target=watch, name="bayesgrasp-parent-watchdog", daemon=True).start()
+def _run(job) -> dict:
+    """One run: ``job`` is (fn, RunKey); returns fn(experiment, object, run_index, seed)."""
+    fn, key = job
+    return fn(key.experiment, key.object, key.run_index, key.seed)
 
 
-def _call(fn, key: RunKey):
-    return key, fn(key.experiment, key.object, key.run_index, key.seed)
+@dataclass(frozen=True)
+class Series:
+    """One series of runs: ``fn(experiment, object, run_index, seed)`` for every object and run
+    index (``fn`` a module-level function or a partial of one: it is sent to workers). The seeds
+    derive from ``seed_name`` (default: ``experiment``): the points of a sweep share it, so every
+    point meets the same problems."""
+
+    experiment: str
+    objects: tuple
+    runs: int
+    fn: Callable[[str, str, int, int], dict]
+    seed_name: Optional[str] = None
+
+    def keys(self, base_seed: int) -> list:
+        name = self.seed_name or self.experiment
+        return [RunKey(self.experiment, o, i, run_seed(base_seed, name, o, i))
+                for o in self.objects for i in range(self.runs)]
+
+
+def run_all(series: Sequence[Series], store: ResultStore, base_seed: int = 0, engine=None, progress: bool = True,
+            settings: Optional[dict] = None) -> Dict[str, list]:
+    """Runs every series' runs not yet in ``store`` on ``engine`` (default: this process),
+    saving each result as soon as it arrives, with one progress bar (runs done / total, rate,
+    ETA) on stderr for all of them. ``settings``: what else the results depend on
+    (:meth:`ResultStore.check_settings`: recorded with the first run, a resume with other values
+    is refused). Returns {experiment: every stored (RunKey, result) of its runs}."""
+    from .engines import LocalEngine
+
+    engine = engine or LocalEngine(1)
+    for s in series:
+        if s.runs < 1:
+            raise ValueError(f"runs must be at least 1, got {s.runs}")
+        if settings is not None:
+            store.check_settings(s.experiment, settings)
+    keys = {s.experiment: s.keys(base_seed) for s in series}
+    total = sum(len(k) for k in keys.values())
+    todo = []
+    for s in series:
+        done = store.done(s.experiment)
+        todo += [(s.fn, k) for k in keys[s.experiment] if k not in done]
+    bar = tqdm(total=total, initial=total - len(todo), desc="+".join(keys), unit="run", disable=not progress,
+               file=sys.stderr)
+    try:
+        for (_, key), result in engine.map(_run, todo):
+            store.add(key, result)
+            bar.update()
+    except KeyboardInterrupt:
+        bar.close()
+        n = sum(len(store.done(e)) for e in keys)
+        print(f"\ninterrupted: {n} of {total} runs saved in {store.path}; run again to resume", file=sys.stderr)
+        raise
+    bar.close()
+    out = {}
+    for e, ks in keys.items():
+        wanted = set(ks)
+        out[e] = [(k, r) for k, r in store.results(e) if k in wanted]
+    return out
 
 
 def run_experiment(experiment: str, objects: Iterable[str], runs: int, fn: Callable[[str, str, int, int], dict],
                    store: ResultStore, base_seed: int = 0, workers: int = 1,
-                   progress: bool = True, settings: dict | None = None) -> list[tuple[RunKey, dict]]:
-    """Runs ``fn(experiment, object, run_index, seed)`` for every object and run index not
-    yet in ``store``, saving each result as soon as it arrives. ``fn`` must be a module-level
-    function (it is sent to worker processes). ``settings``: what else the results depend on
-    (:meth:`ResultStore.check_settings`: recorded with the first run, a resume with other values
-    is refused). Returns every stored result of the experiment.
-    """
+                   progress: bool = True, settings: dict | None = None, engine=None) -> list[tuple[RunKey, dict]]:
+    """One series (:func:`run_all`): ``fn(experiment, object, run_index, seed)`` for every object
+    and run index not yet in ``store``, on ``engine`` (default: ``workers`` local processes).
+    Returns every stored result of the series' runs."""
+    from .engines import LocalEngine
+
     if runs < 1:
         raise ValueError(f"runs must be at least 1, got {runs}")
     if workers < 1:
         raise ValueError(f"workers must be at least 1, got {workers}")
-    if settings is not None:
-        store.check_settings(experiment, settings)
-    keys = [RunKey(experiment, o, i, run_seed(base_seed, experiment, o, i))
-            for o in objects for i in range(runs)]
-    done = store.done(experiment)
-    todo = [k for k in keys if k not in done]
-    bar = tqdm(total=len(keys), initial=len(keys) - len(todo), desc=experiment, unit="run",
-               disable=not progress, file=sys.stderr)
-    try:
-        if workers == 1:
-            for key in todo:
-                store.add(key, fn(key.experiment, key.object, key.run_index, key.seed))
-                bar.update()
-        else:
-            # spawn, not fork: a forked child inherits OpenMP's thread pool in a broken state
-            # (the parent has run parallel C++ batches) and hangs in its first parallel region
-            with ProcessPoolExecutor(max_workers=workers, mp_context=multiprocessing.get_context("spawn"),
-                                     initializer=_die_with_parent, initargs=(os.getpid(),)) as pool:
-                pending = {pool.submit(_call, fn, k) for k in todo}
-                try:
-                    while pending:
-                        finished, pending = wait(pending, return_when=FIRST_COMPLETED)
-                        for fut in finished:
-                            key, result = fut.result()
-                            store.add(key, result)
-                            bar.update()
-                except BaseException:
-                    for fut in pending:
-                        fut.cancel()
-                    raise
-    except KeyboardInterrupt:
-        bar.close()
-        n = len(store.done(experiment))
-        print(f"\ninterrupted: {n} of {len(keys)} runs saved in {store.path}; run again to resume",
-              file=sys.stderr)
-        raise
-    bar.close()
-    wanted = set(keys)
-    return [(k, r) for k, r in store.results(experiment) if k in wanted]
+    series = Series(experiment, tuple(objects), int(runs), fn)
+    return run_all([series], store, base_seed, engine or LocalEngine(workers), progress, settings)[experiment]

@@ -356,14 +356,13 @@ def planned_on_truth(exp: Experiment, objects: List[str], ctx: RunContext, out) 
                 report._markdown(rows, ("object", "runs", "success_on_truth")) + "\n")
 
 
-def prepare_models(exp: Experiment, objects: List[str], ctx: RunContext) -> None:
-    """The grasp models of every object (Fig. 2.1's second grasp plans on them), built once."""
-    for o in objects:
-        ctx.models(o)
+def prepare_models(exp: Experiment, obj: str, ctx: RunContext) -> None:
+    """One object's grasp models (Fig. 2.1's second grasp plans on them), built once."""
+    ctx.models(obj)
 
 
 register(Experiment("pub1", OBJECTS, 30, "what one touch tells about an object: four optimisers (Pub. I)",
-                    _make_run, write_report, OPTIMIZERS, planned_on_truth, prepare_models))
+                    _make_run, write_report, OPTIMIZERS, planned_on_truth, prepare_object=prepare_models))
 
 
 # ---- variants: the continuous contact term, another hand ---------------------------------------
