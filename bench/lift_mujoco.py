@@ -398,6 +398,17 @@ def summarize(rows):
         a[3] += r["mujoco_lifted"]
     for k, (n, ag, o, mj) in sorted(by_obj.items()):
         print(f"  {k:10s} {n:4d} grasps, agree {ag:4d} ({ag / n:.3f}); held ours {o}, mujoco {mj}")
+    by_source = {}
+    for r in rows:
+        by_source.setdefault(r["source"], []).append(r)
+    for src, rs in sorted(by_source.items()):
+        ag = sum(r["ours_lifted"] == r["mujoco_lifted"] for r in rs)
+        print(f"  source {src:18s} {len(rs):4d} grasps, agree {ag:4d} ({ag / len(rs):.3f}); held ours "
+              f"{sum(r['ours_lifted'] for r in rs)}, mujoco {sum(r['mujoco_lifted'] for r in rs)}")
+    executed = [r for r in rows if r["source"].startswith("executed_")]
+    if executed:
+        ag = sum(r["ours_lifted"] == r["mujoco_lifted"] for r in executed)
+        print(f"executed grasps (the planners'): agree {ag}/{len(executed)} = {ag / len(executed):.3f}")
     dis = [r for r in rows if r["ours_lifted"] != r["mujoco_lifted"]]
     causes = {}
     for r in dis:
@@ -407,7 +418,7 @@ def summarize(rows):
     for c, rs in sorted(causes.items(), key=lambda kv: -len(kv[1])):
         print(f"  {len(rs):3d}  {c}")
         for r in rs:
-            print(f"         {r['object']:10s} {r['source']:8s} #{r['grasp']:<3d} {r['shape']:13s} "
+            print(f"         {r['object']:10s} {r['source']:17s} #{r['grasp']:<3d} {r['shape']:13s} "
                   f"ours {r['ours_displacement'] * 100:6.2f} cm hold {r.get('ours_hold_displacement', np.nan) * 100:5.2f} "
                   f"gain {r.get('ours_height_gain', np.nan) * 100:6.2f} (break {r['ours_breakaway']}), "
                   f"mujoco {r['mujoco_displacement'] * 100:6.2f} cm hold {r.get('mujoco_hold_displacement', np.nan) * 100:5.2f} "
