@@ -20,8 +20,9 @@ it also prints the held share of N force-closure top grasps per Pub. II object.
 experiment's output with its results.sqlite): ``pub2`` attempts per grasp family (sources
 ``executed_top`` / ``executed_side``, re-closed from the attempt's relative grasp and variant)
 and category task grasps of mugs and bottles (``executed_category``, re-closed along the stored
-hand pose in the object's frame); force-closure ones only, at most ``--per-executed`` per object
-and source, and our re-closed verdict is checked against the stored one.
+hand pose in the object's frame); every executed grasp that touched the object without starting
+in collision (force closure or not: the lift test decides those too), at most ``--per-executed``
+per object and source, and our re-closed verdict is checked against the stored one.
 
     BAYESGRASP_CORE_DIR=build/dev/bayesgrasp_core PYTHONPATH=python python bench/lift_heldset.py --out bench/results/heldset
 """
@@ -117,7 +118,8 @@ def reclose(w, items):
                            joint_angles=np.array([g.joint_angles for g in rows]),
                            epsilon=np.array([g.epsilon for g in rows]),
                            collision_at_start=np.array([g.collision_at_start for g in rows], bool),
-                           lifted=np.array([bool(g.lifted) for g in rows]))
+                           lifted=np.array([bool(g.lifted) for g in rows]),
+                           touched=np.array([any(not c.on_table for c in g.contacts) for g in rows], bool))
 
 
 def export(w, name, b, idx, source, out, sweep=()):
@@ -238,12 +240,14 @@ def main():
         b = reclose(w, items)
         stored = np.array([it[2] for it in items])
         fc = force_closure(b)
-        idx = rng.choice(fc, size=min(a.per_executed, len(fc)), replace=False) if len(fc) else fc
+        touched = np.flatnonzero(b.touched & ~b.collision_at_start)
+        idx = rng.choice(touched, size=min(a.per_executed, len(touched)), replace=False) if len(touched) else touched
         if len(idx) == 0:
             continue
         r = export(w, name, b, idx, source, a.out, sweep)
         total += len(idx)
-        print(f"{name} {source}: {len(items)} executed, {len(fc)} force closure, exported {len(idx)}, lifted "
+        print(f"{name} {source}: {len(items)} executed, {len(touched)} touched, {len(fc)} force closure, exported "
+              f"{len(idx)} (force closure {int(np.sum(np.asarray(b.epsilon)[idx] > 0))}), lifted "
               f"{int(np.sum(r.lifted))}; re-closed verdict = stored on {int(np.sum(b.lifted == stored))}/{len(items)}",
               file=sys.stderr, flush=True)
     print(f"exported {total} grasps to {a.out}", file=sys.stderr)
