@@ -162,3 +162,34 @@ def test_a_bad_config_file_is_refused_in_one_line(tmp_path, text, message):
     code, _, err = run_cli("experiment", "pub2", "--config", str(cfg), "--out", str(tmp_path / "e"))
     assert code != 0 and message in err, err
     assert not (tmp_path / "e" / "results.sqlite").exists()
+
+
+def test_config_tables_reach_the_planner_the_episode_and_the_sweep(tmp_path):
+    from bayesgrasp.cli import build_parser
+    from bayesgrasp.cli.args import context
+    from bayesgrasp.cli.experiment import apply_config, sweep_points
+
+    cfg = tmp_path / "sweep.toml"
+    cfg.write_text('[planner]\nn_particles = 120\nhalf_width = [0.02, 0.02, 0.5]\n[episode]\nmeasurement_noise = 0.01\n'
+                   '[sweep]\n"planner.pso_iter" = [5, 10]\n[sweep.models]\nn_samples = [300, 400]\n')
+    args = build_parser().parse_args(["experiment", "pub2", "--config", str(cfg), "--sweep", "models.n_samples=350"])
+    apply_config(args, str(cfg), {"runs": None, "workers": 1, "out": None, "objects": None, "hand": "barrett_bh8",
+                                  "success": "lift", "no_lift": False, "seed": 0, "families": "top",
+                                  "engine": "local", "address": None, "cache": None})
+    ctx = context(args, progress=False)
+    assert ctx.planner_settings().n_particles == 120 and tuple(ctx.planner_settings().half_width) == (0.02, 0.02, 0.5)
+    assert ctx.measurement_noise == 0.01
+    s = ctx.result_settings()
+    assert s["planner"]["n_particles"] == 120 and s["measurement_noise"] == 0.01
+    # the file's sweep axes, the command line's value list winning for the axis it names
+    points = sweep_points(args)
+    assert [p for p, _ in points] == [{"planner.pso_iter": 5, "models.n_samples": 350},
+                                      {"planner.pso_iter": 10, "models.n_samples": 350}]
+    for params, a in points:
+        c = context(a, progress=False)
+        assert c.planner_settings().pso_iter == params["planner.pso_iter"] and c.planner_settings().n_particles == 120
+        assert c.model_settings.n_samples == 350
+    bad = tmp_path / "bad.toml"
+    bad.write_text("[planner]\nn_particles = 1\n")
+    code, _, err = run_cli("experiment", "pub2", "--config", str(bad), "--out", str(tmp_path / "e"))
+    assert code != 0 and "n_particles" in err
