@@ -1,6 +1,9 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <sstream>
 
 #include "bayesgrasp/hand/hand_model.hpp"
 
@@ -106,4 +109,30 @@ TEST(Hand, RejectsBadFilesAndJoints) {
   EXPECT_THROW(h.check_spread(M_PI + 1e-6), std::invalid_argument);
   EXPECT_THROW(h.check_spread(NAN), std::invalid_argument);
   EXPECT_THROW(h.phalanx_pose(Iso3::Identity(), 0, 2, q), std::invalid_argument);
+}
+
+// Issue 31: a hand file is strict - an unknown or a missing key throws, naming where it is.
+TEST(Hand, StrictKeys) {
+  std::ifstream in(kBarrett);
+  std::stringstream ss;
+  ss << in.rdbuf();
+  const nlohmann::json spec = nlohmann::json::parse(ss.str());
+  auto message = [](const nlohmann::json& j) {
+    try {
+      HandModel::from_json(j.dump());
+    } catch (const std::invalid_argument& e) {
+      return std::string(e.what());
+    }
+    return std::string();
+  };
+  nlohmann::json no_knuckle = spec;
+  no_knuckle["fingers"][2].erase("knuckle");
+  EXPECT_NE(message(no_knuckle).find("fingers[2]: missing key 'knuckle'"), std::string::npos);
+  nlohmann::json extra = spec;
+  extra["fingers"][0]["phalanges"][1]["stiffness"] = 3.0;
+  EXPECT_NE(message(extra).find("fingers[0].phalanges[1]: unknown key 'stiffness'"), std::string::npos);
+  nlohmann::json no_ratio = spec;
+  no_ratio["fingers"][1]["phalanges"][0].erase("ratio");
+  EXPECT_NE(message(no_ratio).find("missing key 'ratio'"), std::string::npos);
+  EXPECT_EQ(message(spec), "");
 }

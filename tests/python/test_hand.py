@@ -108,3 +108,37 @@ def test_approach_pose_convention():
             Hand.approach_pose(bad, 0.0, [0, 0, 0])
     with pytest.raises(ValueError, match="palm"):
         Hand.approach_pose([0, 0, -1], 0.0, [0, np.inf, 0])
+
+
+def _edited(edit):
+    spec = json.loads((HANDS_DIR / "barrett_bh8.json").read_text())
+    edit(spec)
+    return json.dumps(spec)
+
+
+@pytest.mark.parametrize("edit, needle", [
+    (lambda s: s["fingers"][1]["phalanges"][0].update(torque=2.0),
+     r"fingers\[1\]\.phalanges\[0\]: unknown key 'torque'"),
+    (lambda s: s["fingers"][0]["phalanges"][1].pop("offset_deg"), r"fingers\[0\]\.phalanges\[1\]: missing key 'offset_deg'"),
+    (lambda s: s["fingers"][0]["phalanges"][1].pop("torque_nm"), r"missing key 'torque_nm'"),
+    (lambda s: s["fingers"][0]["phalanges"][0].pop("ratio"), r"missing key 'ratio'"),
+    (lambda s: s["fingers"][2].pop("knuckle"), r"fingers\[2\]: missing key 'knuckle'"),
+    (lambda s: s["fingers"][2].pop("spread_sign"), r"missing key 'spread_sign'"),
+    (lambda s: s["fingers"][0].pop("name"), r"fingers\[0\]: missing key 'name'"),
+    (lambda s: s["spread"].pop("default_deg"), r"spread: missing key 'default_deg'"),
+    (lambda s: s.pop("actuation"), r"top level: missing key 'actuation'"),
+    (lambda s: s.update(colour="red"), r"top level: unknown key 'colour'"),
+    (lambda s: s["palm"]["shapes"][0].update(radius=0.01), r"palm\.shapes\[0\]: unknown key 'radius'"),
+    (lambda s: s["fingers"][0]["knuckle"].pop("shapes"), r"knuckle: missing key 'shapes'"),
+])
+def test_hand_files_are_strict_one_line_naming_the_key(edit, needle):
+    # issue 31: an unknown or missing key is refused in one line naming where; nothing defaults
+    with pytest.raises(ValueError, match=needle) as e:
+        Hand.from_json(_edited(edit))
+    assert "\n" not in str(e.value)
+
+
+def test_documentation_keys_may_be_left_out():
+    h = Hand.from_json(_edited(lambda s: (s.pop("description"), s.pop("frame"))))
+    ref = Hand.load()
+    np.testing.assert_array_equal(h.link_poses(ref.open_joints()), ref.link_poses(ref.open_joints()))

@@ -115,8 +115,11 @@ def test_a_hand_without_torques_is_refused_unless_overridden():
         spec = json.load(f)
     for finger in spec["fingers"]:
         for ph in finger["phalanges"]:
-            ph.pop("torque_nm")
+            ph["torque_nm"] = 0.0   # strength unknown (a missing key is refused when the file loads)
     weak = Hand.from_json(json.dumps(spec))
+    spec["fingers"][0]["phalanges"][0].pop("torque_nm")
+    with pytest.raises(ValueError, match="missing key 'torque_nm'"):
+        Hand.from_json(json.dumps(spec))
     box = trimesh.creation.box([0.05, 0.05, 0.05])
     with pytest.raises(ValueError, match=r"no torque for finger1/proximal .*torque_nm.*finger_torque"):
         physics.LiftTester(weak.core, box.vertices, box.faces, shape="hull")

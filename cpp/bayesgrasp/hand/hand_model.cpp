@@ -1,7 +1,9 @@
 #include "bayesgrasp/hand/hand_model.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <fstream>
+#include <initializer_list>
 #include <nlohmann/json.hpp>
 #include <sstream>
 #include <stdexcept>
@@ -22,16 +24,37 @@ const json& need(const json& j, const char* key, const std::string& where) {
   return j.at(key);
 }
 
+/// A strict object: every key one of `known`, none missing from `known` (every key is required:
+/// nothing takes a default), except the documentation keys `docs`, which may be absent.
+void exactly(const json& j, std::initializer_list<const char*> known, const std::string& where,
+             std::initializer_list<const char*> docs = {}) {
+  if (!j.is_object()) fail(where, "must be an object");
+  auto listed = [](const std::string& k, std::initializer_list<const char*> keys) {
+    return std::any_of(keys.begin(), keys.end(), [&](const char* x) { return k == x; });
+  };
+  for (auto it = j.begin(); it != j.end(); ++it) {
+    if (listed(it.key(), known) || listed(it.key(), docs)) continue;
+    std::string names;
+    for (const char* k : known) names += std::string(names.empty() ? "" : ", ") + k;
+    for (const char* k : docs) names += std::string(", ") + k;
+    fail(where, "unknown key '" + it.key() + "' (known: " + names + ")");
+  }
+  for (const char* k : known)
+    if (!j.contains(k)) fail(where, std::string("missing key '") + k + "'");
+}
+
+std::string text(const json& j, const char* key, const std::string& where) {
+  const json& v = need(j, key, where);
+  if (!v.is_string() || v.get<std::string>().empty()) fail(where, std::string("'") + key + "' must be a non-empty string");
+  return v.get<std::string>();
+}
+
 double number(const json& j, const char* key, const std::string& where) {
   const json& v = need(j, key, where);
   if (!v.is_number()) fail(where, std::string("'") + key + "' must be a number");
   const double x = v.get<double>();
   if (!std::isfinite(x)) fail(where, std::string("'") + key + "' must be finite");
   return x;
-}
-
-double number_or(const json& j, const char* key, double fallback, const std::string& where) {
-  return j.contains(key) ? number(j, key, where) : fallback;
 }
 
 Vec3 vec3(const json& j, const char* key, const std::string& where) {
@@ -48,8 +71,7 @@ Vec3 vec3(const json& j, const char* key, const std::string& where) {
 
 std::vector<Shape> shapes(const json& j, const std::string& where) {
   std::vector<Shape> out;
-  if (!j.contains("shapes")) return out;
-  const json& arr = j.at("shapes");
+  const json& arr = need(j, "shapes", where);
   if (!arr.is_array()) fail(where, "'shapes' must be a list");
   for (size_t i = 0; i < arr.size(); ++i) {
     const std::string w = where + ".shapes[" + std::to_string(i) + "]";
@@ -57,11 +79,13 @@ std::vector<Shape> shapes(const json& j, const std::string& where) {
     const json& type = need(s, "type", w);
     Shape shape;
     if (type == "box") {
+      exactly(s, {"type", "center", "half_extents"}, w);
       shape.type = Shape::Type::Box;
       shape.center = vec3(s, "center", w);
       shape.half_extents = vec3(s, "half_extents", w);
       if ((shape.half_extents.array() <= 0).any()) fail(w, "half_extents must be positive");
     } else if (type == "capsule") {
+      exactly(s, {"type", "p0", "p1", "radius"}, w);
       shape.type = Shape::Type::Capsule;
       shape.p0 = vec3(s, "p0", w);
       shape.p1 = vec3(s, "p1", w);
@@ -77,17 +101,18 @@ std::vector<Shape> shapes(const json& j, const std::string& where) {
 
 /// One phalanx of a finger from its JSON object (`where` names it in errors).
 Phalanx parse_phalanx(const json& j, size_t p, const std::string& where) {
+  exactly(j, {"name", "length", "lower_deg", "upper_deg", "offset_deg", "ratio", "torque_nm", "shapes"}, where);
   Phalanx phalanx;
-  phalanx.name = j.contains("name") ? j.at("name").get<std::string>() : "phalanx" + std::to_string(p);
+  phalanx.name = text(j, "name", where);
   phalanx.length = number(j, "length", where);
   if (!(phalanx.length > 0)) fail(where, "length must be positive");
   phalanx.lower = number(j, "lower_deg", where) * kDeg;
   phalanx.upper = number(j, "upper_deg", where) * kDeg;
   if (phalanx.lower > phalanx.upper) fail(where, "lower_deg > upper_deg");
-  phalanx.offset = number_or(j, "offset_deg", j.contains("lower_deg") ? number(j, "lower_deg", where) : 0.0, where) * kDeg;
-  phalanx.ratio = number_or(j, "ratio", 1.0, where);
+  phalanx.offset = number(j, "offset_deg", where) * kDeg;
+  phalanx.ratio = number(j, "ratio", where);
   if (phalanx.ratio < 0) fail(where, "ratio must be >= 0");
-  phalanx.torque = number_or(j, "torque_nm", 0.0, where);
+  phalanx.torque = number(j, "torque_nm", where);
   if (!(phalanx.torque >= 0) || !std::isfinite(phalanx.torque)) fail(where, "torque_nm must be >= 0 and finite");
   phalanx.shapes = shapes(j, where);
   return phalanx;
@@ -121,20 +146,22 @@ HandModel HandModel::from_json(const std::string& json_text) {
     throw std::invalid_argument(std::string("hand file: not valid JSON: ") + e.what());
   }
   HandModel h;
-  if (!root.is_object()) fail("top level", "must be an object");
-  const json& name = need(root, "name", "top level");
-  if (!name.is_string()) fail("top level", "'name' must be a string");
-  h.name_ = name.get<std::string>();
+  // name, geometry and actuation are required; description and frame are documentation
+  exactly(root, {"name", "actuation", "palm", "spread", "fingers"}, "top level", {"description", "frame"});
+  h.name_ = text(root, "name", "top level");
+  if (!root.at("actuation").is_object()) fail("actuation", "must be an object (the strength's figures and sources)");
 
   Link palm;
   palm.name = "palm";
-  palm.shapes = shapes(need(root, "palm", "top level"), "palm");
+  exactly(root.at("palm"), {"shapes"}, "palm");
+  palm.shapes = shapes(root.at("palm"), "palm");
   h.links_.push_back(palm);
 
-  const json& spread = need(root, "spread", "top level");
+  const json& spread = root.at("spread");
+  exactly(spread, {"lower_deg", "upper_deg", "default_deg"}, "spread");
   h.spread_lower_ = number(spread, "lower_deg", "spread") * kDeg;
   h.spread_upper_ = number(spread, "upper_deg", "spread") * kDeg;
-  h.spread_default_ = number_or(spread, "default_deg", 0.0, "spread") * kDeg;
+  h.spread_default_ = number(spread, "default_deg", "spread") * kDeg;
   if (h.spread_lower_ > h.spread_upper_) fail("spread", "lower_deg > upper_deg");
 
   const json& fingers = need(root, "fingers", "top level");
@@ -143,14 +170,17 @@ HandModel HandModel::from_json(const std::string& json_text) {
   for (size_t f = 0; f < fingers.size(); ++f) {
     const std::string w = "fingers[" + std::to_string(f) + "]";
     const json& jf = fingers[f];
+    exactly(jf, {"name", "base", "base_yaw_deg", "spread_sign", "knuckle", "phalanges"}, w);
     Finger finger;
-    finger.name = jf.contains("name") ? jf.at("name").get<std::string>() : "finger" + std::to_string(f + 1);
+    finger.name = text(jf, "name", w);
     finger.base = vec3(jf, "base", w);
     finger.base_yaw = number(jf, "base_yaw_deg", w) * kDeg;
-    finger.spread_sign = number_or(jf, "spread_sign", 0.0, w);
-    if (jf.contains("knuckle")) {
+    finger.spread_sign = number(jf, "spread_sign", w);
+    {
       const json& k = jf.at("knuckle");
-      finger.knuckle_length = number_or(k, "length", 0.0, w + ".knuckle");
+      exactly(k, {"length", "shapes"}, w + ".knuckle");
+      finger.knuckle_length = number(k, "length", w + ".knuckle");
+      if (finger.knuckle_length < 0) fail(w + ".knuckle", "length must be >= 0");
       finger.knuckle_shapes = shapes(k, w + ".knuckle");
     }
     if (!finger.knuckle_shapes.empty()) {
