@@ -28,11 +28,29 @@ auto per_link(const HandModel& h, F&& value) {
   return out;
 }
 
+const char* type_name(const Shape& s) {
+  return s.type == Shape::Type::Box ? "box" : s.type == Shape::Type::Capsule ? "capsule" : "convex";
+}
+
 void bind_shape(py::module_& m) {
   py::class_<Shape>(m, "Shape", "A collision primitive of a hand link, in the link frame.")
+      .def_property_readonly("type", &type_name, "type : str\n    'box', 'capsule' or 'convex'.")
       .def_property_readonly(
-          "type", [](const Shape& s) { return s.type == Shape::Type::Box ? "box" : "capsule"; },
-          "type : str\n    'box' or 'capsule'.")
+          "vertices",
+          [](const Shape& s) {
+            Eigen::MatrixX3d V(static_cast<Eigen::Index>(s.vertices.size()), 3);
+            for (size_t i = 0; i < s.vertices.size(); ++i) V.row(static_cast<Eigen::Index>(i)) = s.vertices[i].transpose();
+            return V;
+          },
+          "vertices : numpy.ndarray (N, 3)\n    Convex: its vertices, m (empty otherwise).")
+      .def_property_readonly(
+          "faces",
+          [](const Shape& s) {
+            Eigen::MatrixX3i F(static_cast<Eigen::Index>(s.faces.size()), 3);
+            for (size_t i = 0; i < s.faces.size(); ++i) F.row(static_cast<Eigen::Index>(i)) << s.faces[i][0], s.faces[i][1], s.faces[i][2];
+            return F;
+          },
+          "faces : numpy.ndarray (M, 3) int\n    Convex: its triangles, counter-clockwise seen from outside.")
       .def_property_readonly(
           "center", [](const Shape& s) { return Eigen::Vector3d(s.center); },
           "center : numpy.ndarray (3,)\n    Box centre (box axes = link axes), m.")
@@ -43,13 +61,15 @@ void bind_shape(py::module_& m) {
           "p0", [](const Shape& s) { return Eigen::Vector3d(s.p0); }, "p0 : numpy.ndarray (3,)\n    Capsule axis start, m.")
       .def_property_readonly(
           "p1", [](const Shape& s) { return Eigen::Vector3d(s.p1); }, "p1 : numpy.ndarray (3,)\n    Capsule axis end, m.")
-      .def_readonly("radius", &Shape::radius, "radius : float\n    Capsule radius, m.")
-      .def("__repr__", [](const Shape& s) { return std::string("<Shape ") + (s.type == Shape::Type::Box ? "box>" : "capsule>"); });
+      .def_readonly("radius", &Shape::radius, "radius : float\n    Capsule radius (convex: largest vertex distance from center), m.")
+      .def("__repr__", [](const Shape& s) { return std::string("<Shape ") + type_name(s) + ">"; });
 }
 
 /// The joint vector, link poses, fingertips and collision shapes.
 void def_kinematics(py::class_<HandModel>& hand) {
   hand      .def_property_readonly("spread_default", &HandModel::spread_default, "Default spread (rad).")
+      .def_property_readonly("measured_joints", [](const HandModel& h) { return h.measured_joints(); },
+                             "Indices into q of the joints the fingers-read measurement uses (the file's measured_joints).")
       .def(
           "coupled_joints",
           [](const HandModel& h, double spread, const py::object& t) {

@@ -29,8 +29,23 @@ HANDS_DIR = Path(__file__).parent / "data" / "hands"
 
 
 def builtin_hands() -> list[str]:
-    """Names of the built-in hand files (without ``.json``)."""
-    return sorted(p.stem for p in HANDS_DIR.glob("*.json"))
+    """Names of the built-in hands: hand files by name (without ``.json``) and URDF hands by file
+    name (``barrett_bh8.urdf``; each has its sidecar ``NAME.hand.json``)."""
+    files = [p.stem for p in HANDS_DIR.glob("*.json") if not p.name.endswith(".hand.json")]
+    return sorted(files) + sorted(p.name for p in HANDS_DIR.glob("*.urdf"))
+
+
+def resolve_hand(name_or_path: str | Path) -> Path:
+    """The file behind a hand name or path: an existing path, a built-in name (``barrett_bh8``)
+    or a built-in URDF's file name (``barrett_bh8.urdf``). Raises ValueError naming what exists."""
+    p = Path(name_or_path)
+    if p.exists():
+        return p
+    for cand in (HANDS_DIR / p.name, HANDS_DIR / f"{p.name}.json"):
+        if p.parent == Path(".") and cand.is_file() and not cand.name.endswith(".hand.json"):
+            return cand
+    raise ValueError(f"name_or_path: no built-in hand '{name_or_path}' (available: {', '.join(builtin_hands())}) "
+                     "and no such file")
 
 
 def _pose(hand_pose):
@@ -44,51 +59,87 @@ class ShapeGeometry:
     """One collision shape of a hand link in the world frame (see :meth:`Hand.link_geometry`).
 
     A ``'capsule'`` has ``p0``, ``p1`` (3,) and ``radius``; a ``'box'`` has ``center`` (3,),
-    ``rotation`` (3, 3) (columns = box axes) and ``half_extents`` (3,); the other fields are None.
+    ``rotation`` (3, 3) (columns = box axes) and ``half_extents`` (3,); a ``'convex'`` shape has
+    ``vertices`` (N, 3) and ``faces`` (M, 3); the other fields are None.
     """
 
     link: int                               # link index
     name: str                               # link name
-    type: str                               # 'capsule' or 'box'
+    type: str                               # 'capsule', 'box' or 'convex'
     p0: Optional[np.ndarray] = None
     p1: Optional[np.ndarray] = None
     radius: Optional[float] = None
     center: Optional[np.ndarray] = None
     rotation: Optional[np.ndarray] = None
     half_extents: Optional[np.ndarray] = None
+    vertices: Optional[np.ndarray] = None
+    faces: Optional[np.ndarray] = None
+
+    def mesh(self) -> tuple[np.ndarray, np.ndarray]:
+        """The shape as a triangle mesh (V, F) in the world frame, for drawing."""
+        from .viz import box_mesh, capsule_mesh
+
+        if self.type == "capsule":
+            return capsule_mesh(self.p0, self.p1, self.radius)
+        if self.type == "convex":
+            return self.vertices, self.faces
+        T = np.eye(4)
+        T[:3, :3], T[:3, 3] = self.rotation, self.center
+        return box_mesh(T, self.half_extents)
 
 
 class Hand:
     """A hand model (wraps :class:`bayesgrasp._core.hand.Hand`)."""
 
-    def __init__(self, core: _core.hand.Hand, source: str = ""):
+    def __init__(self, core: _core.hand.Hand, source: str = "", text: str = ""):
         if not isinstance(core, _core.hand.Hand):
             raise ValueError("core: expected a bayesgrasp._core.hand.Hand; use Hand.load(...)")
         self.core = core
         self.source = source
+        self._text = text
 
     @classmethod
     def load(cls, name_or_path: str | Path = "barrett_bh8") -> "Hand":
-        """A built-in hand by name (see :func:`builtin_hands`) or a hand file by path."""
-        p = Path(name_or_path)
-        if not p.suffix and not p.exists():
-            p = HANDS_DIR / f"{name_or_path}.json"
-            if not p.exists():
-                raise ValueError(f"name_or_path: no built-in hand '{name_or_path}' "
-                                 f"(available: {', '.join(builtin_hands())}) and no such file")
-        if not p.exists():
-            raise ValueError(f"name_or_path: file not found: {p}")
-        return cls(_core.hand.Hand.from_file(str(p)), str(p))
+        """A built-in hand by name (see :func:`builtin_hands`), a hand file (JSON) by path, or a
+        URDF (``NAME.urdf`` with its sidecar ``NAME.hand.json`` beside it; see
+        :mod:`bayesgrasp.hand_urdf`)."""
+        p = resolve_hand(name_or_path)
+        if p.suffix.lower() == ".urdf":
+            return cls.from_urdf(p)
+        if p.name.endswith(".hand.json"):
+            raise ValueError(f"name_or_path: {p} is a URDF hand's sidecar; load the URDF it names")
+        text = p.read_text()
+        return cls(_core.hand.Hand.from_file(str(p)), str(p), text)
+
+    @classmethod
+    def from_urdf(cls, urdf: str | Path, sidecar: str | Path | None = None) -> "Hand":
+        """A hand from a URDF and its sidecar (default: ``NAME.hand.json`` beside ``NAME.urdf``),
+        converted to a hand file's model (:func:`bayesgrasp.hand_urdf.hand_json_from_urdf`)."""
+        from .hand_urdf import hand_json_from_urdf
+
+        text = hand_json_from_urdf(urdf, sidecar)
+        return cls(_core.hand.Hand.from_json(text), str(urdf), text)
 
     @classmethod
     def from_json(cls, text: str) -> "Hand":
         """A hand from the JSON text of a hand file."""
-        return cls(_core.hand.Hand.from_json(text), "<json>")
+        return cls(_core.hand.Hand.from_json(text), "<json>", text)
 
     @property
     def path(self) -> str:
-        """The hand file this hand was loaded from ('<json>' when built from text)."""
+        """The hand file or URDF this hand was loaded from ('<json>' when built from text)."""
         return self.source
+
+    @property
+    def text(self) -> str:
+        """The hand-file text (JSON) the model was built from (for a URDF hand, its conversion):
+        everything that shapes a result, for cache keys."""
+        return self._text
+
+    @property
+    def measured_joints(self) -> np.ndarray:
+        """Indices into q of the joints the "fingers read" measurement uses."""
+        return np.asarray(self.core.measured_joints, dtype=int)
 
     # ---- structure ----
     name = property(lambda self: self.core.name, doc="The hand's name.")
@@ -152,7 +203,7 @@ class Hand:
 
     def link_shapes(self) -> list:
         """Per link, its collision shapes (``_core.hand.Shape``: type, center, half_extents, p0,
-        p1, radius) in the link frame."""
+        p1, radius, vertices, faces) in the link frame."""
         return self.core.link_shapes()
 
     def link_geometry(self, q=None, hand_pose=None) -> list[ShapeGeometry]:
@@ -167,6 +218,9 @@ class Hand:
                 if s.type == "capsule":
                     out.append(ShapeGeometry(li, self.links[li], "capsule", p0=R @ s.p0 + t, p1=R @ s.p1 + t,
                                              radius=float(s.radius)))
+                elif s.type == "convex":
+                    out.append(ShapeGeometry(li, self.links[li], "convex", vertices=np.asarray(s.vertices) @ R.T + t,
+                                             faces=np.asarray(s.faces)))
                 else:
                     out.append(ShapeGeometry(li, self.links[li], "box", center=R @ s.center + t, rotation=R.copy(),
                                              half_extents=np.asarray(s.half_extents, dtype=float)))

@@ -55,7 +55,17 @@ def make_options(**kwargs) -> LiftOptions:
 
 
 def _hand(hand):
-    return BARRETT_HAND if hand is None else hand
+    """The hand for the C++ tester: a hand file's path as it is; a Hand, a built-in name or a
+    URDF (converted with its sidecar) as the loaded model."""
+    from .hand import Hand
+
+    if hand is None:
+        return BARRETT_HAND
+    if isinstance(hand, Hand):
+        return hand.core
+    if isinstance(hand, (str, os.PathLike)) and (Path(hand).suffix.lower() == ".urdf" or not Path(hand).exists()):
+        return Hand.load(hand).core
+    return hand
 
 
 def decomposition_cache_dir() -> Path:

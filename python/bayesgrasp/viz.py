@@ -309,12 +309,7 @@ def hand_meshes(hand, joint_angles, hand_pose, color="tab:gray", alpha: float = 
     ``(V, F, color, alpha)`` meshes for :func:`draw_meshes` / :func:`plot_scene`."""
     items = []
     for s in hand.link_geometry(joint_angles, hand_pose):
-        if s.type == "capsule":
-            V, F = capsule_mesh(s.p0, s.p1, s.radius)
-        else:
-            T = np.eye(4)
-            T[:3, :3], T[:3, 3] = s.rotation, s.center
-            V, F = box_mesh(T, s.half_extents)
+        V, F = s.mesh()
         items.append((V, F, color, alpha))
     return items
 

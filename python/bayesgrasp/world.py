@@ -359,11 +359,11 @@ class World:
     def lift_tester(self) -> physics.LiftTester:
         if self._lift is None:
             pieces = None
-            if physics.is_concave(self.vertices, self.faces, self.hand.path):
+            if physics.is_concave(self.vertices, self.faces, self.hand.core):
                 # Decompose the object-frame mesh (cached across poses), then place the pieces.
                 obj, T = self.object, self.scene.object_pose(self.object_index)
                 pieces = [p @ T[:3, :3].T + T[:3, 3] for p in physics.convex_decomposition(obj.vertices, obj.faces)]
-            self._lift = physics.LiftTester(self.hand.path, self.vertices, self.faces, convex_pieces=pieces,
+            self._lift = physics.LiftTester(self.hand.core, self.vertices, self.faces, convex_pieces=pieces,
                                             mu=self.mu, density=self.object.density, table=self.table)
         return self._lift
 

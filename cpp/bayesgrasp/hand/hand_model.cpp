@@ -4,6 +4,8 @@
 #include <cmath>
 #include <fstream>
 #include <initializer_list>
+#include <limits>
+#include <map>
 #include <nlohmann/json.hpp>
 #include <sstream>
 #include <stdexcept>
@@ -69,6 +71,55 @@ Vec3 vec3(const json& j, const char* key, const std::string& where) {
   return out;
 }
 
+/// A convex shape from its vertices and outward triangles; refuses one that is not closed, not
+/// convex or wound inwards (every vertex must lie behind every face's plane).
+Shape convex_shape(const json& s, const std::string& w) {
+  Shape shape;
+  shape.type = Shape::Type::Convex;
+  const json& v = need(s, "vertices", w);
+  if (!v.is_array() || v.size() < 4) fail(w, "'vertices' must be a list of at least 4 points");
+  for (size_t i = 0; i < v.size(); ++i) {
+    if (!v[i].is_array() || v[i].size() != 3 || !v[i][0].is_number() || !v[i][1].is_number() || !v[i][2].is_number())
+      fail(w, "vertices[" + std::to_string(i) + "] must be a list of 3 numbers");
+    const Vec3 p(v[i][0].get<double>(), v[i][1].get<double>(), v[i][2].get<double>());
+    if (!p.allFinite()) fail(w, "vertices[" + std::to_string(i) + "] must be finite");
+    shape.vertices.push_back(p);
+  }
+  const json& f = need(s, "faces", w);
+  if (!f.is_array() || f.size() < 4) fail(w, "'faces' must be a list of at least 4 triangles");
+  const int n = static_cast<int>(shape.vertices.size());
+  std::map<std::pair<int, int>, int> edges;  // directed edge -> count: closed and consistently wound
+  for (size_t i = 0; i < f.size(); ++i) {
+    const std::string wi = "faces[" + std::to_string(i) + "]";
+    if (!f[i].is_array() || f[i].size() != 3) fail(w, wi + " must be 3 vertex indices");
+    std::array<int, 3> t{};
+    for (int k = 0; k < 3; ++k) {
+      if (!f[i][k].is_number_integer() || f[i][k].get<long long>() < 0 || f[i][k].get<long long>() >= n)
+        fail(w, wi + " must be 3 vertex indices in [0, " + std::to_string(n) + ")");
+      t[k] = f[i][k].get<int>();
+    }
+    const Vec3 nrm = (shape.vertices[t[1]] - shape.vertices[t[0]]).cross(shape.vertices[t[2]] - shape.vertices[t[0]]);
+    if (!(nrm.norm() > 1e-14)) fail(w, wi + " is degenerate (zero area)");
+    for (int k = 0; k < 3; ++k) ++edges[{t[k], t[(k + 1) % 3]}];
+    shape.faces.push_back(t);
+    const Vec3 u = nrm.normalized();
+    shape.planes.emplace_back(u.x(), u.y(), u.z(), u.dot(shape.vertices[t[0]]));
+  }
+  for (const auto& [e, count] : edges)
+    if (count != 1 || !edges.count({e.second, e.first}))
+      fail(w, "faces do not close the shape with a consistent winding (edge " + std::to_string(e.first) + "-" +
+                  std::to_string(e.second) + ")");
+  double scale = 0.0;
+  for (const Vec3& p : shape.vertices) shape.center += p / n;
+  for (const Vec3& p : shape.vertices) scale = std::max(scale, (p - shape.center).norm());
+  shape.radius = scale;
+  for (size_t i = 0; i < shape.planes.size(); ++i)
+    for (const Vec3& p : shape.vertices)
+      if (shape.planes[i].head<3>().dot(p) - shape.planes[i][3] > 1e-9 * std::max(scale, 1e-3))
+        fail(w, "not convex or wound inwards: a vertex lies outside faces[" + std::to_string(i) + "]'s plane");
+  return shape;
+}
+
 std::vector<Shape> shapes(const json& j, const std::string& where) {
   std::vector<Shape> out;
   const json& arr = need(j, "shapes", where);
@@ -91,8 +142,11 @@ std::vector<Shape> shapes(const json& j, const std::string& where) {
       shape.p1 = vec3(s, "p1", w);
       shape.radius = number(s, "radius", w);
       if (!(shape.radius > 0)) fail(w, "radius must be positive");
+    } else if (type == "convex") {
+      exactly(s, {"type", "vertices", "faces"}, w);
+      shape = convex_shape(s, w);
     } else {
-      fail(w, "unknown shape type (expected 'box' or 'capsule')");
+      fail(w, "unknown shape type (expected 'box', 'capsule' or 'convex')");
     }
     out.push_back(shape);
   }
@@ -129,7 +183,33 @@ Eigen::Matrix3d link_rotation(const Vec3& d, double theta) {
   return R;
 }
 
+/// Indices into q of the joints the "fingers read" measurement uses, from their link names
+/// ("finger/phalanx"); each at most once.
+std::vector<int> parse_measured_joints(const json& names, const HandModel& h) {
+  if (!names.is_array() || names.empty()) fail("measured_joints", "must be a non-empty list of phalanx names");
+  std::vector<int> out;
+  for (size_t i = 0; i < names.size(); ++i) {
+    const std::string w = "measured_joints[" + std::to_string(i) + "]";
+    if (!names[i].is_string()) fail(w, "must be a phalanx name 'finger/phalanx'");
+    const std::string n = names[i].get<std::string>();
+    int found = -1;
+    for (const Finger& f : h.fingers())
+      for (size_t p = 0; p < f.phalanges.size(); ++p)
+        if (f.name + "/" + f.phalanges[p].name == n) found = f.first_joint + static_cast<int>(p);
+    if (found < 0) fail(w, "no phalanx named '" + n + "'");
+    if (std::find(out.begin(), out.end(), found) != out.end()) fail(w, "'" + n + "' listed twice");
+    out.push_back(found);
+  }
+  return out;
+}
+
 }  // namespace
+
+double Shape::plane_distance(const Vec3& p) const {
+  double d = -std::numeric_limits<double>::infinity();
+  for (const Eigen::Vector4d& pl : planes) d = std::max(d, pl.head<3>().dot(p) - pl[3]);
+  return d;
+}
 
 double Finger::t_max() const {
   double t = 0.0;
@@ -147,7 +227,8 @@ HandModel HandModel::from_json(const std::string& json_text) {
   }
   HandModel h;
   // name, geometry and actuation are required; description and frame are documentation
-  exactly(root, {"name", "actuation", "palm", "spread", "fingers"}, "top level", {"description", "frame"});
+  exactly(root, {"name", "actuation", "palm", "spread", "fingers", "measured_joints"}, "top level",
+          {"description", "frame"});
   h.name_ = text(root, "name", "top level");
   if (!root.at("actuation").is_object()) fail("actuation", "must be an object (the strength's figures and sources)");
 
@@ -209,6 +290,7 @@ HandModel HandModel::from_json(const std::string& json_text) {
     h.fingers_.push_back(finger);
   }
   h.num_joints_ = joint;
+  h.measured_joints_ = parse_measured_joints(root.at("measured_joints"), h);
   return h;
 }
 

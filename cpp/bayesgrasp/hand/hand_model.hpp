@@ -25,6 +25,7 @@
 // or at its limit.
 #pragma once
 
+#include <array>
 #include <string>
 #include <vector>
 
@@ -34,13 +35,22 @@ namespace bayesgrasp {
 
 /// A collision primitive in a link frame.
 struct Shape {
-  enum class Type { Box, Capsule };
+  enum class Type { Box, Capsule, Convex };
   Type type = Type::Box;
-  Vec3 center = Vec3::Zero();        // Box: centre (box axes = link axes)
+  Vec3 center = Vec3::Zero();        // Box: centre (box axes = link axes); Convex: the vertices' mean
   Vec3 half_extents = Vec3::Zero();  // Box
   Vec3 p0 = Vec3::Zero();            // Capsule: segment end points and radius
   Vec3 p1 = Vec3::Zero();
-  double radius = 0.0;
+  double radius = 0.0;               // Capsule; Convex: the largest distance of a vertex from center
+  // Convex: a closed convex polyhedron (a mesh link's hull, a cylinder's prism): its vertices,
+  // its triangles wound counter-clockwise seen from outside, and per triangle the outward plane
+  // (unit normal n, offset d: n . x <= d inside).
+  std::vector<Vec3> vertices;
+  std::vector<std::array<int, 3>> faces;
+  std::vector<Eigen::Vector4d> planes;
+  /// Convex: the largest plane distance n . p - d over the faces (<= 0 inside; a lower bound on
+  /// the distance outside, exact inside as minus the depth).
+  double plane_distance(const Vec3& p) const;
 };
 
 struct Phalanx {
@@ -92,6 +102,8 @@ class HandModel {
   double spread_lower() const { return spread_lower_; }
   double spread_upper() const { return spread_upper_; }
   double spread_default() const { return spread_default_; }
+  /// Indices into q of the joints the "fingers read" measurement uses (the file's measured_joints).
+  const std::vector<int>& measured_joints() const { return measured_joints_; }
 
   /// Joint vector with the given spread and every finger at actuator parameter t.
   Eigen::VectorXd coupled_joints(double spread, double t = 0.0) const;
@@ -142,6 +154,7 @@ class HandModel {
   std::vector<Finger> fingers_;
   std::vector<Link> links_;
   int num_joints_ = 1;
+  std::vector<int> measured_joints_;
   double spread_lower_ = 0.0, spread_upper_ = 0.0, spread_default_ = 0.0;
 };
 

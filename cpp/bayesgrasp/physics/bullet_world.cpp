@@ -1,6 +1,19 @@
 #include "bayesgrasp/physics/bullet_world.hpp"
 
+#include <LinearMath/btConvexHullComputer.h>
+
 namespace bayesgrasp::physics {
+
+std::vector<btVector3> shrunk_hull(const std::vector<btVector3>& pts, double margin) {
+  std::vector<btVector3> scaled(pts.size());
+  for (size_t i = 0; i < pts.size(); ++i) scaled[i] = pts[i] * btScalar(kUnit);
+  btConvexHullComputer chc;
+  chc.compute(&scaled[0].x(), sizeof(btVector3), static_cast<int>(scaled.size()), btScalar(kUnit * margin),
+              btScalar(0.5));
+  std::vector<btVector3> out;
+  for (int i = 0; i < chc.vertices.size(); ++i) out.push_back(chc.vertices[i]);
+  return out;
+}
 
 BulletWorld::BulletWorld(const LiftOptions& o)
     : config_(separated_pair_skip_config()),

@@ -35,6 +35,11 @@ inline btTransform to_bt(const Iso3& T) {
   return btTransform(B, to_bt(Vec3(T.translation())));
 }
 
+/// A convex hull for Bullet: the points (m) in Bullet units, the hull shrunk by the collision
+/// margin (each face moved inwards by `margin`, btConvexHullComputer's shrink; at most half the
+/// hull's inner radius), so that hull + margin is the true surface.
+std::vector<btVector3> shrunk_hull(const std::vector<btVector3>& pts, double margin);
+
 inline Iso3 from_bt(const btTransform& t) {
   Iso3 T = Iso3::Identity();
   const btMatrix3x3& B = t.getBasis();

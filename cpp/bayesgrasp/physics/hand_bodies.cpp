@@ -62,6 +62,15 @@ void add_shapes(btCompoundShape* compound, const std::vector<Shape>& shapes, con
       Iso3 local = Iso3::Identity();
       local.translation() = s.center;
       compound->addChildShape(to_bt(T * local), box);
+    } else if (s.type == Shape::Type::Convex) {
+      // the hull shrunk by the margin, so that hull + margin is the shape's surface
+      std::vector<btVector3> pts;
+      for (const Vec3& v : s.vertices) pts.push_back(bt(v));
+      const std::vector<btVector3> inner = shrunk_hull(pts, margin);
+      auto* hull = static_cast<btConvexHullShape*>(w.keep(new btConvexHullShape(&inner[0].x(), static_cast<int>(inner.size()),
+                                                                                   sizeof(btVector3))));
+      hull->setMargin(btScalar(kUnit * margin));
+      compound->addChildShape(to_bt(T), hull);
     } else {
       const Vec3 axis = s.p1 - s.p0;
       const double len = axis.norm();

@@ -77,20 +77,6 @@ ConvexHull convex_hull(const std::vector<btVector3>& pts) {
   return h;
 }
 
-// A convex hull for Bullet: the points (m) in Bullet units, the hull shrunk by the collision
-// margin (each face moved inwards by `margin`, btConvexHullComputer's shrink; at most half the
-// hull's inner radius), so that hull + margin is the true surface.
-std::vector<btVector3> shrunk_hull(const std::vector<btVector3>& pts, double margin) {
-  std::vector<btVector3> scaled(pts.size());
-  for (size_t i = 0; i < pts.size(); ++i) scaled[i] = pts[i] * btScalar(kUnit);
-  btConvexHullComputer chc;
-  chc.compute(&scaled[0].x(), sizeof(btVector3), static_cast<int>(scaled.size()), btScalar(kUnit * margin),
-              btScalar(0.5));
-  std::vector<btVector3> out;
-  for (int i = 0; i < chc.vertices.size(); ++i) out.push_back(chc.vertices[i]);
-  return out;
-}
-
 // Principal axes (right-handed) at the centre of mass.
 void set_body_frame(LiftObject& o) {
   Eigen::SelfAdjointEigenSolver<Mat3> es(o.mass.inertia);
@@ -177,7 +163,7 @@ LiftObject prepare_object(const TriMesh& object, const LiftOptions& options,
 
 LiftOptions::Shape shape_for_grasp(const LiftObject& o, const HandModel& hand, const std::vector<Iso3>& poses) {
   if (!o.per_grasp) return o.shape;
-  // Links are sampled: capsule axes (11 points, radius added), box corners and centre.
+  // Links are sampled: capsule axes (11 points, radius added), box corners and centre, convex vertices.
   const Iso3 to_body = o.body0.inverse();
   auto depth = [&](const Vec3& p_world, double radius) {  // > 0: inside the hull by that much
     const Vec3 p = to_body * p_world;
@@ -190,6 +176,9 @@ LiftOptions::Shape shape_for_grasp(const LiftObject& o, const HandModel& hand, c
       if (sh.type == Shape::Type::Capsule) {
         for (int k = 0; k <= 10; ++k)
           if (depth(poses[l] * (sh.p0 + (sh.p1 - sh.p0) * (k / 10.0)), sh.radius) > 1e-3) return o.shape;
+      } else if (sh.type == Shape::Type::Convex) {
+        for (const Vec3& v : sh.vertices)
+          if (depth(poses[l] * v, 0.0) > 1e-3) return o.shape;
       } else {
         if (depth(poses[l] * sh.center, 0.0) > 1e-3) return o.shape;
         for (int c = 0; c < 8; ++c) {

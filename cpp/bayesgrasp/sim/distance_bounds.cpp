@@ -10,6 +10,8 @@ double table_distance(const std::vector<LinkShape>& shapes, const Iso3& T) {
   for (const LinkShape& s : shapes) {
     if (s.capsule) {
       d = std::min(d, std::min((T * s.p0).z(), (T * s.p1).z()) - s.radius);
+    } else if (s.convex) {
+      for (const Vec3& v : s.vertices) d = std::min(d, (T * v).z());
     } else {
       const Vec3 c = T * s.center;
       const double ext = std::abs(T.linear()(2, 0)) * s.half_extents.x() +
@@ -29,6 +31,11 @@ Vec3 lowest_point(const std::vector<LinkShape>& shapes, const Iso3& T) {
       const Vec3 a = T * s.p0, b = T * s.p1;
       Vec3 q = std::abs(a.z() - b.z()) < 1e-9 ? Vec3(0.5 * (a + b)) : (a.z() < b.z() ? a : b);
       if (q.z() - s.radius < best) best = q.z() - s.radius, p = q;
+    } else if (s.convex) {
+      for (const Vec3& v : s.vertices) {
+        const Vec3 q = T * v;
+        if (q.z() < best) best = q.z(), p = q;
+      }
     } else {
       const Mat3 R = T.linear();
       Vec3 q = T * s.center;
@@ -49,6 +56,8 @@ double box_distance(const std::vector<LinkShape>& shapes, const Iso3& T, const O
       const Vec3 a = T * s.p0, c = T * s.p1;
       b.extend(a.cwiseMin(c) - Vec3::Constant(s.radius));
       b.extend(a.cwiseMax(c) + Vec3::Constant(s.radius));
+    } else if (s.convex) {
+      for (const Vec3& v : s.vertices) b.extend(T * v);
     } else {
       const Vec3 c = T * s.center;
       const Vec3 e = T.linear().cwiseAbs() * s.half_extents;
@@ -70,6 +79,8 @@ double link_min_along(const std::vector<LinkShape>& shapes, const Iso3& T, const
   for (const LinkShape& s : shapes) {
     if (s.capsule) {
       lo = std::min(lo, std::min(n.dot(T * s.p0), n.dot(T * s.p1)) - s.radius);
+    } else if (s.convex) {
+      for (const Vec3& v : s.vertices) lo = std::min(lo, n.dot(T * v));
     } else {
       const Vec3 nl = T.linear().transpose() * n;
       lo = std::min(lo, n.dot(T * s.center) - nl.cwiseAbs().dot(s.half_extents));

@@ -3,6 +3,7 @@
 #include <fcl/geometry/bvh/BVH_model.h>
 #include <fcl/geometry/shape/box.h>
 #include <fcl/geometry/shape/capsule.h>
+#include <fcl/geometry/shape/convex.h>
 #include <fcl/geometry/shape/sphere.h>
 #include <fcl/math/bv/OBBRSS.h>
 #include <fcl/math/bv/RSS.h>
@@ -139,6 +140,27 @@ LinkShape box_shape(const Shape& s, const SimOptions& options) {
   return g;
 }
 
+// A convex polyhedron: FCL's Convex for boolean checks (and distances with primitives), its
+// triangles as a BVH otherwise.
+LinkShape convex_shape(const Shape& s, const SimOptions& options) {
+  LinkShape g;
+  g.capsule = false;
+  g.convex = true;
+  g.vertices = s.vertices;
+  auto verts = std::make_shared<std::vector<fcl::Vector3d>>(s.vertices.begin(), s.vertices.end());
+  auto faces = std::make_shared<std::vector<int>>();
+  Triangles lt;
+  for (const auto& f : s.faces) {
+    faces->insert(faces->end(), {3, f[0], f[1], f[2]});
+    lt.emplace_back(f[0], f[1], f[2]);
+  }
+  g.primitive = std::make_shared<fcl::Convexd>(verts, static_cast<int>(s.faces.size()), faces);
+  if (options.links == SimOptions::LinkGeometry::Primitives) g.geometry = g.primitive;
+  else g.geometry = make_mesh_geometry(*verts, lt, options.bv, g.mesh);
+  for (const Vec3& v : s.vertices) g.reach = std::max(g.reach, v.norm());
+  return g;
+}
+
 }  // namespace
 
 ObjectGeometry make_object_geometry(const TriMesh& object, SimOptions::Bv bv) {
@@ -171,7 +193,9 @@ LinkShapes make_link_shapes(const HandModel& hand, const SimOptions& options) {
   LinkShapes links(hand.num_links());
   for (int l = 0; l < hand.num_links(); ++l)
     for (const Shape& s : hand.links()[l].shapes) {
-      LinkShape g = s.type == Shape::Type::Capsule ? capsule_shape(s, options) : box_shape(s, options);
+      LinkShape g = s.type == Shape::Type::Capsule ? capsule_shape(s, options)
+                    : s.type == Shape::Type::Box   ? box_shape(s, options)
+                                                   : convex_shape(s, options);
       g.geometry->computeLocalAABB();
       g.primitive->computeLocalAABB();
       links[l].push_back(std::move(g));
@@ -192,6 +216,8 @@ double depth_below_palm(const HandModel& hand, const LinkShapes& links, const Ei
     for (const LinkShape& s : links[l]) {
       if (s.capsule) {
         depth = std::max(depth, std::max((local[l] * s.p0).z(), (local[l] * s.p1).z()) + s.radius);
+      } else if (s.convex) {
+        for (const Vec3& v : s.vertices) depth = std::max(depth, (local[l] * v).z());
       } else {
         const Vec3 c = local[l] * s.center;
         depth = std::max(depth, c.z() + (local[l].linear().row(2).cwiseAbs() * s.half_extents)(0));

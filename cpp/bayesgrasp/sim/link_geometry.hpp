@@ -26,7 +26,7 @@ struct MeshView {
   const fcl::Triangle* triangles = nullptr;
 };
 
-/// One collision shape of a link (a capsule or a box of the hand file), prepared for queries.
+/// One collision shape of a link (a capsule, box or convex shape of the hand file), prepared for queries.
 struct LinkShape {
   FclGeometry geometry;                 // for distance queries (SimOptions::links)
   MeshView mesh;                        // geometry's triangles when it is a BVH (warm starts), else empty
@@ -36,6 +36,8 @@ struct LinkShape {
   FclGeometry primitive;                // FCL capsule, sphere or box (boolean collision checks)
   Iso3 primitive_frame = Iso3::Identity();
   bool capsule = true;
+  bool convex = false;                  // a convex polyhedron (vertices); neither capsule nor box
+  std::vector<Vec3> vertices;           // convex: its vertices (link frame)
   Vec3 p0 = Vec3::Zero(), p1 = Vec3::Zero();  // capsule axis end points (link frame)
   double radius = 0.0;                        // capsule radius
   Vec3 center = Vec3::Zero(), half_extents = Vec3::Zero();  // box (link frame, link axes)

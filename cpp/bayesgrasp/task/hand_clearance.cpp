@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <stdexcept>
 #include <string>
 
@@ -19,12 +20,18 @@ struct Bound {
 
 Bound bound_of(const Shape& s) {
   if (s.type == Shape::Type::Capsule) return {0.5 * (s.p0 + s.p1), 0.5 * (s.p1 - s.p0).norm() + s.radius};
+  if (s.type == Shape::Type::Convex) return {s.center, s.radius};
   return {s.center, s.half_extents.norm()};
 }
 
 /// Lowest z of a shape placed by T (world).
 double lowest_z(const Shape& s, const Iso3& T) {
   if (s.type == Shape::Type::Capsule) return std::min((T * s.p0).z(), (T * s.p1).z()) - s.radius;
+  if (s.type == Shape::Type::Convex) {
+    double z = std::numeric_limits<double>::infinity();
+    for (const Vec3& v : s.vertices) z = std::min(z, (T * v).z());
+    return z;
+  }
   const Vec3 c = T * s.center;
   return c.z() - (T.linear().row(2).cwiseAbs() * s.half_extents)(0);
 }
@@ -55,6 +62,7 @@ double shape_depth(const Shape& s, const Vec3& p, double margin) {
     const double u = len2 > 0 ? std::clamp((p - s.p0).dot(ab) / len2, 0.0, 1.0) : 0.0;
     return s.radius + margin - (p - (s.p0 + u * ab)).norm();
   }
+  if (s.type == Shape::Type::Convex) return margin - s.plane_distance(p);  // exact inside, a bound outside
   // box: depth = min over axes of (half extent + margin - |offset|) when inside on all axes
   const Vec3 d = (p - s.center).cwiseAbs() - s.half_extents - Vec3::Constant(margin);
   if ((d.array() > 0).any()) return -d.cwiseMax(0.0).norm();

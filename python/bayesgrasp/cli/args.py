@@ -91,7 +91,7 @@ def output_file(path: Optional[str], what: str) -> Optional[Path]:
 
 def add_context_options(p: argparse.ArgumentParser, lift: bool = False, seed: bool = True) -> None:
     """The options every run context is built from: --hand, --cache, --success (and --seed, --no-lift)."""
-    p.add_argument("--hand", type=hand_name, default="barrett_bh8", help="built-in hand name or hand file path")
+    p.add_argument("--hand", type=hand_name, default="barrett_bh8", help="built-in hand name, hand file or URDF (with its NAME.hand.json sidecar)")
     p.add_argument("--success", default="lift", choices=["lift", "epsilon"],
                    help="what a successful grasp is: held in the lift test (default) or epsilon above the "
                         "models' eps_stable (the thesis's simulation criterion)")
@@ -281,13 +281,14 @@ def output_format(args: argparse.Namespace) -> str:
 def hand_name(text: str) -> str:
     """An argparse type for --hand: a built-in hand's name or a hand file that exists (argparse then
     names --hand in the error, before any work)."""
-    from ..hand import HANDS_DIR, builtin_hands
+    from ..hand import builtin_hands, resolve_hand
 
-    p = Path(text)
-    if p.is_file() or (not p.suffix and (HANDS_DIR / f"{text}.json").is_file()):
+    try:
+        resolve_hand(text)
         return text
-    raise argparse.ArgumentTypeError(f"unknown hand {text!r} (built-in: {', '.join(builtin_hands())}; or the path "
-                                     "of a hand file)")
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"unknown hand {text!r} (built-in: {', '.join(builtin_hands())}; or the "
+                                         "path of a hand file or a URDF)") from None
 
 
 hand_name.__name__ = "hand"

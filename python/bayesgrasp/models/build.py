@@ -131,7 +131,7 @@ def _train(world: World, settings: ModelSettings, key: str, say: Say) -> GraspMo
     rel, q, eps = simulate_training_data(world, settings, spread=variant)
     if len(rel) < 10:
         raise ValueError(f"{name}: only {len(rel)} collision-free {variant.family} grasps in the sampled range")
-    joint_index = np.arange(1, q.shape[1])     # every phalanx joint (the spread is fixed)
+    joint_index = world.hand.measured_joints   # the hand file's measured_joints (the spread is fixed)
     X = variant.features(rel)
     say(f"models for {name}: fitting FITC GPs on {len(rel)} grasps")
     measurement = _fit(X, q[:, joint_index], settings, len(rel))
@@ -160,7 +160,7 @@ def build_models(obj: Union[str, ObjectModel], hand="barrett_bh8", settings: Opt
     settings = settings or ModelSettings()
     obj = load_object(obj) if isinstance(obj, str) else obj
     world = World.single(obj, pose=(0.0, 0.0, 0.0), hand=hand)
-    hand_text = Path(world.hand.path).read_text() if getattr(world.hand, "path", None) else world.hand.name
+    hand_text = world.hand.text or world.hand.name
     key = cache_key(world.object, hand_text, settings)
     say = progress or (lambda msg: None)
     files = None if cache_dir is None else _CacheFiles(cache_dir, key)

@@ -203,7 +203,7 @@ def task_grasps(models: Sequence[Union[str, ObjectModel]], rule: TaskRule, hand:
     from ..hand import Hand
 
     s = settings or TaskGraspSettings()
-    hand_text = Path(Hand.load(hand).path).read_text()
+    hand_text = Hand.load(hand).text
     out: List[TaskGrasp] = []
     for m in models:
         o = load_object(m)

@@ -19,7 +19,6 @@ from typing import Dict, List, Optional, Tuple
 import numpy as np
 
 from ..hand import Hand, builtin_hands
-from ..viz import box_mesh, capsule_mesh
 from .scene import ResultScene, Step, planar_transform
 
 LAYERS = ("object", "hand", "pregrasp", "approach", "contacts", "models", "particles", "lift trace", "cloud")
@@ -56,12 +55,7 @@ def hand_link_meshes(hand: Hand, q, pose) -> List[Tuple[str, np.ndarray, np.ndar
     """The hand's collision shapes at joints ``q`` and 4x4 ``pose`` as (name, V, F) meshes."""
     out, count = [], {}
     for s in hand.link_geometry(np.asarray(q, float), np.asarray(pose, float)):
-        if s.type == "capsule":
-            V, F = capsule_mesh(s.p0, s.p1, s.radius)
-        else:
-            T = np.eye(4)
-            T[:3, :3], T[:3, 3] = s.rotation, s.center
-            V, F = box_mesh(T, s.half_extents)
+        V, F = s.mesh()
         i = count[s.name] = count.get(s.name, -1) + 1
         out.append((f"{s.name.replace('/', '_')}-{i}", np.asarray(V, float), np.asarray(F, np.int32)))
     return out

@@ -1,0 +1,492 @@
+"""Hands from a URDF and a sidecar file (issue 31).
+
+A URDF gives the links, their collision geometry, the joints with their axes, limits and mimic
+couplings. The sidecar (``NAME.hand.json`` beside ``NAME.urdf``) says what a URDF cannot: the
+palm frame and approach axis, the spread joint, which joints close each finger and how (the
+closing scheme), each joint's motor torque with its source, and the joints the "fingers read"
+measurement uses. :func:`hand_json_from_urdf` turns the pair into the text of a hand file (the
+format of ``barrett_bh8.json``), so a URDF hand runs through the same C++ model as any other.
+
+What the conversion needs of the URDF (each is checked and refused in one line naming it):
+
+* every finger is a planar chain: its phalanx joints are revolute with parallel axes lying in
+  the palm plane; a positive angle closes the finger (turns it towards the approach axis);
+* a finger's spread joint (if any) is a revolute joint about the approach axis between the palm
+  and the finger's first phalanx joint: the sidecar's spread joint or a mimic of it;
+* every other link hangs from the palm or a phalanx by fixed joints (it joins that body);
+* the tree has no loop (a link that is the child of two joints).
+
+Collision shapes: boxes (axis-aligned with the link after the conversion, else their 8 corners
+as a convex shape), spheres, cylinders (a cylinder with a sphere of its radius at each end cap
+is one capsule; else a 32-sided prism), and meshes (their convex hull). Units: metres and radians.
+"""
+from __future__ import annotations
+
+import json
+import math
+from pathlib import Path
+from typing import Optional
+
+import numpy as np
+
+__all__ = ["HandFileError", "hand_json_from_urdf", "sidecar_path"]
+
+SIDECAR_SUFFIX = ".hand.json"
+_TOL = 1e-6           # geometric checks (m, or cosine of an angle)
+_PRISM_SIDES = 32     # a lone cylinder's convex prism
+
+
+class HandFileError(ValueError):
+    """A URDF or sidecar the conversion cannot take (the message names the file and what)."""
+
+
+def sidecar_path(urdf: Path) -> Path:
+    """The sidecar that goes with a URDF: ``NAME.hand.json`` beside ``NAME.urdf``."""
+    return urdf.with_name(urdf.stem + SIDECAR_SUFFIX)
+
+
+# ---------------------------------------------------------------- reading the two files ----
+
+def _load_sidecar(path: Path) -> dict:
+    import jsonschema
+
+    try:
+        data = json.loads(path.read_text())
+    except OSError as e:
+        raise HandFileError(f"{path}: cannot read the sidecar ({e.strerror or e})") from None
+    except json.JSONDecodeError as e:
+        raise HandFileError(f"{path}: not valid JSON ({e})") from None
+    schema = json.loads((Path(__file__).parent / "data" / "schema" / "hand_sidecar.schema.json").read_text())
+    errors = sorted(jsonschema.Draft202012Validator(schema).iter_errors(data), key=lambda e: list(e.absolute_path))
+    if errors:
+        e = errors[0]
+        where = ".".join(str(p) for p in e.absolute_path) or "top level"
+        raise HandFileError(f"{path}: {where}: {e.message}")
+    return data
+
+
+def _load_urdf(path: Path):
+    import yourdfpy
+    from lxml import etree
+
+    try:  # strict XML first: yourdfpy recovers from broken XML with a guess
+        root = etree.parse(str(path)).getroot()
+    except OSError as e:
+        raise HandFileError(f"{path}: cannot read the URDF ({e})") from None
+    except etree.XMLSyntaxError as e:
+        raise HandFileError(f"{path}: not a readable URDF (XML: {e})") from None
+    if root.tag != "robot":
+        raise HandFileError(f"{path}: not a readable URDF (its root element is <{root.tag}>, not <robot>)")
+    try:
+        robot = yourdfpy.URDF.load(str(path), build_scene_graph=False, load_meshes=False,
+                                   build_collision_scene_graph=False, load_collision_meshes=False)
+    except OSError as e:
+        raise HandFileError(f"{path}: cannot read the URDF ({e.strerror or e})") from None
+    except Exception as e:  # noqa: BLE001 - lxml and yourdfpy raise many kinds; one line names the file
+        raise HandFileError(f"{path}: not a readable URDF ({type(e).__name__}: {e})") from None
+    return robot.robot
+
+
+# ---------------------------------------------------------------- small geometry ----
+
+def _rpy(rpy) -> np.ndarray:
+    r, p, y = (float(v) for v in rpy)
+    cr, sr, cp, sp, cy, sy = math.cos(r), math.sin(r), math.cos(p), math.sin(p), math.cos(y), math.sin(y)
+    return np.array([[cy * cp, cy * sp * sr - sy * cr, cy * sp * cr + sy * sr],
+                     [sy * cp, sy * sp * sr + cy * cr, sy * sp * cr - cy * sr],
+                     [-sp, cp * sr, cp * cr]])
+
+
+def _pose(R: np.ndarray, t) -> np.ndarray:
+    T = np.eye(4)
+    T[:3, :3], T[:3, 3] = R, np.asarray(t, dtype=float)
+    return T
+
+
+def _origin(x) -> np.ndarray:
+    return np.eye(4) if x is None else np.asarray(x, dtype=float)
+
+
+def _unit(v) -> np.ndarray:
+    v = np.asarray(v, dtype=float)
+    return v / np.linalg.norm(v)
+
+
+# ---------------------------------------------------------------- the URDF's tree ----
+
+class _Tree:
+    """The URDF's links and joints at the zero configuration, in the hand (palm) frame."""
+
+    def __init__(self, robot, where: str):
+        self.where = where
+        self.links = {l.name: l for l in robot.links}
+        self.joints = {j.name: j for j in robot.joints}
+        self.parent_joint: dict[str, object] = {}
+        for j in robot.joints:
+            for end in (j.parent, j.child):
+                if end not in self.links:
+                    raise HandFileError(f"{where}: joint '{j.name}' names a link '{end}' that the URDF does not have")
+            if j.child in self.parent_joint:
+                raise HandFileError(f"{where}: kinematic loop: link '{j.child}' is the child of two joints "
+                                    f"('{self.parent_joint[j.child].name}' and '{j.name}')")
+            self.parent_joint[j.child] = j
+        for name in self.links:  # a cycle without a double parent (every link on it has one parent)
+            seen, n = {name}, name
+            while n in self.parent_joint:
+                n = self.parent_joint[n].parent
+                if n in seen:
+                    raise HandFileError(f"{where}: kinematic loop through link '{n}'")
+                seen.add(n)
+
+    def joint(self, name: str, what: str):
+        if name not in self.joints:
+            raise HandFileError(f"{self.where}: {what} names joint '{name}', which the URDF does not have")
+        return self.joints[name]
+
+    def chain(self, link: str) -> list:
+        """Joints from the root down to `link` (root first)."""
+        out = []
+        while link in self.parent_joint:
+            j = self.parent_joint[link]
+            out.append(j)
+            link = j.parent
+        return out[::-1]
+
+    def zero_pose(self, link: str) -> np.ndarray:
+        """The link's frame in the root's frame at every joint 0 (a joint at 0 is its origin)."""
+        T = np.eye(4)
+        for j in self.chain(link):
+            T = T @ _origin(j.origin)
+        return T
+
+
+# ---------------------------------------------------------------- collision shapes ----
+
+def _mesh_points(geom_mesh, urdf_dir: Path, where: str, link: str) -> np.ndarray:
+    import trimesh
+
+    name = geom_mesh.filename
+    rel = name.split("://", 1)[1] if "://" in name else name
+    if name.startswith("package://"):   # package://PKG/path: resolved beside the URDF without PKG, or with it
+        cands = [urdf_dir / rel.split("/", 1)[-1], urdf_dir / rel]
+    else:
+        cands = [Path(rel) if Path(rel).is_absolute() else urdf_dir / rel]
+    path = next((c for c in cands if c.is_file()), None)
+    if path is None:
+        raise HandFileError(f"{where}: link '{link}': mesh file '{name}' not found (looked for {cands[0]})")
+    try:
+        m = trimesh.load(str(path), force="mesh")
+    except Exception as e:  # noqa: BLE001 - trimesh's loaders raise many kinds
+        raise HandFileError(f"{where}: link '{link}': cannot read mesh '{path}' ({e})") from None
+    V = np.asarray(m.vertices, dtype=float)
+    if len(V) < 4:
+        raise HandFileError(f"{where}: link '{link}': mesh '{path}' has fewer than 4 vertices")
+    scale = geom_mesh.scale
+    return V * (1.0 if scale is None else np.asarray(scale, dtype=float))
+
+
+def _transform(T: np.ndarray, P: np.ndarray) -> np.ndarray:
+    return P @ T[:3, :3].T + T[:3, 3]
+
+
+def _convex(points: np.ndarray, where: str = "convex shape") -> dict:
+    """The convex hull of the points (Qhull, through scipy) as a hand file's convex shape: its
+    vertices and its triangles wound counter-clockwise seen from outside."""
+    from scipy.spatial import ConvexHull, QhullError
+
+    P = np.asarray(points, dtype=float)
+    try:
+        hull = ConvexHull(P)
+    except QhullError:
+        raise HandFileError(f"{where}: its points span no volume (flat or degenerate)") from None
+    keep = hull.vertices
+    index = {int(v): i for i, v in enumerate(keep)}
+    V = P[keep]
+    faces = []
+    for tri, eq in zip(hull.simplices, hull.equations):   # equations: outward normal n and offset, n.x + c <= 0
+        a, b, c = (index[int(v)] for v in tri)
+        if np.cross(V[b] - V[a], V[c] - V[a]) @ eq[:3] < 0:
+            b, c = c, b
+        faces.append([a, b, c])
+    return {"type": "convex", "vertices": [[float(x) for x in p] for p in V], "faces": faces}
+
+
+def _box(T: np.ndarray, size) -> dict:
+    """A URDF box at pose T in our link frame: a box if its axes are the link's (up to order and
+    sign), else its 8 corners as a convex shape."""
+    h = 0.5 * np.asarray(size, dtype=float)
+    R = T[:3, :3]
+    A = np.abs(R)
+    if np.all((A < _TOL) | (np.abs(A - 1.0) < _TOL)):
+        return {"type": "box", "center": [float(x) for x in T[:3, 3]], "half_extents": [float(x) for x in A @ h]}
+    corners = np.array([[sx, sy, sz] for sx in (-1, 1) for sy in (-1, 1) for sz in (-1, 1)]) * h
+    return _convex(_transform(T, corners), "a box")
+
+
+def _shapes_of(items: list, where: str) -> list:
+    """Our shapes from (kind, pose in our link frame, geometry) items; a cylinder with a sphere of
+    its radius at each end cap becomes one capsule."""
+    spheres = [(i, T[:3, 3], g.radius) for i, (kind, T, g) in enumerate(items) if kind == "sphere"]
+    used, out = set(), []
+    for i, (kind, T, g) in enumerate(items):
+        if kind != "cylinder":
+            continue
+        axis = T[:3, 2]
+        p0, p1 = T[:3, 3] - 0.5 * g.length * axis, T[:3, 3] + 0.5 * g.length * axis
+        caps = [next((k for k, c, r in spheres if k not in used and abs(r - g.radius) < _TOL
+                      and np.linalg.norm(c - p) < _TOL), None) for p in (p0, p1)]
+        if None not in caps and caps[0] != caps[1]:
+            used.update(caps)
+            used.add(i)
+            out.append({"type": "capsule", "p0": [float(x) for x in p0], "p1": [float(x) for x in p1],
+                        "radius": float(g.radius)})
+    for i, (kind, T, g) in enumerate(items):
+        if i in used:
+            continue
+        if kind == "sphere":
+            c = [float(x) for x in T[:3, 3]]
+            out.append({"type": "capsule", "p0": c, "p1": c, "radius": float(g.radius)})
+        elif kind == "box":
+            out.append(_box(T, g.size))
+        elif kind == "cylinder":
+            a = np.linspace(0.0, 2.0 * np.pi, _PRISM_SIDES, endpoint=False)
+            ring = np.c_[g.radius * np.cos(a), g.radius * np.sin(a)]
+            P = np.vstack([np.c_[ring, np.full(len(a), z)] for z in (-0.5 * g.length, 0.5 * g.length)])
+            out.append(_convex(_transform(T, P), f"{where}: a cylinder"))
+        else:  # mesh points, already in our link frame
+            out.append(_convex(g, f"{where}: a mesh"))
+    return out
+
+
+# ---------------------------------------------------------------- the conversion ----
+
+def hand_json_from_urdf(urdf: str | Path, sidecar: Optional[str | Path] = None) -> str:
+    """The hand-file text (JSON) of a URDF hand and its sidecar (default: ``NAME.hand.json``
+    beside ``NAME.urdf``). Raises :class:`HandFileError` naming the file and what is wrong."""
+    urdf = Path(urdf)
+    side_path = Path(sidecar) if sidecar is not None else sidecar_path(urdf)
+    if not urdf.is_file():
+        raise HandFileError(f"{urdf}: URDF file not found")
+    if not side_path.is_file():
+        raise HandFileError(f"{urdf}: its sidecar {side_path.name} is missing (palm frame, spread, fingers, "
+                            "actuation; see the README, 'Bring your own hand')")
+    side = _load_sidecar(side_path)
+    named = (side_path.parent / side["urdf"]).resolve()
+    if named != urdf.resolve():
+        raise HandFileError(f"{side_path}: urdf: names {side['urdf']}, but it was loaded with {urdf}")
+    tree = _Tree(_load_urdf(urdf), str(urdf))
+    return json.dumps(_Converter(tree, side, str(side_path), urdf.parent).hand(), indent=1)
+
+
+class _Converter:
+    def __init__(self, tree: _Tree, side: dict, where: str, urdf_dir: Path):
+        self.tree, self.side, self.where, self.urdf_dir = tree, side, where, urdf_dir
+        palm = side["palm"]
+        if palm["link"] not in tree.links:
+            raise HandFileError(f"{where}: palm.link names link '{palm['link']}', which the URDF does not have")
+        # hand frame H in the root frame: palm link's zero pose times the sidecar's offset
+        self.H = tree.zero_pose(palm["link"]) @ _pose(_rpy(palm["rpy"]), palm["xyz"])
+        self.Hinv = np.linalg.inv(self.H)
+        self.body_of: dict[str, str] = {}   # URDF link -> our link name
+        self.frames: dict[str, np.ndarray] = {}  # our link name -> its frame in the hand frame (URDF zero)
+
+    def _in_hand(self, T_root: np.ndarray) -> np.ndarray:
+        return self.Hinv @ T_root
+
+    def _fail(self, msg: str):
+        raise HandFileError(f"{self.where}: {msg}")
+
+    # -- the spread --
+    def _spread(self) -> tuple[dict, Optional[object]]:
+        sp = self.side["spread"]
+        if sp is None:
+            return {"lower_deg": 0.0, "upper_deg": 0.0, "default_deg": 0.0}, None
+        j = self.tree.joint(sp["joint"], "spread.joint")
+        if j.type != "revolute" or j.limit is None:
+            self._fail(f"spread.joint '{j.name}' must be a revolute joint with limits (it is {j.type})")
+        lo, hi = math.degrees(j.limit.lower), math.degrees(j.limit.upper)
+        if not lo <= sp["default_deg"] <= hi:
+            self._fail(f"spread.default_deg {sp['default_deg']} lies outside the joint's limits [{lo:.6g}, {hi:.6g}]")
+        return {"lower_deg": lo, "upper_deg": hi, "default_deg": float(sp["default_deg"])}, j
+
+    # -- one finger --
+    def _finger(self, fi: int, spec: dict, spread_joint, joint0: int) -> dict:
+        w = f"fingers[{fi}]"
+        joints = [self.tree.joint(p["joint"], f"{w}.phalanges[{k}].joint") for k, p in enumerate(spec["phalanges"])]
+        for k, j in enumerate(joints):
+            if j.type not in ("revolute", "continuous"):
+                self._fail(f"{w}.phalanges[{k}]: joint '{j.name}' is {j.type}; a finger's joints must be revolute")
+        # the chain from the palm to the first joint: fixed joints and at most a spread joint
+        above = self.tree.chain(joints[0].parent)
+        spread_here = [j for j in above if j.type != "fixed"]
+        palm_chain = self.tree.chain(self.side["palm"]["link"])
+        spread_here = [j for j in spread_here if j not in palm_chain]
+        if len(spread_here) > 1:
+            self._fail(f"{w}: joints {[j.name for j in spread_here]} move the finger's base; at most one spread joint")
+        # each phalanx joint's child must hang from the previous one through fixed joints only
+        for k in range(1, len(joints)):
+            up = self.tree.chain(joints[k].parent)
+            if joints[k - 1] not in up or any(j.type != "fixed" for j in up[up.index(joints[k - 1]) + 1:]):
+                self._fail(f"{w}: joint '{joints[k].name}' does not follow '{joints[k - 1].name}' through fixed joints")
+        z = np.array([0.0, 0.0, 1.0])
+        T0 = [self._in_hand(self.tree.zero_pose(j.child)) for j in joints]     # child frames = joint frames at 0
+        pos = [T[:3, 3] for T in T0]
+        axes = [_unit(T[:3, :3] @ np.asarray(j.axis if j.axis is not None else (1, 0, 0), dtype=float))
+                for T, j in zip(T0, joints)]
+        a = axes[0]
+        if abs(a @ z) > _TOL:
+            self._fail(f"{w}: joint '{joints[0].name}' axis is not in the palm plane (its z in the hand frame is {a @ z:.3g})")
+        for k, ak in enumerate(axes[1:], 1):
+            if ak @ a < 1.0 - _TOL:
+                self._fail(f"{w}: joint '{joints[k].name}' axis is not parallel to '{joints[0].name}''s "
+                           "(a finger is a planar chain; a positive angle closes every joint)")
+        d = np.cross(z, a)  # outward direction: a positive angle turns d towards +z (a = d x z)
+        # the finger's base and spread
+        if spread_here:
+            sj = spread_here[0]
+            Ts = self._in_hand(self.tree.zero_pose(sj.child))
+            saxis = Ts[:3, :3] @ _unit(sj.axis if sj.axis is not None else (1, 0, 0))
+            if abs(abs(saxis @ z) - 1.0) > _TOL:
+                self._fail(f"{w}: joint '{sj.name}' moves the finger's base but does not turn about the approach axis")
+            if spread_joint is None:
+                self._fail(f"{w}: joint '{sj.name}' moves the finger's base but the sidecar's spread is null")
+            if sj.name == spread_joint.name:
+                mult, off = 1.0, 0.0
+            elif sj.mimic is not None and sj.mimic.joint == spread_joint.name:
+                mult, off = float(sj.mimic.multiplier or 1.0), float(sj.mimic.offset or 0.0)
+            else:
+                self._fail(f"{w}: joint '{sj.name}' moves the finger's base but is neither the spread joint "
+                           f"'{spread_joint.name}' nor a mimic of it")
+            sign = float(np.sign(saxis @ z))
+            base = Ts[:3, 3] + (pos[0][2] - Ts[2, 3]) * z
+            spread_sign, yaw_offset = sign * mult, sign * off
+        else:
+            base, spread_sign, yaw_offset = pos[0].copy(), 0.0, 0.0
+        knuckle = float((pos[0] - base) @ d)
+        if np.linalg.norm(pos[0] - base - knuckle * d) > _TOL or knuckle < -_TOL:
+            self._fail(f"{w}: joint '{joints[0].name}' is not on the finger's outward line from its base "
+                       f"(off by {np.linalg.norm(pos[0] - base - knuckle * d):.3g} m)")
+        base_yaw = math.degrees(math.atan2(d[1], d[0])) + math.degrees(yaw_offset)  # mimic offset: yaw at spread 0
+        # phalanx lengths and directions at URDF zero
+        tip = _transform(T0[-1], np.asarray(spec["fingertip"], dtype=float)[None])[0]
+        ends = pos[1:] + [tip]
+        theta_prev, phalanges = 0.0, []
+        driver = joints[0]
+        lower0 = float(driver.limit.lower) if driver.limit is not None else 0.0
+        frames = []
+        for k, (j, p) in enumerate(zip(joints, spec["phalanges"])):
+            v = ends[k] - pos[k]
+            length = float(np.linalg.norm(v))
+            if length < 1e-9:
+                self._fail(f"{w}.phalanges[{k}]: joint '{j.name}' has zero length to the next joint or fingertip")
+            x = v / length
+            if abs(x @ a) > _TOL:
+                self._fail(f"{w}.phalanges[{k}]: link '{j.child}' does not lie in the finger's plane")
+            theta = math.atan2(x @ z, x @ d)
+            phi = theta - theta_prev  # our relative angle at the URDF's zero
+            theta_prev = theta
+            if j.limit is None or j.type == "continuous":
+                self._fail(f"{w}.phalanges[{k}]: joint '{j.name}' needs limits")
+            lo, hi = j.limit.lower + phi, j.limit.upper + phi
+            # coupling while free: the driver runs from its lower limit at t = 0 with ratio 1
+            if k == 0:
+                ratio, offset = 1.0, lo
+            elif j.mimic is not None and j.mimic.joint == driver.name:
+                m, o = float(j.mimic.multiplier or 1.0), float(j.mimic.offset or 0.0)
+                ratio, offset = m, phi + m * lower0 + o
+            else:
+                self._fail(f"{w}.phalanges[{k}]: joint '{j.name}' is neither the finger's first joint nor a mimic "
+                           f"of '{driver.name}' (the closing law needs the coupling)")
+            frame = np.eye(4)
+            frame[:3, 0], frame[:3, 1], frame[:3, 2], frame[:3, 3] = x, a, np.cross(x, a), pos[k]
+            frames.append(frame)
+            phalanges.append({"name": p["name"], "length": length, "lower_deg": math.degrees(lo),
+                              "upper_deg": math.degrees(hi), "offset_deg": math.degrees(offset), "ratio": ratio,
+                              "torque_nm": float(p["torque_nm"]), "link": j.child})
+        knuckle_frame = np.eye(4)
+        knuckle_frame[:3, 0], knuckle_frame[:3, 1], knuckle_frame[:3, 2], knuckle_frame[:3, 3] = d, a, np.cross(d, a), base
+        return {"spec": spec, "joints": joints, "base": base, "base_yaw": base_yaw, "spread_sign": spread_sign,
+                "knuckle": max(knuckle, 0.0), "knuckle_frame": knuckle_frame, "phalanges": phalanges, "frames": frames,
+                "spread_joint": spread_here[0] if spread_here else None, "first_q": joint0}
+
+    # -- which URDF links make each of our links --
+    def _bodies(self, fingers: list) -> dict:
+        """Our link name -> (frame in hand, [URDF links]) by following fixed joints from each moving one."""
+        owner = {}  # the joint (or None: the palm) that moves each URDF link
+        for name in self.tree.links:
+            moving = [j for j in self.tree.chain(name) if j.type != "fixed"]
+            owner[name] = moving[-1].name if moving else None
+        ours: dict[str, tuple] = {}
+        by_joint = {None: "palm"}
+        ours["palm"] = (np.eye(4), [])
+        for f in fingers:
+            fname = f["spec"]["name"]
+            if f["spread_joint"] is not None:
+                by_joint[f["spread_joint"].name] = f"{fname}/knuckle"
+                ours[f"{fname}/knuckle"] = (f["knuckle_frame"], [])
+            for p, j, frame in zip(f["phalanges"], f["joints"], f["frames"]):
+                by_joint[j.name] = f"{fname}/{p['name']}"
+                ours[f"{fname}/{p['name']}"] = (frame, [])
+        for name, j in owner.items():
+            if j not in by_joint:
+                self._fail(f"joint '{j}' moves link '{name}', but the sidecar names it nowhere "
+                           "(neither the spread nor a finger's phalanx)")
+            ours[by_joint[j]][1].append(name)
+        return ours
+
+    def _link_shapes(self, frame: np.ndarray, urdf_links: list) -> list:
+        inv = np.linalg.inv(frame)
+        items = []
+        for name in urdf_links:
+            T_link = inv @ self._in_hand(self.tree.zero_pose(name))
+            for c in self.tree.links[name].collisions or []:
+                T = T_link @ _origin(c.origin)
+                g = c.geometry
+                if g.box is not None:
+                    items.append(("box", T, g.box))
+                elif g.sphere is not None:
+                    items.append(("sphere", T, g.sphere))
+                elif g.cylinder is not None:
+                    items.append(("cylinder", T, g.cylinder))
+                elif g.mesh is not None:
+                    items.append(("mesh", T, _transform(T, _mesh_points(g.mesh, self.urdf_dir, self.where, name))))
+        return _shapes_of(items, self.where)
+
+    def hand(self) -> dict:
+        spread, spread_joint = self._spread()
+        fingers, q = [], 1
+        for fi, spec in enumerate(self.side["fingers"]):
+            fingers.append(self._finger(fi, spec, spread_joint, q))
+            q += len(spec["phalanges"])
+        names = [f["spec"]["name"] for f in fingers]
+        if len(set(names)) != len(names):
+            self._fail(f"fingers: names repeat ({names})")
+        joint_names = {}
+        for f in fingers:
+            for p, j in zip(f["phalanges"], f["joints"]):
+                if j.name in joint_names:
+                    self._fail(f"joint '{j.name}' closes two phalanges ({joint_names[j.name]} and {f['spec']['name']}/{p['name']})")
+                joint_names[j.name] = f"{f['spec']['name']}/{p['name']}"
+        bodies = self._bodies(fingers)
+        measured = []
+        for k, n in enumerate(self.side["measured_joints"]):
+            self.tree.joint(n, f"measured_joints[{k}]")
+            if n not in joint_names:
+                self._fail(f"measured_joints[{k}]: joint '{n}' is not a finger's phalanx joint")
+            measured.append(joint_names[n])
+        out_fingers = []
+        for f in fingers:
+            fname = f["spec"]["name"]
+            kn = bodies.get(f"{fname}/knuckle")
+            out_fingers.append({
+                "name": fname, "base": [float(x) for x in f["base"]], "base_yaw_deg": f["base_yaw"],
+                "spread_sign": f["spread_sign"],
+                "knuckle": {"length": f["knuckle"], "shapes": self._link_shapes(*kn) if kn else []},
+                "phalanges": [{k: v for k, v in p.items() if k != "link"} |
+                              {"shapes": self._link_shapes(*bodies[f"{fname}/{p['name']}"])}
+                              for p in f["phalanges"]]})
+        return {"name": self.side["name"], "description": self.side.get("description", ""),
+                "actuation": self.side["actuation"], "frame": "converted from a URDF: origin at the centre of the palm "
+                "face (the sidecar's palm frame); +z is the approach direction",
+                "palm": {"shapes": self._link_shapes(*bodies["palm"])}, "spread": spread,
+                "fingers": out_fingers, "measured_joints": measured}
