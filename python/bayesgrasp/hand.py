@@ -75,18 +75,6 @@ class ShapeGeometry:
     vertices: Optional[np.ndarray] = None
     faces: Optional[np.ndarray] = None
 
-    def mesh(self) -> tuple[np.ndarray, np.ndarray]:
-        """The shape as a triangle mesh (V, F) in the world frame, for drawing."""
-        from .viz import box_mesh, capsule_mesh
-
-        if self.type == "capsule":
-            return capsule_mesh(self.p0, self.p1, self.radius)
-        if self.type == "convex":
-            return self.vertices, self.faces
-        T = np.eye(4)
-        T[:3, :3], T[:3, 3] = self.rotation, self.center
-        return box_mesh(T, self.half_extents)
-
 
 class Hand:
     """A hand model (wraps :class:`bayesgrasp._core.hand.Hand`)."""

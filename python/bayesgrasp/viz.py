@@ -304,12 +304,24 @@ def plot_registrations(cloud: np.ndarray, models: Sequence, results: Sequence, p
     plt.close(fig)
 
 
+def shape_mesh(s) -> Tuple[np.ndarray, np.ndarray]:
+    """One hand shape (a :class:`~bayesgrasp.hand.ShapeGeometry`, world frame) as a triangle mesh
+    (V, F): a capsule or a box tessellated, a convex shape's own triangles."""
+    if s.type == "capsule":
+        return capsule_mesh(s.p0, s.p1, s.radius)
+    if s.type == "convex":
+        return np.asarray(s.vertices, float), np.asarray(s.faces)
+    T = np.eye(4)
+    T[:3, :3], T[:3, 3] = s.rotation, s.center
+    return box_mesh(T, s.half_extents)
+
+
 def hand_meshes(hand, joint_angles, hand_pose, color="tab:gray", alpha: float = 1.0) -> list:
     """A hand's collision shapes (a :class:`~bayesgrasp.hand.Hand` at joints and 4x4 pose) as
     ``(V, F, color, alpha)`` meshes for :func:`draw_meshes` / :func:`plot_scene`."""
     items = []
     for s in hand.link_geometry(joint_angles, hand_pose):
-        V, F = s.mesh()
+        V, F = shape_mesh(s)
         items.append((V, F, color, alpha))
     return items
 

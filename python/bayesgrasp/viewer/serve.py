@@ -19,6 +19,7 @@ from typing import Dict, List, Optional, Tuple
 import numpy as np
 
 from ..hand import Hand, builtin_hands
+from ..viz import shape_mesh
 from .scene import ResultScene, Step, planar_transform
 
 LAYERS = ("object", "hand", "pregrasp", "approach", "contacts", "models", "particles", "lift trace", "cloud")
@@ -55,7 +56,7 @@ def hand_link_meshes(hand: Hand, q, pose) -> List[Tuple[str, np.ndarray, np.ndar
     """The hand's collision shapes at joints ``q`` and 4x4 ``pose`` as (name, V, F) meshes."""
     out, count = [], {}
     for s in hand.link_geometry(np.asarray(q, float), np.asarray(pose, float)):
-        V, F = s.mesh()
+        V, F = shape_mesh(s)
         i = count[s.name] = count.get(s.name, -1) + 1
         out.append((f"{s.name.replace('/', '_')}-{i}", np.asarray(V, float), np.asarray(F, np.int32)))
     return out
