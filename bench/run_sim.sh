@@ -10,6 +10,9 @@
 #   4. bench_sim on the built-in mug (exported by world_export_mesh.py): approaches from random
 #      directions on the upper hemisphere (all, and those reaching the object) beside top grasps
 #      -> bench/results/bench_sim_approach.json.
+#   5. hands_urdf.py: top grasps/s with the BH8 and Robotiq 3F from their hand files and from
+#      their URDFs, and the parallel-jaw gripper (convex mesh jaws), on the built-in mug
+#      -> bench/results/hands_urdf.json.
 # Env: BUILD_DIR (holds bench_sim), BENCH_PY (pybullet), BAYESGRASP_PY (exports the built-in mug).
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -27,3 +30,4 @@ export OMP_NUM_THREADS=${OMP_NUM_THREADS:-1}
 "$BUILD_DIR/bench_sim" --mesh="$OUT/builtin_mug.obj" --grasps=256 --benchmark_filter='Approach/|TopGrasp/0$' \
   --benchmark_repetitions=5 --benchmark_report_aggregates_only=true \
   --benchmark_out="$OUT/bench_sim_approach.json" --benchmark_out_format=json
+"${BAYESGRASP_PY:-.venv/bin/python}" bench/hands_urdf.py --out "$OUT/hands_urdf.json"

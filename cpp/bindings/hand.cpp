@@ -68,6 +68,15 @@ void bind_shape(py::module_& m) {
 /// The joint vector, link poses, fingertips and collision shapes.
 void def_kinematics(py::class_<HandModel>& hand) {
   hand      .def_property_readonly("spread_default", &HandModel::spread_default, "Default spread (rad).")
+      .def_property_readonly(
+          "prismatic_joints",
+          [](const HandModel& h) {
+            std::vector<bool> out(static_cast<size_t>(h.num_joints()), false);
+            for (const Finger& f : h.fingers())
+              for (size_t p = 0; p < f.phalanges.size(); ++p) out[f.first_joint + p] = f.phalanges[p].prismatic;
+            return out;
+          },
+          "Per entry of q: whether it is a prismatic joint (a jaw's travel, m) rather than an angle (rad).")
       .def_property_readonly("measured_joints", [](const HandModel& h) { return h.measured_joints(); },
                              "Indices into q of the joints the fingers-read measurement uses (the file's measured_joints).")
       .def(

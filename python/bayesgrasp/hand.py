@@ -27,6 +27,10 @@ __all__ = ["Hand", "HANDS_DIR", "ShapeGeometry", "builtin_hands"]
 
 HANDS_DIR = Path(__file__).parent / "data" / "hands"
 
+#: m per rad: a jaw (prismatic finger) is driven and measured like a fingertip this far from a
+#: joint (cpp/bayesgrasp/physics/squeeze_model.hpp, kJawLever).
+JAW_LEVER = 0.05
+
 
 def builtin_hands() -> list[str]:
     """Names of the built-in hands: hand files by name (without ``.json``) and URDF hands by file
@@ -123,6 +127,18 @@ class Hand:
         """The hand-file text (JSON) the model was built from (for a URDF hand, its conversion):
         everything that shapes a result, for cache keys."""
         return self._text
+
+    @property
+    def prismatic_joints(self) -> np.ndarray:
+        """(J,) bool: the entries of q that are a jaw's travel (m) rather than an angle (rad)."""
+        return np.asarray(self.core.prismatic_joints, dtype=bool)
+
+    @property
+    def measurement_scale(self) -> np.ndarray:
+        """Per measured joint, the unit of "a radian" of measurement noise: 1 for an angle, and
+        for a jaw's travel the 5 cm lever its motor is modelled with (0.05 m; the lift test's
+        kJawLever)."""
+        return np.where(self.prismatic_joints[self.measured_joints], JAW_LEVER, 1.0)
 
     @property
     def measured_joints(self) -> np.ndarray:

@@ -10,7 +10,10 @@ format of ``barrett_bh8.json``), so a URDF hand runs through the same C++ model 
 What the conversion needs of the URDF (each is checked and refused in one line naming it):
 
 * every finger is a planar chain: its phalanx joints are revolute with parallel axes lying in
-  the palm plane; a positive angle closes the finger (turns it towards the approach axis);
+  the palm plane; a positive angle closes the finger (turns it towards the approach axis); or
+  it is a jaw: one prismatic joint in the palm plane that opens with a positive value (the
+  convention of two-finger grippers' URDFs); a mimic between two fingers' first joints (a
+  gripper's second jaw) is dropped: each finger closes on its own;
 * a finger's spread joint (if any) is a revolute joint about the approach axis between the palm
   and the finger's first phalanx joint: the sidecar's spread joint or a mimic of it;
 * every other link hangs from the palm or a phalanx by fixed joints (it joins that body);
@@ -61,6 +64,9 @@ def _load_sidecar(path: Path) -> dict:
     if errors:
         e = errors[0]
         where = ".".join(str(p) for p in e.absolute_path) or "top level"
+        keys = [s.get("required", [None])[0] for s in e.validator_value] if e.validator == "oneOf" else []
+        if keys and all(keys):   # a choice of keys: say which
+            raise HandFileError(f"{path}: {where}: needs exactly one of {', '.join(keys)}")
         raise HandFileError(f"{path}: {where}: {e.message}")
     return data
 
@@ -313,9 +319,14 @@ class _Converter:
     def _finger(self, fi: int, spec: dict, spread_joint, joint0: int) -> dict:
         w = f"fingers[{fi}]"
         joints = [self.tree.joint(p["joint"], f"{w}.phalanges[{k}].joint") for k, p in enumerate(spec["phalanges"])]
+        if joints[0].type == "prismatic":
+            return self._jaw(fi, spec, joints, joint0)
         for k, j in enumerate(joints):
             if j.type not in ("revolute", "continuous"):
-                self._fail(f"{w}.phalanges[{k}]: joint '{j.name}' is {j.type}; a finger's joints must be revolute")
+                self._fail(f"{w}.phalanges[{k}]: joint '{j.name}' is {j.type}; a finger's joints must be revolute "
+                           "(or one prismatic joint: a jaw)")
+            if "torque_nm" not in spec["phalanges"][k]:
+                self._fail(f"{w}.phalanges[{k}]: a revolute joint's motor is given as torque_nm")
         # the chain from the palm to the first joint: fixed joints and at most a spread joint
         above = self.tree.chain(joints[0].parent)
         spread_here = [j for j in above if j.type != "fixed"]
@@ -400,7 +411,7 @@ class _Converter:
             frame = np.eye(4)
             frame[:3, 0], frame[:3, 1], frame[:3, 2], frame[:3, 3] = x, a, np.cross(x, a), pos[k]
             frames.append(frame)
-            phalanges.append({"name": p["name"], "length": length, "lower_deg": math.degrees(lo),
+            phalanges.append({"name": p["name"], "joint": "revolute", "length": length, "lower_deg": math.degrees(lo),
                               "upper_deg": math.degrees(hi), "offset_deg": math.degrees(offset), "ratio": ratio,
                               "torque_nm": float(p["torque_nm"]), "link": j.child})
         knuckle_frame = np.eye(4)
@@ -408,6 +419,41 @@ class _Converter:
         return {"spec": spec, "joints": joints, "base": base, "base_yaw": base_yaw, "spread_sign": spread_sign,
                 "knuckle": max(knuckle, 0.0), "knuckle_frame": knuckle_frame, "phalanges": phalanges, "frames": frames,
                 "spread_joint": spread_here[0] if spread_here else None, "first_q": joint0}
+
+    def _jaw(self, fi: int, spec: dict, joints: list, joint0: int) -> dict:
+        """A parallel jaw: one prismatic joint whose positive direction opens the finger (the URDF
+        convention of two-finger grippers), in the palm plane; its link points along the approach."""
+        w = f"fingers[{fi}]"
+        if len(joints) != 1:
+            self._fail(f"{w}: a prismatic joint must be its finger's only phalanx (a jaw)")
+        j, p = joints[0], spec["phalanges"][0]
+        if "force_n" not in p:
+            self._fail(f"{w}.phalanges[0]: a prismatic joint's motor is given as force_n")
+        if j.limit is None:
+            self._fail(f"{w}.phalanges[0]: joint '{j.name}' needs limits")
+        z = np.array([0.0, 0.0, 1.0])
+        T0 = self._in_hand(self.tree.zero_pose(j.child))
+        d = _unit(T0[:3, :3] @ np.asarray(j.axis if j.axis is not None else (1, 0, 0), dtype=float))
+        if abs(d @ z) > _TOL:
+            self._fail(f"{w}: joint '{j.name}' does not slide in the palm plane (its axis's z in the hand frame is {d @ z:.3g})")
+        for above in self.tree.chain(j.parent):
+            if above.type != "fixed" and above not in self.tree.chain(self.side["palm"]["link"]):
+                self._fail(f"{w}: joint '{above.name}' moves the jaw's base; a jaw hangs from the palm by fixed joints")
+        pos = T0[:3, 3]
+        tip = _transform(T0, np.asarray(spec["fingertip"], dtype=float)[None])[0]
+        length = float((tip - pos) @ z)
+        if length <= 1e-9:
+            self._fail(f"{w}: the fingertip is not beyond the jaw's joint along the approach")
+        lo, hi = float(j.limit.lower), float(j.limit.upper)
+        # our travel inwards q = upper - q_urdf; at the URDF's zero the joint sits at pos
+        a = np.cross(d, z)
+        frame = np.eye(4)
+        frame[:3, 0], frame[:3, 1], frame[:3, 2], frame[:3, 3] = z, a, d, pos
+        phalanx = {"name": p["name"], "joint": "prismatic", "length": length, "lower_m": 0.0, "upper_m": hi - lo,
+                   "offset_m": 0.0, "ratio": 1.0, "force_n": float(p["force_n"]), "link": j.child}
+        return {"spec": spec, "joints": joints, "base": pos, "base_yaw": math.degrees(math.atan2(d[1], d[0])),
+                "spread_sign": 0.0, "knuckle": hi, "knuckle_frame": None, "phalanges": [phalanx], "frames": [frame],
+                "spread_joint": None, "first_q": joint0}
 
     # -- which URDF links make each of our links --
     def _bodies(self, fingers: list) -> dict:

@@ -94,7 +94,7 @@ def test_copied_urdf_hand_loads(tmp_path):
 @pytest.mark.parametrize("side_edit, urdf_edit, message", [
     (lambda s: s.pop("palm"), None, r"hand\.hand\.json: top level: 'palm' is a required property"),
     (lambda s: s.update(stiffness=3), None, r"Additional properties are not allowed \('stiffness'"),
-    (lambda s: s["fingers"][0]["phalanges"][0].pop("torque_nm"), None, r"fingers\.0\.phalanges\.0: 'torque_nm' is a required"),
+    (lambda s: s["fingers"][0]["phalanges"][0].pop("torque_nm"), None, r"fingers\.0\.phalanges\.0: needs exactly one of torque_nm, force_n"),
     (lambda s: s["fingers"][1]["phalanges"][1].update(joint="bh_j99"), None,
      r"fingers\[1\]\.phalanges\[1\]\.joint names joint 'bh_j99', which the URDF does not have"),
     (lambda s: s["spread"].update(joint="nope"), None, r"spread\.joint names joint 'nope'"),

@@ -153,21 +153,36 @@ std::vector<Shape> shapes(const json& j, const std::string& where) {
   return out;
 }
 
-/// One phalanx of a finger from its JSON object (`where` names it in errors).
+/// One phalanx of a finger from its JSON object (`where` names it in errors). A revolute joint's
+/// limits and offset are in degrees and its motor's strength a torque (N m); a prismatic
+/// joint's in metres and a force (N).
 Phalanx parse_phalanx(const json& j, size_t p, const std::string& where) {
-  exactly(j, {"name", "length", "lower_deg", "upper_deg", "offset_deg", "ratio", "torque_nm", "shapes"}, where);
+  const json& kind = need(j, "joint", where);
   Phalanx phalanx;
+  double unit = kDeg;
+  const char* effort = "torque_nm";
+  if (kind == "revolute") {
+    exactly(j, {"name", "joint", "length", "lower_deg", "upper_deg", "offset_deg", "ratio", "torque_nm", "shapes"}, where);
+  } else if (kind == "prismatic") {
+    exactly(j, {"name", "joint", "length", "lower_m", "upper_m", "offset_m", "ratio", "force_n", "shapes"}, where);
+    phalanx.prismatic = true;
+    unit = 1.0;
+    effort = "force_n";
+  } else {
+    fail(where, "'joint' must be 'revolute' or 'prismatic'");
+  }
+  const bool m = phalanx.prismatic;
   phalanx.name = text(j, "name", where);
   phalanx.length = number(j, "length", where);
   if (!(phalanx.length > 0)) fail(where, "length must be positive");
-  phalanx.lower = number(j, "lower_deg", where) * kDeg;
-  phalanx.upper = number(j, "upper_deg", where) * kDeg;
-  if (phalanx.lower > phalanx.upper) fail(where, "lower_deg > upper_deg");
-  phalanx.offset = number(j, "offset_deg", where) * kDeg;
+  phalanx.lower = number(j, m ? "lower_m" : "lower_deg", where) * unit;
+  phalanx.upper = number(j, m ? "upper_m" : "upper_deg", where) * unit;
+  if (phalanx.lower > phalanx.upper) fail(where, m ? "lower_m > upper_m" : "lower_deg > upper_deg");
+  phalanx.offset = number(j, m ? "offset_m" : "offset_deg", where) * unit;
   phalanx.ratio = number(j, "ratio", where);
   if (phalanx.ratio < 0) fail(where, "ratio must be >= 0");
-  phalanx.torque = number(j, "torque_nm", where);
-  if (!(phalanx.torque >= 0) || !std::isfinite(phalanx.torque)) fail(where, "torque_nm must be >= 0 and finite");
+  phalanx.torque = number(j, effort, where);
+  if (!(phalanx.torque >= 0) || !std::isfinite(phalanx.torque)) fail(where, std::string(effort) + " must be >= 0 and finite");
   phalanx.shapes = shapes(j, where);
   return phalanx;
 }
@@ -287,6 +302,9 @@ HandModel HandModel::from_json(const std::string& json_text) {
       finger.phalanges.push_back(phalanx);
       ++joint;
     }
+    for (const Phalanx& p : finger.phalanges)
+      if (p.prismatic && finger.phalanges.size() != 1)
+        fail(w, "a prismatic phalanx must be its finger's only phalanx (a jaw)");
     h.fingers_.push_back(finger);
   }
   h.num_joints_ = joint;
@@ -363,6 +381,12 @@ void HandModel::phalanx_poses(const Iso3& hand_pose, int f, double spread, const
   double theta = 0.0;  // cumulative phalanx angle
   Iso3 local = Iso3::Identity();
   for (int p = 0; p < n; ++p) {
+    if (finger.phalanges[p].prismatic) {  // a jaw: along the approach, moved inwards by its travel
+      local.linear() = link_rotation(d, M_PI / 2);
+      local.translation() = joint - angles[p] * d;
+      out[p] = hand_pose * local;
+      continue;
+    }
     theta += angles[p];
     local.linear() = link_rotation(d, theta);
     local.translation() = joint;

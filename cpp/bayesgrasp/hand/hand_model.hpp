@@ -23,6 +23,9 @@
 // stopped by a contact, phalanges 0..k freeze, and phalanges after k keep closing; a phalanx
 // that reaches its upper limit stops alone. The finger is done when every phalanx is frozen
 // or at its limit.
+//
+// Parallel jaws. A finger whose only phalanx is prismatic translates along -d_f (inwards) by
+// q metres instead of turning (Phalanx::prismatic).
 #pragma once
 
 #include <array>
@@ -56,9 +59,14 @@ struct Shape {
 struct Phalanx {
   std::string name;
   double length = 0.0;  // joint to next joint / fingertip (m)
-  double lower = 0.0, upper = 0.0;  // joint limits (rad)
+  double lower = 0.0, upper = 0.0;  // joint limits (rad; m for a prismatic joint)
   double offset = 0.0, ratio = 1.0; // coupling: q(t) = offset + ratio * t
-  double torque = 0.0;  // N m: the finger motor's torque limit at this joint while it drives it (0: not given)
+  double torque = 0.0;  // N m (N for a prismatic joint): the finger motor's limit at this joint while it drives it
+  // A prismatic phalanx (a parallel jaw, its finger's only phalanx): its link points along the
+  // approach (the revolute frame at Theta = 90 deg: x = +z_hand, local +z = d_f outwards, the
+  // grasping face local -z) and its joint value is the travel inwards from the knuckle's end:
+  // origin = b_f + (knuckle_length - q) d_f.
+  bool prismatic = false;
   std::vector<Shape> shapes;
   int link = -1;  // index into HandModel::links
 };

@@ -7,14 +7,16 @@ namespace bayesgrasp::physics {
 
 // Up to two velocity rows along one joint axis (A's local `axis`, world = A's basis x axis):
 //     w_A . axis - gain w_B . axis = rhs_i,  lambda_i in [lo_i, hi_i]
-// (the constraint's world axis is recomputed each step). Set by HandBodies::apply.
+// (the constraint's world axis is recomputed each step). Set by HandBodies::apply. A `linear`
+// row is the same on the bodies' linear velocities (a prismatic joint; the parent B does not
+// rotate in the lift script, so its velocity at A's centre is its own).
 class AngularRow : public btTypedConstraint {
  public:
   struct Row {
     btScalar rhs, lo, hi;
   };
-  AngularRow(btRigidBody& a, btRigidBody& b, const btVector3& axis)
-      : btTypedConstraint(D6_CONSTRAINT_TYPE, a, b), axis_(axis) {}
+  AngularRow(btRigidBody& a, btRigidBody& b, const btVector3& axis, bool linear = false)
+      : btTypedConstraint(D6_CONSTRAINT_TYPE, a, b), axis_(axis), linear_(linear) {}
   void set(btScalar gain, std::initializer_list<Row> rows) {
     gain_ = gain;
     n_ = 0;
@@ -30,8 +32,8 @@ class AngularRow : public btTypedConstraint {
     for (int i = 0; i < n_; ++i) {
       const int s = i * info->rowskip;
       for (int k = 0; k < 3; ++k) {
-        info->m_J1angularAxis[s + k] = ax[k];
-        info->m_J2angularAxis[s + k] = -gain_ * ax[k];
+        (linear_ ? info->m_J1linearAxis : info->m_J1angularAxis)[s + k] = ax[k];
+        (linear_ ? info->m_J2linearAxis : info->m_J2angularAxis)[s + k] = -gain_ * ax[k];
       }
       info->m_constraintError[s] = rows_[i].rhs;
       info->m_lowerLimit[s] = rows_[i].lo;
@@ -43,6 +45,7 @@ class AngularRow : public btTypedConstraint {
 
  private:
   btVector3 axis_;
+  bool linear_ = false;
   btScalar gain_ = 1;
   Row rows_[2];
   int n_ = 0;
@@ -110,6 +113,9 @@ HandBodies add_hand(BulletWorld& w, const HandModel& hand, const Iso3& hand_pose
   hb.joint_link.assign(nj, -1);
   hb.joint_parent.assign(nj, 0);
   hb.hinge.assign(nj, nullptr);
+  hb.slider.assign(nj, nullptr);
+  hb.slide_origin.assign(nj, Vec3::Zero());
+  hb.slide_axis.assign(nj, Vec3::Zero());
   hb.limit_row.assign(nj, nullptr);
   hb.coupling_row.assign(nj, {});
   hb.q0 = joints;
@@ -136,16 +142,35 @@ HandBodies add_hand(BulletWorld& w, const HandModel& hand, const Iso3& hand_pose
                                      kObject, o.mu);
       body->setUserIndex(ph.link);
       btRigidBody* parent = hb.link_body[parent_link];
-      auto* hinge = new btHingeConstraint(*parent, *body, to_bt(Iso3(parent_pose.inverse() * pose * z_to_y)),
-                                          to_bt(z_to_y), false);
-      hinge->setLimit(1, -1);  // free: the limits are the limit row's
-      w.add_constraint(hinge);
-      auto* limit = new AngularRow(*body, *parent, btVector3(0, 1, 0));
+      AngularRow* limit = nullptr;
+      if (ph.prismatic) {
+        // A jaw: Bullet's slider along its frame's x = the link's +z (d_f, outwards), no turning.
+        Iso3 z_to_x = Iso3::Identity();
+        z_to_x.linear() = Eigen::AngleAxisd(-M_PI / 2, Vec3::UnitY()).toRotationMatrix();
+        auto* slider = new btSliderConstraint(*parent, *body, to_bt(Iso3(parent_pose.inverse() * pose * z_to_x)),
+                                              to_bt(z_to_x), true);
+        slider->setLowerLinLimit(1);  // free: the limits are the limit row's
+        slider->setUpperLinLimit(-1);
+        slider->setLowerAngLimit(0);
+        slider->setUpperAngLimit(0);
+        w.add_constraint(slider);
+        limit = new AngularRow(*body, *parent, btVector3(0, 0, -1), true);  // along -d_f: closing
+        hb.slider[k] = slider;
+        const Iso3 inv = parent_pose.inverse();
+        hb.slide_origin[k] = inv * pose.translation();
+        hb.slide_axis[k] = -(inv.linear() * pose.linear().col(2));
+      } else {
+        auto* hinge = new btHingeConstraint(*parent, *body, to_bt(Iso3(parent_pose.inverse() * pose * z_to_y)),
+                                            to_bt(z_to_y), false);
+        hinge->setLimit(1, -1);  // free: the limits are the limit row's
+        w.add_constraint(hinge);
+        limit = new AngularRow(*body, *parent, btVector3(0, 1, 0));
+        hb.hinge[k] = hinge;
+      }
       w.add_constraint(limit);
       hb.link_body[ph.link] = body;
       hb.joint_link[k] = ph.link;
       hb.joint_parent[k] = parent_link;
-      hb.hinge[k] = hinge;
       hb.limit_row[k] = limit;
       parent_link = ph.link;
       parent_pose = pose;
@@ -166,14 +191,27 @@ HandBodies add_hand(BulletWorld& w, const HandModel& hand, const Iso3& hand_pose
 
 Eigen::VectorXd HandBodies::angles() const {
   Eigen::VectorXd q = q0;
-  for (size_t k = 0; k < hinge.size(); ++k)
+  for (size_t k = 0; k < hinge.size(); ++k) {
     if (hinge[k]) q[k] = q0[k] + hinge[k]->getHingeAngle();
+    if (slider[k]) {  // travel inwards since the start, from the bodies' poses
+      const Iso3 P = from_bt(link_body[joint_parent[k]]->getWorldTransform());
+      const Vec3 c = from_bt(link_body[joint_link[k]]->getWorldTransform().getOrigin());
+      q[k] = q0[k] + (c - P * slide_origin[k]).dot(P.linear() * slide_axis[k]);
+    }
+  }
   return q;
 }
 
 Eigen::VectorXd HandBodies::velocities() const {
   Eigen::VectorXd v = Eigen::VectorXd::Zero(q0.size());
   for (size_t k = 0; k < hinge.size(); ++k) {
+    if (slider[k]) {
+      const btRigidBody* c = link_body[joint_link[k]];
+      const btRigidBody* p = link_body[joint_parent[k]];
+      const Vec3 axis = from_bt(p->getWorldTransform()).linear() * slide_axis[k];
+      v[k] = eig(c->getLinearVelocity() - p->getLinearVelocity()).dot(axis) / kUnit;
+      continue;
+    }
     if (!hinge[k]) continue;
     const btRigidBody* c = link_body[joint_link[k]];
     const btRigidBody* p = link_body[joint_parent[k]];
@@ -189,16 +227,27 @@ void HandBodies::apply(const HandModel& hand, const SqueezeModel& model, const E
   const btScalar fps = btScalar(1.0 / time_step), inf = SIMD_INFINITY;
   const auto& cmd = model.commands();
   for (size_t k = 0; k < hinge.size(); ++k) {
-    if (!hinge[k]) continue;
+    if (!hinge[k] && !slider[k]) continue;
     const JointCommand& c = cmd[k];
-    // Motor: the finger's, on its driven joint only (torque in Bullet units, x kUnit^2).
-    hinge[k]->enableAngularMotor(c.driven, btScalar(c.velocity),
-                                 btScalar(c.max_torque * kUnit * kUnit * time_step));
+    double unit = 1.0;  // rows in rad/s, or for a jaw in Bullet lengths per second
+    if (slider[k]) {
+      // Motor: along the slider's x (outwards), so closing is negative; force x kUnit.
+      slider[k]->setPoweredLinMotor(c.driven);
+      slider[k]->setTargetLinMotorVelocity(btScalar(-c.velocity * kUnit));
+      slider[k]->setMaxLinMotorForce(btScalar(c.max_torque * kUnit));
+      unit = kUnit;
+    } else {
+      // Motor: the finger's, on its driven joint only (torque in Bullet units, x kUnit^2).
+      hinge[k]->enableAngularMotor(c.driven, btScalar(c.velocity),
+                                   btScalar(c.max_torque * kUnit * kUnit * time_step));
+    }
     // Limits as speculative rows: the joint may move up to its limit in this step, and is
     // pushed back (kErp of the error) once past it.
-    auto target = [&](double limit, bool past) { return btScalar(fps * (limit - q[k]) * (past ? kErp : 1.0)); };
+    auto target = [&](double limit, bool past) {
+      return btScalar(unit * fps * (limit - q[k]) * (past ? kErp : 1.0));
+    };
     if (c.upper - c.lower < 1e-9) {
-      limit_row[k]->set(1, {{btScalar(kErp) * fps * btScalar(c.lower - q[k]), -inf, inf}});
+      limit_row[k]->set(1, {{btScalar(unit * kErp * fps * (c.lower - q[k])), -inf, inf}});
     } else {
       limit_row[k]->set(1, {{target(c.lower, q[k] < c.lower), 0, inf}, {target(c.upper, q[k] > c.upper), -inf, 0}});
     }

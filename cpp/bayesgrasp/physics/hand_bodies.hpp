@@ -1,5 +1,6 @@
 // The hand in the lift test's Bullet world: a kinematic palm (palm and knuckle shapes: the
-// spread is frozen) and, per phalanx, a dynamic body hinged to its parent at its joint. The
+// spread is frozen) and, per phalanx, a dynamic body hinged to its parent at its joint (a jaw,
+// a prismatic phalanx: on a slider, its motor a force). The
 // hinge carries the finger motor when the squeeze model drives that joint; two one-row
 // constraints per joint carry the rest of the model (squeeze_model.hpp): the joint's limits
 // (the worm lock below, the hand file's limit above, or locked) and, while coupled, the
@@ -23,7 +24,10 @@ struct HandBodies {
   std::vector<btRigidBody*> link_body;     // per HandModel link: its body (the palm for palm and knuckles)
   std::vector<int> joint_link;             // per joint: the phalanx's link (-1 for the spread)
   std::vector<int> joint_parent;           // per joint: the parent link (0 = palm)
-  std::vector<btHingeConstraint*> hinge;   // per joint
+  std::vector<btHingeConstraint*> hinge;   // per revolute joint (else null)
+  std::vector<btSliderConstraint*> slider; // per prismatic joint, a jaw (else null)
+  std::vector<Vec3> slide_origin;          // per prismatic joint: the jaw's start in its parent's frame
+  std::vector<Vec3> slide_axis;            // ... and its closing direction (-d_f) there
   std::vector<AngularRow*> limit_row;      // per joint: limits (worm lock, upper, locked)
   std::vector<std::vector<AngularRow*>> coupling_row;  // per joint j: (S1) to phalanx a < j of its finger
   Eigen::VectorXd q0;                      // the closed grasp (hinge angle 0)

@@ -60,7 +60,7 @@ bool SqueezeModel::update(const Eigen::VectorXd& q, const Eigen::VectorXd& qdot,
     if (a + 1 >= static_cast<int>(fi.phalanges.size())) continue;  // the last phalanx stays driven
     const int ja = fi.first_joint + a;
     // Stopped by the object: touching it and (nearly) still for kStallTime.
-    const bool slow = qdot[ja] < kStallFraction * speed_;
+    const bool slow = qdot[ja] < kStallFraction * speed_ * (fi.phalanges[a].prismatic ? kJawLever : 1.0);
     stall_[f] = slow && link_touches[fi.phalanges[a].link] ? stall_[f] + 1 : 0;
     if (stall_[f] >= stall_steps_ || at_upper(static_cast<int>(f), a, q)) {
       driven_[f] = a + 1;  // breakaway: lock phalanx a, drive the next one
@@ -82,15 +82,16 @@ void SqueezeModel::set_commands() {
       JointCommand& c = cmd_[k];
       c = JointCommand{};
       c.upper = ph.upper;
+      const double lever = ph.prismatic ? kJawLever : 1.0;  // a jaw's metres per radian
       // The worm: never opens by more than its backlash below the largest angle reached.
-      c.lower = std::max(ph.lower, std::min(reached_[k], ph.upper) - backlash_);
+      c.lower = std::max(ph.lower, std::min(reached_[k], ph.upper) - lever * backlash_);
       if (j < a) {
         // Locked by the breakaway where it was (the largest angle reached).
         c.upper = std::min(reached_[k], ph.upper);
       } else if (j == a) {
         c.driven = true;
-        c.velocity = speed_;
-        c.max_torque = torque_ > 0 ? torque_ : ph.torque;  // the override, else the hand file's
+        c.velocity = lever * speed_;
+        c.max_torque = torque_ > 0 ? torque_ / lever : ph.torque;  // the override, else the hand file's
       } else {
         // Coupled: the transmission holds it to the driven joint, whose worm holds both; its
         // own limits are the hand file's.

@@ -40,7 +40,13 @@
 
 namespace bayesgrasp::physics {
 
-/// One joint's command for the next step (joint angles in HandModel layout, closing > 0).
+/// A parallel jaw (a prismatic phalanx) is driven like a fingertip this far from a joint: its
+/// speed is closing_speed x kJawLever (m/s), its backlash backlash x kJawLever (m), and a
+/// finger_torque override of tau N m presses it with tau / kJawLever N.
+constexpr double kJawLever = 0.05;
+
+/// One joint's command for the next step (joint angles in HandModel layout, closing > 0;
+/// metres, m/s and N for a prismatic joint).
 struct JointCommand {
   bool driven = false;     // the finger's motor drives this joint
   double velocity = 0.0;   // rad/s, the motor's target (driven joints)

@@ -96,8 +96,11 @@ class FingerCloser {
   /// Velocity per unit of t of point p (world) of phalanx j's link.
   Vec3 velocity(int j, const Vec3& p) const {
     Vec3 v = Vec3::Zero();
-    for (int i = first_; i <= j; ++i)
-      if (moving_[i]) v += F_.phalanges[i].ratio * T_[i].linear().col(1).cross(p - T_[i].translation());
+    for (int i = first_; i <= j; ++i) {
+      if (!moving_[i]) continue;
+      if (F_.phalanges[i].prismatic) v -= F_.phalanges[i].ratio * T_[i].linear().col(2);  // inwards, -d_f
+      else v += F_.phalanges[i].ratio * T_[i].linear().col(1).cross(p - T_[i].translation());
+    }
     return v;
   }
 

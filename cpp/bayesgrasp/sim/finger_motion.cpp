@@ -18,10 +18,13 @@ std::vector<FingerMotion> make_finger_motion(const HandModel& hand, const LinkSh
     for (int i = 0; i < n; ++i) {
       double along = 0.0;
       for (int j = i; j < n; ++j) {
-        m.arm[i][j] = along + link_reach(links[F.phalanges[j].link]);
+        // a prismatic joint moves every point of its link by exactly its travel
+        m.arm[i][j] = F.phalanges[i].prismatic ? 1.0 : along + link_reach(links[F.phalanges[j].link]);
         along += F.phalanges[j].length;
       }
-      m.reach = std::max(m.reach, m.arm[0][i]);
+      m.reach = std::max(m.reach, F.phalanges[i].prismatic
+                                      ? link_reach(links[F.phalanges[i].link]) + F.phalanges[i].upper - F.phalanges[i].lower
+                                      : m.arm[0][i]);
     }
   }
   return out;

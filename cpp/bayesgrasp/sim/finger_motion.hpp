@@ -5,7 +5,9 @@
 // moves at most ratio_i * r per unit of t, so link j moves at most
 //   v_j = sum over the moving joints i <= j of ratio_i * arm[i][j],
 // with arm[i][j] the largest distance of link j's points from joint i's axis: the length of
-// the chain from joint i to joint j plus link j's reach about its own joint.
+// the chain from joint i to joint j plus link j's reach about its own joint. A prismatic joint
+// (a jaw, its finger's only phalanx) moves every point of its link at ratio per unit of t:
+// arm = 1.
 #pragma once
 
 #include <vector>

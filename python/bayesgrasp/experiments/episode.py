@@ -87,10 +87,11 @@ def execute(world: World, models: GraspModels, action: np.ndarray, true_pose: np
 
 
 def read_fingers(execution: Execution, models: GraspModels, noise: float, rng: np.random.Generator) -> np.ndarray:
-    """The measurement M: the modelled joint angles, plus Gaussian noise of std ``noise`` rad."""
+    """The measurement M: the modelled joint angles, plus Gaussian noise of std ``noise`` rad (a
+    jaw's travel: ``noise`` x 0.05 m, the models' measurement_scale)."""
     q = execution.joint_angles[models.joint_index]
     if noise > 0:
-        q = q + rng.normal(0.0, noise, q.shape)
+        q = q + rng.normal(0.0, noise, q.shape) * np.asarray(models.info["measurement_scale"], dtype=float)
     return q
 
 

@@ -145,7 +145,7 @@ def _train(world: World, settings: ModelSettings, key: str, say: Say) -> GraspMo
                    "force_closure_fraction": float(np.mean(eps > 0)),
                    "stable_fraction": float(np.mean(eps > settings.eps_stable)),
                    "success_fraction": float(np.mean(outcomes)),
-                   "joint_index": joint_index.tolist(), "spread": float(spread), "spread_pilot": pilot,
+                   "joint_index": joint_index.tolist(), "measurement_scale": world.hand.measurement_scale.tolist(), "spread": float(spread), "spread_pilot": pilot,
                    "grasp_box": settings.grasp_box(world.object).tolist(), "variant": variant.as_dict()}
     return models
 

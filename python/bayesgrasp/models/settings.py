@@ -8,7 +8,7 @@ from typing import Optional
 import numpy as np
 
 #: Bumped when the simulator or the models change what a cache key means.
-CACHE_VERSION = 10  # 10: the lift test at the hand's strength (issue 30)
+CACHE_VERSION = 11  # 11: measured joints and their measurement scale from the hand file (issue 31); 10: the lift test at the hand's strength (issue 30)
 
 #: What a successful grasp is: held in the lift test (the default) or epsilon above eps_stable.
 SUCCESS_CRITERIA = ("lift", "epsilon")

@@ -125,6 +125,22 @@ def _rule_ok(batch, rule: TaskRule) -> np.ndarray:
     return ok
 
 
+def every_finger_touches(batch, hand) -> np.ndarray:
+    """Per grasp of a world batch: every finger has a link on the object (table contacts left
+    out). A parallel jaw's two point contacts never make force closure in the point-contact
+    model (nothing resists turning about the line through them), so for a gripper with jaws
+    this replaces epsilon > 0 as the candidate filter; the lift test then decides."""
+    off = np.asarray(batch.contacts.offsets)
+    link = np.asarray(batch.contacts.link)
+    on_table = np.asarray(batch.contacts.on_table, bool)
+    fingers = [set(int(l) for l in links) for links in hand.phalanx_links]
+    out = np.zeros(len(off) - 1, bool)
+    for i in range(len(out)):
+        touched = {int(l) for l, t in zip(link[off[i]:off[i + 1]], on_table[off[i]:off[i + 1]]) if not t}
+        out[i] = all(f & touched for f in fingers)
+    return out
+
+
 def generate_task_grasps(obj: Union[str, ObjectModel], rule: TaskRule, hand: str = "barrett_bh8",
                          settings: Optional[TaskGraspSettings] = None, say: Optional[Say] = None) -> List[TaskGrasp]:
     """The demonstrated grasps of one model for one task (see the module docstring)."""
@@ -134,12 +150,14 @@ def generate_task_grasps(obj: Union[str, ObjectModel], rule: TaskRule, hand: str
     world = World.single(o, pose=(0.0, 0.0, 0.0), hand=hand, table=rule.table)
     rng = np.random.default_rng([s.seed, zlib.crc32(f"{o.name}/{rule.name}".encode())])
     found = []   # (epsilon, spread, pose) of grasps that satisfy the rule
+    jaws = bool(world.hand.prismatic_joints.any())
     for spread in s.spreads:
         d = sample_directions(rule, s.candidates, rng)
         t = sample_targets(o, rule.targets, s.candidates, rng)
         roll = sample_rolls(world.hand, d, rng)
         b = world.approach_batch(d, t, roll, spread=spread, standoff=s.standoff)
-        ok = _rule_ok(b, rule) & (np.asarray(b.epsilon) > 0)
+        held = every_finger_touches(b, world.hand) if jaws else np.asarray(b.epsilon) > 0
+        ok = _rule_ok(b, rule) & held
         found += [(float(b.epsilon[i]), float(spread), np.asarray(b.hand_pose_object[i])) for i in np.flatnonzero(ok)]
     found.sort(key=lambda x: -x[0])
     tested = found[:s.lift_tests]

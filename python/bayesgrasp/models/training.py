@@ -69,10 +69,19 @@ def success_labels(world: World, settings: ModelSettings, rel: np.ndarray, eps: 
     return np.asarray(eps) > settings.eps_stable
 
 
+def hand_spreads(world: World, candidates) -> tuple:
+    """The candidate spreads the hand can take (within its spread limits); its default spread
+    when none can (a hand without a spread, a gripper's [0, 0])."""
+    lo, hi = world.hand.spread_limits
+    inside = tuple(sp for sp in candidates if lo - 1e-12 <= sp <= hi + 1e-12)
+    return inside or (float(world.hand.core.spread_default),)
+
+
 def choose_spread(world: World, settings: ModelSettings, say=lambda m: None) -> tuple:
     """The top family's pilot (ModelSettings.spread = None): :func:`choose_variant` over the
-    spreads in AUTO_SPREADS. Returns (best spread, {degrees: (fraction, lifted, tested)})."""
-    variants = [Variant("top", sp) for sp in AUTO_SPREADS]
+    spreads in AUTO_SPREADS the hand can take. Returns (best spread, {degrees: (fraction,
+    lifted, tested)})."""
+    variants = [Variant("top", sp) for sp in hand_spreads(world, AUTO_SPREADS)]
     best, table = choose_variant(world, settings, variants, say)
     return best.spread, {round(float(np.degrees(v.spread))): row for v, row in zip(variants, table)}
 
@@ -81,7 +90,7 @@ def side_variants(world: World, settings: ModelSettings) -> list:
     """The side family's pilot candidates: SIDE_SPREADS (or the settings' spread) x
     SIDE_HEIGHT_FRACTIONS of the object's height x SIDE_ROLLS."""
     top = float(np.asarray(world.object.bounds, dtype=float)[1, 2])
-    spreads = SIDE_SPREADS if settings.spread is None else (settings.spread,)
+    spreads = hand_spreads(world, SIDE_SPREADS) if settings.spread is None else (settings.spread,)
     return [Variant("side", sp, round(f * top, 4), r) for sp in spreads for f in SIDE_HEIGHT_FRACTIONS
             for r in SIDE_ROLLS]
 
