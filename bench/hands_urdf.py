@@ -1,7 +1,8 @@
 """Top grasps per second with hands from URDF (issue 31), one core: the BH8 from its hand file and
 from its URDF + sidecar (the same model after conversion), and the parallel-jaw gripper (prismatic
 jaws, convex mesh fingers), on the built-in mug (2,322 triangles), the same grasp set for every
-hand. Also the Robotiq 3F both ways. Medians of repeated batches, ratios in the same run.
+hand. Also the Robotiq 3F both ways, and the jaw with the hand offset along its pads' width
+about the mug's axis (0, 5, 15, 30 mm). Medians of repeated batches, ratios in the same run.
 
     OMP_NUM_THREADS=1 python bench/hands_urdf.py [--grasps 256] [--repeats 7] [--out bench/results/hands_urdf.json]
 """
@@ -57,6 +58,15 @@ def main(argv=None) -> int:
         out["hands"][key] = r
         print(f"{key:18s} {r['grasps_per_s']:8.0f} grasps/s  {r['queries_per_grasp']:5.1f} queries/grasp  "
               f"{r['grasps_touching']}/{a.grasps} touch", file=sys.stderr)
+    # the jaw with the hand offset along its pads' width about the mug's axis (where its time goes)
+    jaw = Hand.load(HANDS["parallel_jaw_urdf"])
+    yaw = rng.uniform(-np.pi, np.pi, a.grasps)
+    out["parallel_jaw_offsets"] = {}
+    for off in (0.0, 0.005, 0.015, 0.03):
+        r = rate(jaw, mug, np.c_[off * np.cos(yaw), off * np.sin(yaw), yaw], a.repeats)
+        out["parallel_jaw_offsets"][f"{off * 1000:.0f}mm"] = r
+        print(f"jaw offset {off * 1000:4.0f} mm  {r['grasps_per_s']:8.0f} grasps/s  {r['queries_per_grasp']:6.1f} queries/grasp",
+              file=sys.stderr)
     h = out["hands"]
     out["ratio_bh8_urdf_to_json"] = h["bh8_urdf"]["grasps_per_s"] / h["bh8_json"]["grasps_per_s"]
     out["ratio_robotiq_urdf_to_json"] = h["robotiq_urdf"]["grasps_per_s"] / h["robotiq_json"]["grasps_per_s"]
