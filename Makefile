@@ -15,7 +15,7 @@ DEB_PACKAGES := build-essential cmake pkg-config python3-dev python3-venv \
 SOURCES := $(shell find cpp python tests/cpp bench -type f \( -name '*.cpp' -o -name '*.hpp' -o -name '*.h' -o -name '*.py' -o -name '*.json' \) 2>/dev/null) \
            CMakeLists.txt pyproject.toml
 
-.PHONY: all demo test bench deps clean distclean ctest pytest fuzz
+.PHONY: all demo test bench deps clean distclean ctest pytest fuzz sanitize
 all: $(VENV)/.installed
 
 # ---- system packages -------------------------------------------------------------------
@@ -77,3 +77,8 @@ clean:
 	rm -rf build/py out
 distclean:
 	rm -rf build $(VENV) $(BENCH_VENV)
+
+# The core, bindings and C++ tests under ASan + UBSan in build/asan (kept between runs), then a
+# fast Python subset on the sanitized module (tests/sanitize/run.sh; the README gives its time).
+sanitize: $(VENV)/.installed
+	JOBS=$(JOBS) bash tests/sanitize/run.sh
