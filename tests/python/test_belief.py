@@ -184,3 +184,91 @@ def test_absolute_planar_pose_inverts_relative_planar_pose_both_ways():
         again = belief.relative_planar_pose(world[:, j], P[j])
         np.testing.assert_allclose(again[:, :2], A[:, :2], atol=1e-12)
         np.testing.assert_allclose(np.angle(np.exp(1j * (again[:, 2] - A[:, 2]))), 0.0, atol=1e-12)
+
+
+def test_planar_pose_bounds_by_hand():
+    low, high, wraps = belief.planar_pose_bounds((-0.1, 0.2), (-0.3, 0.4))
+    np.testing.assert_array_equal(low, [-0.1, -0.3, -np.pi])
+    np.testing.assert_array_equal(high, [0.2, 0.4, np.pi])
+    assert wraps == [False, False, True]
+
+
+def test_wrapping_flags_reach_every_constructor_and_the_kde():
+    # A Gaussian at yaw = pi - 0.01 with std 0.1: wrapped, about half the particles land near -pi;
+    # not wrapped, the truncation keeps them all below pi.
+    mean, std = [0.0, 0.0, np.pi - 0.01], [0.01, 0.01, 0.1]
+    wrapped = ParticleBelief.gaussian(LOW, HIGH, mean, std, 400, WRAPS, seed=1)
+    clipped = ParticleBelief.gaussian(LOW, HIGH, mean, std, 400, seed=1)
+    assert list(wrapped.wraps) == WRAPS and list(clipped.wraps) == [False] * 3
+    assert 0.2 < np.mean(wrapped.particles[:, 2] < 0) < 0.8 and np.all(clipped.particles[:, 2] > 2.5)
+    assert list(ParticleBelief.uniform(LOW, HIGH, 5, WRAPS).wraps) == WRAPS
+    assert list(ParticleBelief(np.zeros((2, 3)), LOW, HIGH, WRAPS).wraps) == WRAPS
+    # the KDE of that wrapped cloud measures it across the seam: as narrow as the same cloud at 0
+    P = wrapped.particles
+    at_zero = P.copy()
+    at_zero[:, 2] = np.mod(P[:, 2] - np.pi, 2 * np.pi) - np.pi     # rotate by pi: the seam moves away
+    lw = np.full(len(P), -np.log(len(P)))
+    h_seam = belief.kde_entropy(P, lw, LOW, HIGH, WRAPS)
+    assert h_seam == pytest.approx(belief.kde_entropy(at_zero, lw, LOW, HIGH, WRAPS), abs=0.05)
+    assert belief.kde_entropy(P, lw, LOW, HIGH) > h_seam + 1.0       # unwrapped: two far clumps
+
+
+def test_entropy_of_a_one_output_measurement_takes_flat_arrays():
+    rng = np.random.default_rng(4)
+    lw, mean, var = np.log(np.full(50, 1 / 50)), rng.uniform(0, 1, 50), rng.uniform(0.01, 0.1, 50)
+    flat = belief.expected_posterior_entropy(lw, mean, var, n_samples=40, seed=3)
+    column = belief.expected_posterior_entropy(lw, mean[:, None], var[:, None], n_samples=40, seed=3)
+    assert flat == column and isinstance(flat[0], float)
+
+
+def test_entropy_gp_with_one_model_per_output_matches_its_predictions():
+    # shared_hyperparameters=False fits one C++ model per output: the Python path of
+    # expected_posterior_entropy_gp and update_gp (not the single-model C++ call) is used.
+    from bayesgrasp.gp import ExactGP
+    rng = np.random.default_rng(0)
+    X = np.column_stack([rng.uniform(-0.3, 0.3, 150), rng.uniform(-0.3, 0.3, 150), rng.uniform(-1, 1, 150)])
+    gp = ExactGP(lengthscale=[0.5, 0.5, 1.0], noise=1e-4, optimize=False, shared_hyperparameters=False).fit(X, X * [1, 2, 3])
+    assert len(gp.models_) == 3 and belief._single_core_model(gp) is None
+    a = ParticleBelief.gaussian(LOW, HIGH, [0, 0, 0.2], [0.05, 0.05, 0.15], 200, WRAPS, seed=2)
+    actions = np.array([[0.0, 0.0, 0.0], [0.05, 0.02, 0.4], [-0.04, 0.01, -0.3]])
+    h, se = belief.expected_posterior_entropy_gp(gp, a, actions, n_samples=30, seed=1)
+    Xr = belief.relative_planar_pose(actions, a.particles)
+    mv = [m.predict(Xr, True) for m in gp.models_]
+    mean = np.column_stack([m for m, _ in mv]).reshape(3, len(a), 3)
+    var = np.column_stack([v for _, v in mv]).reshape(3, len(a), 3)
+    h2, se2 = belief.expected_posterior_entropy(a.log_weights, mean, var, n_samples=30, seed=1)
+    np.testing.assert_array_equal(h, h2)
+    np.testing.assert_array_equal(se, se2)
+    assert len(set(np.round(h, 9))) == 3                     # the three actions differ
+    # update_gp = a Gaussian likelihood of the measurement under each output's predictive
+    action, meas = np.array([0.02, -0.01, 0.3]), np.array([-0.03, 0.04, 0.25])
+    b = ParticleBelief(a.particles, LOW, HIGH, WRAPS)
+    b.update_gp(gp, action, meas)
+    Xa = belief.relative_planar_pose(action[None, :], a.particles)
+    ll = sum(-0.5 * ((meas[k] - m) ** 2 / v + np.log(2 * np.pi * v))
+             for k, (m, v) in enumerate(m.predict(Xa, True) for m in gp.models_))
+    ll = np.ravel(ll)
+    expect = ll - np.logaddexp.reduce(ll)
+    np.testing.assert_allclose(b.log_weights, expect, atol=1e-8)
+
+
+@pytest.mark.parametrize("call, name", [
+    (lambda: ParticleBelief.uniform(LOW, HIGH, 2**40), "n"),
+    (lambda: ParticleBelief.uniform(LOW, HIGH, 5, seed=-1), "seed"),
+    (lambda: ParticleBelief.gaussian(LOW, HIGH, [0, 0, 0], [1, 1, 1], 2**40), "n"),
+    (lambda: ParticleBelief.gaussian(LOW, HIGH, [0, 0, 0], [1, 1, 1], 5, seed=-1), "seed"),
+    (lambda: belief.resample_indices([1.0, 1.0], 2**40), "n"),
+    (lambda: belief.resample_indices([1.0, 1.0], 3, seed=-1), "seed"),
+    (lambda: belief.expected_posterior_entropy([0.0], [[0.0]], [[1.0]], n_samples=2**40), "n_samples"),
+    (lambda: belief.expected_posterior_entropy([0.0], [[0.0]], [[1.0]], seed=-1), "seed"),
+    (lambda: belief.expected_posterior_entropy([0.0], [[0.0]], [[1.0]], n_threads=2**40), "n_threads"),
+    (lambda: belief.expected_posterior_entropy_gp(_identity_gp(), ParticleBelief.uniform(LOW, HIGH, 5), [[0, 0, 0]],
+                                                  n_samples=2**40), "n_samples"),
+    (lambda: belief.expected_posterior_entropy_gp(_identity_gp(), ParticleBelief.uniform(LOW, HIGH, 5), [[0, 0, 0]],
+                                                  seed=-1), "seed"),
+    (lambda: belief.expected_posterior_entropy_gp(_identity_gp(), ParticleBelief.uniform(LOW, HIGH, 5), [[0, 0, 0]],
+                                                  n_threads=2**40), "n_threads"),
+])
+def test_out_of_range_integers_name_their_argument(call, name):
+    with pytest.raises(ValueError, match=rf"^{name}: must be"):
+        call()

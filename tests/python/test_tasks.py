@@ -145,3 +145,76 @@ def test_unknown_category_or_task():
         load_tasks("spoon")
     with pytest.raises(ValueError, match="its tasks: top, side, handle"):
         task_rule("mug", "throw")
+
+
+def _rule_of(approach, table=True):
+    from bayesgrasp.models.tasks import _rule
+
+    return _rule("c", "t", {"approach": approach, "contacts": {"allowed": ["a"]}}, ["a", "b"], "t.json: task 't'", table)
+
+
+def _dirs_from(azimuth_deg, elevation_deg):
+    """Approach directions (the hand moves along them) that come from the given azimuth and
+    elevation (degrees): the source direction is -d."""
+    az, el = np.broadcast_arrays(np.radians(azimuth_deg), np.radians(elevation_deg))
+    src = np.column_stack([np.cos(el) * np.cos(az), np.cos(el) * np.sin(az), np.sin(el)])
+    return -src
+
+
+def test_every_approach_constraint_at_and_past_its_limits():
+    # Oracles from the definitions: from_axis: angle(source, axis) <= max; from_horizontal:
+    # |elevation| <= max tilt; from_azimuth: |azimuth - azimuth(axis)| wrapped to [-180, 180)
+    # within [min, max]; across_axis: angle(direction, axis line) >= min. 1e-6 deg either side of
+    # a limit; limits are inclusive, checked where the angle is exact (0 deg, and 90 deg across).
+    eps = 1e-6
+    axis = _rule_of({"from_axis": {"axis": [0, 0, 1], "max_angle_deg": 30}})
+    assert axis.approach_ok(_dirs_from([0, 0, 90], [60 + eps, 60 - eps, 60 + eps])).tolist() == [True, False, True]
+    assert _rule_of({"from_axis": {"axis": [0, 0, 1], "max_angle_deg": 0}}).approach_ok([[0, 0, -1]]).tolist() == [True]
+    tilt = _rule_of({"from_horizontal": {"max_tilt_deg": 20}}, table=False)   # from below too
+    assert tilt.approach_ok(_dirs_from([45] * 4, [20 - eps, 20 + eps, -20 + eps, -20 - eps])).tolist() == [
+        True, False, True, False]
+    assert _rule_of({"from_horizontal": {"max_tilt_deg": 0}}).approach_ok([[-1, 0, 0]]).tolist() == [True]
+    # an azimuth window around an axis at 30 deg (not on a coordinate axis: both components count)
+    c30 = [np.cos(np.radians(30)), np.sin(np.radians(30)), 0]
+    az = _rule_of({"from_azimuth": {"axis": c30, "min_angle_deg": 10, "max_angle_deg": 40}})
+    got = az.approach_ok(_dirs_from([40 - eps, 40 + eps, 70 - eps, 70 + eps, 30 - 25, 30, 30 - 40 + eps, -10 - eps], 0.0))
+    assert got.tolist() == [False, True, True, False, True, False, True, False]
+    assert not az.approach_ok([[0, 0, -1]])[0]          # straight down has no azimuth
+    exact = _rule_of({"from_azimuth": {"axis": [1, 0, 0], "min_angle_deg": 0, "max_angle_deg": 0}})
+    assert exact.approach_ok([[-1, 0, 0], [-1, 1e-3, 0]]).tolist() == [True, False]
+    across = _rule_of({"across_axis": {"axis": [1, 0, 0], "min_angle_deg": 60}})
+    # the direction's angle to the axis line: 60 + eps, 60 - eps, 120 - eps (the other way round)
+    d = [[np.cos(np.radians(a)), 0, -np.sin(np.radians(a))] for a in (60 + eps, 60 - eps, 120 - eps)]
+    assert across.approach_ok(d).tolist() == [True, False, True]
+    square = _rule_of({"across_axis": {"axis": [1, 0, 0], "min_angle_deg": 90}})
+    assert square.approach_ok([[0, 0, -1], [1e-3, 0, -1]]).tolist() == [True, False]
+
+
+def test_contact_counts_targets_and_keys_are_read_from_the_file(tmp_path):
+    doc = {"category": "c", "parts": ["a", "b"], "table": False, "tasks": {"t": {
+        "approach": {"from_horizontal": {"max_tilt_deg": 30}},
+        "contacts": {"allowed": ["a", "b"], "min_object_contacts": 0, "min_part_contacts": {"a": 0, "b": 2}},
+        "targets": ["b"]}}}
+    rule = load_task_file(_write(tmp_path / "t.json", doc))["t"]
+    assert rule.targets == ("b",) and rule.min_object_contacts == 0 and rule.min_part_contacts == {"a": 0, "b": 2}
+    assert rule.table is False and rule.category == "c" and rule.name == "t"
+    assert rule.contacts_ok(["b", "b"]) and not rule.contacts_ok(["a", "b"])
+    bad = [({"allowed": ["a"], "min_object_contacts": -1}, "contact counts must be non-negative integers"),
+           ({"allowed": ["a"], "min_part_contacts": {"a": -1}}, "contact counts must be non-negative integers"),
+           ({"allowed": ["a"], "min_part_contacts": {"z": 1}}, r"contacts.min_part_contacts: unknown parts \['z'\]"),
+           ({"allowed": ["z"]}, r"contacts.allowed: unknown parts \['z'\]"),
+           ({"allowed": ["a"], "colour": 1}, r"keys must be among \['allowed', 'min_object_contacts'")]
+    for contacts, needle in bad:
+        doc["tasks"]["t"]["contacts"] = contacts
+        with pytest.raises(ValueError, match=needle):
+            load_task_file(_write(tmp_path / "t.json", doc))
+    doc["tasks"]["t"]["contacts"] = {"allowed": ["a"]}
+    doc["tasks"]["t"]["targets"] = ["z"]
+    with pytest.raises(ValueError, match=r"t.json: task 't'.targets: unknown parts \['z'\]"):
+        load_task_file(_write(tmp_path / "t.json", doc))
+    doc["colour"] = "red"
+    with pytest.raises(ValueError, match=r"unknown keys \['colour'\]$"):
+        load_task_file(_write(tmp_path / "t.json", doc))
+    with pytest.raises(ValueError, match=r"max_tilt_deg: .*90"):
+        _rule_of({"from_horizontal": {"max_tilt_deg": 95}})
+    _rule_of({"from_axis": {"axis": [0, 0, 1], "max_angle_deg": 95}})   # up to 180 for the others
