@@ -114,6 +114,10 @@ The defaults are what every caller uses; the others exist for tests and benchmar
       .def_readwrite("rel_err", &SimOptions::rel_err,
                      "rel_err : float\n    Error allowance of the advancing distance queries, relative to the "
                      "link's lower bound on its distance (in [0, 1); 0 = exact).")
+      .def_readwrite("tie_tolerance", &SimOptions::tie_tolerance,
+                     "tie_tolerance : float\n    Triangle pairs whose distances to a link differ by less than this "
+                     "count as tied; a query keeps the first (m, in [0, contact_tolerance / 10); 0 = FCL's own "
+                     "traversal).")
       .def_readwrite("box_skip", &SimOptions::box_skip,
                      "box_skip : float\n    Links whose lower bound on the object distance exceeds this use the "
                      "bound instead of an FCL query (m, > contact_tolerance).")

@@ -6,6 +6,7 @@
 
 #include <algorithm>
 
+#include "bayesgrasp/sim/bvh_distance.hpp"
 #include "bayesgrasp/sim/distance_bounds.hpp"
 
 namespace bayesgrasp::sim {
@@ -22,8 +23,8 @@ double shape_distance(const SimScene& s, const LinkShape& shape, const Iso3& T, 
   fcl::DistanceResultd res;
   const bool capped = cap < kInf && cap + shape.offset > 0.0;  // FCL stops at once on a best <= 0
   if (capped) res.min_distance = cap + shape.offset;
-  fcl::distance(s.object.bvh.get(), fcl::Transform3d::Identity(), shape.geometry.get(), T * shape.geometry_frame,
-                req, res);
+  bvh_distance(s.object.bvh.get(), shape.geometry.get(), T * shape.geometry_frame, req, res,
+               s.options.tie_tolerance);
   if (capped && res.b1 == fcl::DistanceResultd::NONE) return kInf;  // nothing below cap
   const double d = res.min_distance - shape.offset;
   if (e && d < e->distance) {
@@ -48,8 +49,8 @@ double shape_distance_from(const SimScene& s, const LinkShape& shape, const Iso3
   const double preset = std::min(capped, start);
   if (preset < kInf && preset > 0.0) res.min_distance = preset;  // FCL stops at once on a best <= 0
   else if (preset <= 0.0) return start - shape.offset;  // touching pair known (only when start <= 0)
-  fcl::distance(s.object.bvh.get(), fcl::Transform3d::Identity(), shape.geometry.get(), T * shape.geometry_frame,
-                req, res);
+  bvh_distance(s.object.bvh.get(), shape.geometry.get(), T * shape.geometry_frame, req, res,
+               s.options.tie_tolerance);
   double raw;
   if (res.b1 != fcl::DistanceResultd::NONE) {
     raw = res.min_distance;

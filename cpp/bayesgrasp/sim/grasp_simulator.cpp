@@ -26,6 +26,9 @@ void check_options(const SimOptions& o) {
                                 std::to_string(o.contact_tolerance));
   if (!(o.rel_err >= 0) || !(o.rel_err < 1))
     throw std::invalid_argument("rel_err: must lie in [0, 1), got " + std::to_string(o.rel_err));
+  if (!(o.tie_tolerance >= 0) || !(o.tie_tolerance < 0.1 * o.contact_tolerance))
+    throw std::invalid_argument("tie_tolerance: must lie in [0, contact_tolerance / 10), got " +
+                                std::to_string(o.tie_tolerance));
   if (!(o.box_skip > o.contact_tolerance) || !std::isfinite(o.box_skip))
     throw std::invalid_argument("box_skip: must be finite and exceed contact_tolerance, got " +
                                 std::to_string(o.box_skip));

@@ -54,6 +54,11 @@ struct SimOptions {
   /// to the object (the step subtracts it, so it stays conservative). Final contact queries
   /// are exact.
   double rel_err = 0.0;
+  /// Triangle pairs whose distances to a link differ by less than this (m) count as tied: an FCL
+  /// query keeps the first one it finds and prunes the rest (sim/bvh_distance.hpp). A link
+  /// parallel to a finely tessellated face otherwise visits every triangle under it. 0 = FCL's
+  /// own traversal.
+  double tie_tolerance = 1e-12;
   /// Links whose lower bound on the object distance (box gap, 26-DOP separating axes) exceeds
   /// this use that bound instead of an FCL query (must exceed contact_tolerance).
   double box_skip = 5e-4;
