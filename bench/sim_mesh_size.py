@@ -21,30 +21,6 @@ from bayesgrasp.objects import library
 from bayesgrasp.sim import GraspSimulator
 
 
-def grid_box(half, n):
-    """Closed box of half extents `half`, each face an n x n grid of squares split in two."""
-    V, F = [], []
-    for axis in range(3):
-        u, v = (axis + 1) % 3, (axis + 2) % 3
-        for side in (-1.0, 1.0):
-            base = len(V)
-            for i in range(n + 1):
-                for j in range(n + 1):
-                    p = np.zeros(3)
-                    p[axis] = side * half[axis]
-                    p[u] = half[u] * (2.0 * i / n - 1.0)
-                    p[v] = half[v] * (2.0 * j / n - 1.0)
-                    V.append(p)
-            for i in range(n):
-                for j in range(n):
-                    a = base + i * (n + 1) + j
-                    b = a + n + 1
-                    F += [(a, b, b + 1), (a, b + 1, a + 1)] if side > 0 else [(a, b + 1, b), (a, a + 1, b + 1)]
-    V = np.array(V)
-    V[:, 2] += half[2]  # standing on the table
-    return V, np.array(F, dtype=np.int64)
-
-
 def median_rate(fn, n, reps=3):
     ts = []
     for _ in range(reps):
@@ -60,7 +36,7 @@ def main(out_dir="bench/results"):
     rng = np.random.default_rng(4)
     g = np.column_stack([rng.uniform(-0.02, 0.02, n_grasps), rng.uniform(-0.02, 0.02, n_grasps),
                          rng.uniform(0, np.pi, n_grasps)])
-    meshes = [(f"box n={n}", *grid_box((0.03, 0.02, 0.05), n)) for n in (1, 9, 18, 36, 72)]
+    meshes = [(f"box n={n}", *library.grid_box((0, 0, 0.05), (0.03, 0.02, 0.05), n)) for n in (1, 9, 18, 36, 72)]
     mug = library.builtin("mug")
     meshes.append(("mug", np.asarray(mug.vertices), np.asarray(mug.faces)))
     rows = []

@@ -4,6 +4,7 @@ import pytest
 from scipy.optimize import brentq
 
 from bayesgrasp.hand import Hand
+from bayesgrasp.objects.library import grid_box
 from bayesgrasp.sim import GraspBatch, GraspResult, GraspSimulator, SimOptions, make_options
 
 DEG = np.pi / 180
@@ -226,33 +227,11 @@ def test_every_option_reaches_the_simulator(barrett):
     assert g.num_contacts == 0 and not g.table_contact.any()
 
 
-def grid_box(half, n):
-    """Closed box of half extents ``half`` on the table, each face an n x n grid of squares."""
-    V, F = [], []
-    for axis in range(3):
-        u, v = (axis + 1) % 3, (axis + 2) % 3
-        for side in (-1.0, 1.0):
-            base = len(V)
-            for i in range(n + 1):
-                for j in range(n + 1):
-                    p = np.zeros(3)
-                    p[axis], p[u], p[v] = side * half[axis], half[u] * (2 * i / n - 1), half[v] * (2 * j / n - 1)
-                    V.append(p)
-            for i in range(n):
-                for j in range(n):
-                    a = base + i * (n + 1) + j
-                    b = a + n + 1
-                    F += [(a, b, b + 1), (a, b + 1, a + 1)] if side > 0 else [(a, b + 1, b), (a, a + 1, b + 1)]
-    V = np.array(V)
-    V[:, 2] += half[2]
-    return V, np.array(F)
-
-
 def test_tied_triangles_under_a_flat_finger_give_the_grasp_of_the_exact_traversal(barrett):
     # A finely tessellated box: fingers closing on its faces are parallel to many triangles at
     # once. The tie tolerance (1e-12 m) prunes them; the grasps must be those of FCL's own
     # traversal (tie_tolerance = 0) to round-off, with fewer nodes visited (bench/sim_mesh_size.py).
-    V, F = grid_box((0.03, 0.02, 0.05), 24)
+    V, F = grid_box((0, 0, 0.05), (0.03, 0.02, 0.05), 24)
     rng = np.random.default_rng(5)
     g = np.column_stack([rng.uniform(-0.02, 0.02, 24), rng.uniform(-0.02, 0.02, 24), rng.uniform(0, np.pi, 24)])
     tied = GraspSimulator(barrett, V, F).top_grasp_batch(g, spread=0.0, threads=1)

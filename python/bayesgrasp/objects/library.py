@@ -141,6 +141,30 @@ def box(center, half_extents):
     return prism(sq, c[2] - h[2], c[2] + h[2])
 
 
+def grid_box(center, half_extents, n: int):
+    """Closed axis-aligned box whose six faces are n x n grids of squares, each split in two
+    (12 n^2 triangles): a finely tessellated flat-faced object (the simulator's and the
+    benchmarks' large-mesh case)."""
+    c = np.asarray(center, dtype=np.float64)
+    h = np.asarray(half_extents, dtype=np.float64)
+    t = np.linspace(-1.0, 1.0, n + 1)
+    gu, gv = (a.ravel() for a in np.meshgrid(t, t, indexing="ij"))
+    i, j = (a.ravel() for a in np.meshgrid(np.arange(n), np.arange(n), indexing="ij"))
+    a = i * (n + 1) + j
+    b = a + n + 1
+    quad = np.concatenate([np.stack([a, b, b + 1], 1), np.stack([a, b + 1, a + 1], 1)])
+    V, F = [], []
+    for axis in range(3):
+        u, v = (axis + 1) % 3, (axis + 2) % 3
+        for side in (-1.0, 1.0):
+            P = np.empty((len(gu), 3))
+            P[:, axis], P[:, u], P[:, v] = side, gu, gv
+            F.append((quad if side > 0 else quad[:, [0, 2, 1]]) + sum(len(x) for x in V))  # (u, v, axis) right-handed
+            V.append(P * h + c)
+    V = np.vstack(V)
+    return V, orient_outward(V, np.vstack(F))
+
+
 def _rotate(V, R, t=(0.0, 0.0, 0.0)):
     return V @ np.asarray(R, dtype=np.float64).T + np.asarray(t, dtype=np.float64)
 
