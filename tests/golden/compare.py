@@ -16,7 +16,8 @@ import re
 import sys
 from pathlib import Path
 
-WALL_CLOCK = re.compile(r"(^|_)(seconds|time|times|elapsed|wall|date|timestamp|started|finished|ms|s)$|_s$|_ms$")
+# a wall-clock word as the whole key or one of its underscore-separated parts (plan_ms_median)
+WALL_CLOCK = re.compile(r"(^|_)(seconds|time|times|elapsed|wall|date|timestamp|started|finished|ms|s)(_|$)")
 
 
 def _load(path: Path):
