@@ -80,7 +80,10 @@ void bind_options(py::module_& m) {
       .def_readwrite("density", &LiftOptions::density, "density : float\n    Object density, kg/m^3 (mass from the mesh).")
       .def_readwrite("time_step", &LiftOptions::time_step, "time_step : float\n    Fixed time step, s (default 1/480).")
       .def_readwrite("solver_iterations", &LiftOptions::solver_iterations,
-                     "solver_iterations : int\n    Bullet's constraint solver iterations per step (>= 1, default 20).")
+                     "solver_iterations : int\n    Bullet's constraint solver iterations per step (>= 1, default 100).")
+      .def_readwrite("solver_residual", &LiftOptions::solver_residual,
+                     "solver_residual : float\n    a step's solver iterations end once Bullet's least-squares "
+                     "residual is below this (its units); 0 (default) runs them all.")
       .def_readwrite("squeeze_time", &LiftOptions::squeeze_time,
                      "squeeze_time : float\n    s, the palm still while the fingers tighten.")
       .def_readwrite("lift_height", &LiftOptions::lift_height, "lift_height : float\n    m the palm rises.")

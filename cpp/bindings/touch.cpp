@@ -136,7 +136,10 @@ void bind_options(py::module_& m) {
       .def_readwrite("population", &EstimateOptions::population,
                      "population : int\n    particles / fireflies / chains; 0 = the default (20, 20, 10)")
       .def_readwrite("seed", &EstimateOptions::seed, "seed : int")
-      .def_readwrite("threads", &EstimateOptions::threads, "threads : int\n    0 = all cores");
+      .def_readwrite("threads", &EstimateOptions::threads, "threads : int\n    0 = all cores")
+      .def_readwrite("stop_fitness", &EstimateOptions::stop_fitness,
+                     "stop_fitness : float\n    end the search once the best fitness is below this (the readings "
+                     "reproduced to that level); 0 = spend the whole budget");
   m.def("minimum_budget", &minimum_budget, py::arg("optimizer"), py::arg("dim"), py::arg("population") = 0,
         "The smallest budget the optimiser runs with in `dim` unknowns.");
 }
@@ -175,6 +178,8 @@ void bind_results(py::module_& m) {
       .def_readonly("contact_term", &EstimateResult::contact_term, "contact_term : float")
       .def_readonly("height_term", &EstimateResult::height_term, "height_term : float")
       .def_readonly("evaluations", &EstimateResult::evaluations, "evaluations : int")
+      .def_readonly("stopped", &EstimateResult::stopped,
+                    "stopped : bool\n    the search ended below stop_fitness, before its budget")
       .def_readonly("restarts", &EstimateResult::restarts, "restarts : int\n    local optimisers: runs after the first")
       .def_readonly("trace_evaluations", &EstimateResult::trace_evaluations,
                     "trace_evaluations : list of int\n    evaluations after each batch")

@@ -54,6 +54,23 @@ def test_tester_batch_equals_single_runs():
         out.lifted[0] = False  # read-only view of the results
 
 
+def test_the_solver_stop_level_reaches_bullet():
+    # a level every step's first iteration meets ends each step after one iteration: the same
+    # run as solver_iterations=1, and not the default's 100
+    one = physics.lift_test(None, POSE, GOOD, V, F, density=400.0, solver_iterations=1)
+    huge = physics.lift_test(None, POSE, GOOD, V, F, density=400.0, solver_residual=1e30)
+    full = physics.lift_test(None, POSE, GOOD, V, F, density=400.0)
+    assert huge.displacement == one.displacement and huge.height_gain == one.height_gain
+    assert full.displacement != one.displacement
+    # a tiny level leaves the untouched box exactly where running every iteration leaves it
+    tiny = physics.lift_test(None, POSE, OPEN, V, F, density=400.0, solver_residual=1e-10)
+    rest = physics.lift_test(None, POSE, OPEN, V, F, density=400.0)
+    assert tiny.lifted == rest.lifted and tiny.height_gain == pytest.approx(rest.height_gain, abs=1e-6)
+    for bad in (-1.0, float("nan")):
+        with pytest.raises(ValueError, match="solver_residual"):
+            physics.lift_test(None, POSE, OPEN, V, F, solver_residual=bad)
+
+
 def test_options_and_shapes():
     assert physics.make_options(shape="decomposition").shape == "decomposition"
     o = physics.make_options(mu=0.3, shape="tetrahedra", table=False)

@@ -101,6 +101,32 @@ def test_the_size_is_estimated(cube):
     assert abs(r.state[3] - 1.15) < 0.02 < abs(1.0 - 1.15)
 
 
+def test_the_stop_level_ends_the_search_early_and_changes_nothing_at_zero(cube):
+    truth, guess = np.array([0.005, 0.0, 0.3]), np.array([-0.01, 0.01, 0.5])
+    grasp, readings = _touch("cube", truth, guess)
+    full = cube.estimate(grasp, readings, guess, budget=2000, seed=3)
+    assert full.evaluations == 2000 and not full.stopped
+    zero = cube.estimate(grasp, readings, guess, budget=2000, seed=3, stop_fitness=0.0)
+    np.testing.assert_array_equal(zero.state, full.state)
+    assert zero.trace_fitness == full.trace_fitness
+    # a level the first swarm already reaches: one batch of 20, then the search ends
+    first = cube.estimate(grasp, readings, guess, budget=2000, seed=3, stop_fitness=1e9)
+    assert first.stopped and first.evaluations == 20
+    # a level in between: the same search as the full one up to the first batch below it
+    s = 0.05
+    part = cube.estimate(grasp, readings, guess, budget=2000, seed=3, stop_fitness=s)
+    k = next(i for i, f in enumerate(full.trace_fitness) if f < s)
+    assert part.stopped and part.fitness < s
+    assert part.evaluations == full.trace_evaluations[k] < 2000
+    assert part.trace_fitness == full.trace_fitness[: k + 1]
+    # the local optimisers stop there too
+    local = cube.estimate(grasp, readings, guess, optimizer="descent", budget=2000, stop_fitness=1e9)
+    assert local.stopped and local.evaluations < 2000
+    for bad in (-0.1, float("nan"), float("inf")):
+        with pytest.raises(ValueError, match="stop_fitness"):
+            cube.estimate(grasp, readings, guess, stop_fitness=bad)
+
+
 def test_bad_input(cube):
     grasp, none = _touch("cube", (0.0, 0.0, 0.0), (0.3, 0.3, 0.0))
     assert none.contact_count == 0

@@ -20,6 +20,7 @@ BulletWorld::BulletWorld(const LiftOptions& o)
       skip_funcs_(o.skip_separated_pairs ? make_skip_funcs() : SkipFuncs{}) {
   world_.setGravity(btVector3(0, 0, btScalar(-9.81 * kUnit)));
   world_.getSolverInfo().m_numIterations = o.solver_iterations;
+  world_.getSolverInfo().m_leastSquaresResidualThreshold = btScalar(o.solver_residual);
   world_.getSolverInfo().m_solverMode |= SOLVER_USE_2_FRICTION_DIRECTIONS;
 }
 

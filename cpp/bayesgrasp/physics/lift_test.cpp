@@ -36,6 +36,7 @@ void check_options(const LiftOptions& o) {
   pos(o.density, "density");
   pos(o.time_step, "time_step");
   if (o.solver_iterations < 1) throw std::invalid_argument("solver_iterations must be >= 1");
+  nonneg(o.solver_residual, "solver_residual");
   nonneg(o.squeeze_time, "squeeze_time");
   nonneg(o.lift_height, "lift_height");
   pos(o.lift_time, "lift_time");

@@ -135,6 +135,8 @@ struct LiftOptions {
   double density = 1000.0;      // kg/m^3 (mass from the mesh)
   double time_step = 1.0 / 480.0;  // s; see the note on time steps above
   int solver_iterations = 100;
+  double solver_residual = 0.0;  // Bullet's m_leastSquaresResidualThreshold (its units): a step's
+                                 // iterations end once the residual is below it; 0 = run them all
   double squeeze_time = 0.15;   // s
   double lift_height = 0.10;    // m
   double lift_time = 0.40;      // s

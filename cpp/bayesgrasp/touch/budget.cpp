@@ -5,7 +5,7 @@
 namespace bayesgrasp::touch {
 
 void BudgetedObjective::operator()(const optim::RowMatrixXd& U, Eigen::VectorXd& f) {
-  if (used_ >= budget_) throw BudgetExhausted{};
+  if (used_ >= budget_ || best_f_ < stop_below_) throw BudgetExhausted{};
   const long long n = std::min<long long>(U.rows(), budget_ - used_);
   f.setConstant(U.rows(), std::numeric_limits<double>::infinity());
   Eigen::VectorXd part(n);

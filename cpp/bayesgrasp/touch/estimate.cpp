@@ -1,6 +1,7 @@
 #include "bayesgrasp/touch/estimate.hpp"
 
 #include <chrono>
+#include <cmath>
 #include <ctime>
 #include <stdexcept>
 
@@ -45,15 +46,12 @@ optim::RowMatrixXd initial_population(const SearchSpace& space, int P, Rng& rng)
   return X;
 }
 
-/// A population optimiser with P candidates for floor(B / P) - 1 iterations.
-void run_population(Optimizer which, BudgetedObjective& budget, const SearchSpace& space, int P, long long B,
-                    std::uint64_t seed, Rng& rng) {
-  const optim::Bounds box = space.unit_bounds();
-  const int iterations = static_cast<int>(B / P) - 1;
-  const optim::BatchObjective f = budget.objective();
+/// One population optimiser's run: P candidates from `init`, `iterations` iterations.
+void run_optimizer(Optimizer which, const optim::BatchObjective& f, const optim::Bounds& box, int P, int iterations,
+                   std::uint64_t seed, const optim::RowMatrixXd& init) {
   auto fill = [&](optim::PopulationOptions& o) {
     o.seed = seed;
-    o.init = initial_population(space, P, rng);
+    o.init = init;
   };
   if (which == Optimizer::PSO) {
     optim::PSOOptions o;
@@ -70,6 +68,17 @@ void run_population(Optimizer which, BudgetedObjective& budget, const SearchSpac
     fill(o);
     o.n_chains = P, o.max_iter = iterations;
     optim::simulated_annealing(f, box, o);
+  }
+}
+
+/// A population optimiser with P candidates for floor(B / P) - 1 iterations, or until the budget's
+/// stop level is reached.
+void run_population(Optimizer which, BudgetedObjective& budget, const SearchSpace& space, int P, long long B,
+                    std::uint64_t seed, Rng& rng) {
+  const optim::RowMatrixXd init = initial_population(space, P, rng);
+  try {
+    run_optimizer(which, budget.objective(), space.unit_bounds(), P, static_cast<int>(B / P) - 1, seed, init);
+  } catch (const BudgetExhausted&) {  // stopped below EstimateOptions::stop_fitness
   }
 }
 
@@ -100,6 +109,9 @@ int run_local(Optimizer which, BudgetedObjective& budget, const SearchSpace& spa
 
 void check_options(const EstimateOptions& o, int dim) {
   if (o.population < 0) throw std::invalid_argument("population: must be >= 0 (0 = the default)");
+  if (!(o.stop_fitness >= 0.0) || !std::isfinite(o.stop_fitness))
+    throw std::invalid_argument("stop_fitness: must be >= 0 and finite (0 = spend the whole budget), got " +
+                                std::to_string(o.stop_fitness));
   if (o.population == 1 && !is_local(o.optimizer))
     throw std::invalid_argument("population: a population optimiser needs at least 2 candidates");
   const long long min = minimum_budget(o.optimizer, dim, o.population);
@@ -147,7 +159,7 @@ EstimateResult estimate(const TouchModel& model, const TouchGrasp& grasp, const 
   const std::clock_t cpu_start = std::clock();
   BudgetedObjective budget(
       [&](const optim::RowMatrixXd& U, Eigen::VectorXd& f) { f = fitness_at(space.states(U)).total; },
-      options.budget);
+      options.budget, options.stop_fitness);
   Rng rng(mix_seed(options.seed));
   if (is_local(options.optimizer)) {
     r.restarts = run_local(options.optimizer, budget, space, rng);
@@ -158,6 +170,7 @@ EstimateResult estimate(const TouchModel& model, const TouchGrasp& grasp, const 
   r.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   r.cpu_seconds = static_cast<double>(std::clock() - cpu_start) / CLOCKS_PER_SEC;
   r.evaluations = budget.used();
+  r.stopped = budget.stopped();
   r.trace_evaluations = budget.trace_evaluations();
   r.trace_fitness = budget.trace_best();
   r.message = std::string(optimizer_name(options.optimizer)) + ": " + std::to_string(r.evaluations) + " evaluations";

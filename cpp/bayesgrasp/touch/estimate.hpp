@@ -11,7 +11,9 @@
 //  * steepest descent, trust region: from the initial guess, then restarted from uniform points
 //    of the box whenever a run converges, until the budget is used; finite differences of 0.03
 //    in unit coordinates (0.9 mm, 0.9 degrees, a scale step of 0.006 with the default box).
-// The result is the best candidate any evaluation saw.
+// The result is the best candidate any evaluation saw. With stop_fitness s > 0 the search ends at the
+// first batch after which some candidate has f < s (the readings reproduced to that level), so an
+// estimate may use fewer evaluations than its budget; s = 0 (the default) always spends it all.
 #pragma once
 
 #include <cstdint>
@@ -33,6 +35,7 @@ struct EstimateOptions {
   int population = 0;        ///< PSO particles / fireflies / annealing chains; 0 = the default
   std::uint64_t seed = 0;
   int threads = 1;           ///< for the batches (common/parallel.hpp: 0 = all cores)
+  double stop_fitness = 0.0; ///< end the search once the best f is below this; 0 = spend the budget
 };
 
 enum class EstimateStatus {
@@ -49,6 +52,7 @@ struct EstimateResult {
   double fitness = 0.0;            ///< f at the estimate
   double joint_term = 0.0, contact_term = 0.0, height_term = 0.0;  ///< its terms
   long long evaluations = 0;       ///< fitness evaluations spent
+  bool stopped = false;            ///< the search ended below stop_fitness, before its budget
   int restarts = 0;                ///< local optimisers: runs after the first
   std::vector<long long> trace_evaluations;  ///< after each batch: evaluations so far
   std::vector<double> trace_fitness;         ///< ... and the best f so far

@@ -106,14 +106,16 @@ def read(world: GraspSimulator, grasp: TouchGrasp) -> TouchReadings:
 
 def estimate_options(optimizer: str = "pso", unknowns: str = "pose", budget: int = 2000, seed: int = 0,
                      contact_term: str = "flags", box: Optional[Sequence[float]] = None, population: int = 0,
-                     threads: int = 1) -> EstimateOptions:
+                     threads: int = 1, stop_fitness: float = 0.0) -> EstimateOptions:
     """EstimateOptions from names. ``box``: (xy m, yaw rad, scale_low, scale_high); default
-    (0.03, 30 deg, 0.8, 1.2)."""
+    (0.03, 30 deg, 0.8, 1.2). ``stop_fitness`` > 0 ends the search once a candidate's fitness is
+    below it (0: spend the whole budget)."""
     o = EstimateOptions()
     o.optimizer = _choice(OPTIMIZERS, optimizer, "optimizer")
     o.unknowns = _choice(UNKNOWNS, unknowns, "unknowns")
     o.fitness.contact_term = _choice(CONTACT_TERMS, contact_term, "contact_term")
     o.budget, o.seed, o.population, o.threads = int(budget), int(seed), int(population), int(threads)
+    o.stop_fitness = float(stop_fitness)
     if box is not None:
         b = SearchBox()
         b.xy, b.yaw, b.scale_low, b.scale_high = (float(v) for v in box)
