@@ -93,6 +93,38 @@ def test_planner_interface_and_bad_input(cube):
         run_episode("cube", (5.0, 0, 0), models=cube)  # off the table
 
 
+def test_a_large_belief_is_planned_on_a_compressed_one(cube):
+    # at or below plan_particles the searches see the belief itself: the same plan as with 0
+    small = [StabilityPlanner(cube, (0.01, 0.0, 0.2), PlannerSettings(plan_particles=k), seed=4) for k in (0, 500)]
+    assert small[1].planning_belief() is small[1].belief
+    np.testing.assert_array_equal(small[0].plan().action, small[1].plan().action)
+    # above it: at most 500 distinct particles of the belief, weights counts of 500 draws
+    p = ExplorationPlanner(cube, (0.01, 0.0, 0.2), PlannerSettings(n_particles=5000), seed=4)
+    full = p.belief
+    c = p.planning_belief()
+    assert 2 <= len(c) <= 500
+    rows = {tuple(r) for r in full.particles}
+    assert all(tuple(r) in rows for r in c.particles)
+    counts = c.weights * 500
+    np.testing.assert_allclose(counts, np.round(counts), atol=1e-9)
+    assert counts.sum() == pytest.approx(500)
+    # the searches run on it and the full belief is back afterwards
+    seen = []
+    p.most_stable = lambda P, w, _f=p.most_stable: (seen.append(len(P)), _f(P, w))[1]
+    plan = p.plan()
+    assert seen and max(seen) == len(c) < 5000 and p.belief is full and len(p.belief) == 5000
+    assert plan.action.shape == (3,)
+    # a concentrated belief compresses to a few particles: its size follows the spread
+    lw = np.full(5000, -50.0)
+    lw[:3] = 0.0
+    full.reweight(lw)
+    assert len(p.planning_belief()) == 3
+    with pytest.raises(ValueError, match="plan_particles"):
+        PlannerSettings(plan_particles=1)
+    with pytest.raises(ValueError, match="plan_particles"):
+        PlannerSettings(plan_particles=-5)
+
+
 def test_same_seed_same_episode(cube):
     a = run_episode("cube", (0.03, -0.02, 0.7), EpisodeSettings(method="explore"), NO_LIFT, seed=5, models=cube)
     b = run_episode("cube", (0.03, -0.02, 0.7), EpisodeSettings(method="explore"), NO_LIFT, seed=5, models=cube)

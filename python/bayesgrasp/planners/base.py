@@ -30,7 +30,7 @@ from typing import List, Mapping, Optional, Sequence, Union
 import numpy as np
 
 from .. import optim
-from ..belief import ParticleBelief, absolute_planar_pose_paired, relative_planar_pose
+from ..belief import ParticleBelief, absolute_planar_pose_paired, relative_planar_pose, resample_indices
 from ..models import FAMILIES, GraspModels
 
 
@@ -39,6 +39,10 @@ class PlannerSettings:
     """Settings shared by the planners (defaults reproduce the thesis's set-up)."""
 
     n_particles: int = 500
+    # The searches run on a compressed belief of at most plan_particles distinct particles when
+    # the belief holds more: drawn by systematic resampling, duplicates merged (weight = count),
+    # so a concentrated belief compresses to a few; 0 = search the whole belief.
+    plan_particles: int = 500
     # Initial belief: uniform over estimate +- half_width (x, y in m, yaw in rad).
     half_width: Sequence[float] = (0.04, 0.04, np.radians(45.0))
     # Stability search (Eq. 3.1): PSO over (x, y, yaw).
@@ -67,6 +71,8 @@ class PlannerSettings:
     def __post_init__(self):
         if self.n_particles < 2:
             raise ValueError(f"n_particles: need at least 2, got {self.n_particles}")
+        if self.plan_particles != 0 and self.plan_particles < 2:
+            raise ValueError(f"plan_particles: 0 (the whole belief) or at least 2, got {self.plan_particles}")
         hw = np.asarray(self.half_width, dtype=float)
         if hw.shape != (3,) or not np.all(np.isfinite(hw)) or np.any(hw <= 0):
             raise ValueError(f"half_width: expected three positive numbers (m, m, rad), got {self.half_width}")
@@ -232,10 +238,27 @@ class Planner:
     # ---- interface ------------------------------------------------------------------------------
     def plan(self) -> Plan:
         t0 = time.perf_counter()
-        p = self._plan()
+        full = self.belief
+        self.belief = self.planning_belief()   # the searches read self.belief
+        try:
+            p = self._plan()
+        finally:
+            self.belief = full
         p.seconds = time.perf_counter() - t0
         self._plans += 1
         return p
+
+    def planning_belief(self) -> ParticleBelief:
+        """The belief the next plan searches: the belief itself, or with more than
+        ``settings.plan_particles`` particles, that many systematic draws from it with duplicates
+        merged (weight = number of draws), seeded by the planner's seed and plan count."""
+        b, k = self.belief, self.settings.plan_particles
+        if k == 0 or len(b) <= k:
+            return b
+        idx = resample_indices(b.weights, k, "systematic", seed=self.seed + 104729 * (self._plans + 1))
+        keep, count = np.unique(idx, return_counts=True)
+        return ParticleBelief(b.particles[keep], b.low, b.high, wraps=b.wraps, log_weights=np.log(count),
+                              seed=self.seed)
 
     def _plan(self) -> Plan:
         raise NotImplementedError
