@@ -3,6 +3,7 @@ import pytest
 
 from bayesgrasp.models import ModelSettings, build_models, relative_top_grasps
 from bayesgrasp.models import AUTO_SPREADS, simulate_training_data
+from bayesgrasp.models import training
 from bayesgrasp.models.training import lift_outcomes
 from bayesgrasp.world import World
 
@@ -51,6 +52,21 @@ def test_models_predict_held_out_simulations_and_are_cached(tmp_path):
                          cache_dir=tmp_path)
     assert not other.loaded_from_cache and other.settings.stability_threshold == SMALL.eps_stable
     assert len(list(tmp_path.glob("*.json"))) == 2
+
+
+def test_long_lift_batches_report_progress_and_keep_their_verdicts(monkeypatch):
+    world = World.single("cube")
+    rng = np.random.default_rng(0)
+    rel = np.column_stack([rng.uniform(-0.03, 0.03, 70), rng.uniform(-0.03, 0.03, 70), rng.uniform(-np.pi, np.pi, 70)])
+    whole = lift_outcomes(world, rel, np.pi / 2)
+    lines = []
+    monkeypatch.setattr(training, "PROGRESS_EVERY", 0.0)
+    chunked = lift_outcomes(world, rel, np.pi / 2, say=lines.append)
+    np.testing.assert_array_equal(chunked, whole)
+    assert 0 < whole.sum() < len(whole)   # both verdicts occur
+    touching = len(lines) and int(lines[-1].split("/")[1].split()[0])
+    assert touching > training.LIFT_CHUNK and all("done, about" in x for x in lines)
+    assert len(lines) == -(-touching // training.LIFT_CHUNK) - 1   # one line per batch but the last
 
 
 def test_bad_settings():

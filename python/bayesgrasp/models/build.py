@@ -87,7 +87,7 @@ def _calibrate(models: GraspModels, world: World, settings: ModelSettings, sprea
     rel_c, _, eps_c = simulate_training_data(world, settings, seed_offset=1, n=settings.n_calibration, spread=spread)
     if len(rel_c) < 10:
         return DEFAULT_CALIBRATION
-    return fit_calibration(models.stability_z(rel_c), success_labels(world, settings, rel_c, eps_c, spread))
+    return fit_calibration(models.stability_z(rel_c), success_labels(world, settings, rel_c, eps_c, spread, say))
 
 
 def _fit_stability(world: World, settings: ModelSettings, rel, eps, variant: Variant, say: Say):
@@ -96,7 +96,7 @@ def _fit_stability(world: World, settings: ModelSettings, rel, eps, variant: Var
     if settings.success == "lift":
         n = min(settings.scaled(settings.n_lift_samples, settings.grasp_box(world.object)), len(rel))
         say(f"models for {world.object.name}: lift tests of {n} training grasps")
-        lifted = success_labels(world, settings, rel[:n], eps[:n], variant)
+        lifted = success_labels(world, settings, rel[:n], eps[:n], variant, say)
         return _fit(variant.features(rel[:n]), lifted.astype(float), settings, n), lifted
     return _fit(variant.features(rel), np.maximum(eps, 0.0), settings, len(rel)), eps > settings.eps_stable
 

@@ -4,7 +4,8 @@ chooses the finger spread (and, for side grasps, the height and roll) and the lo
 calibration of P(S)."""
 from __future__ import annotations
 
-from typing import Optional
+import time
+from typing import Callable, Optional
 
 import numpy as np
 from scipy.optimize import minimize
@@ -47,10 +48,33 @@ def simulate_training_data(world: World, settings: ModelSettings, seed_offset: i
     return rel[ok], np.asarray(b.joint_angles)[ok], np.asarray(b.epsilon)[ok]
 
 
-def lift_outcomes(world: World, rel: np.ndarray, spread) -> np.ndarray:
+LIFT_CHUNK = 32        # lift tests per batch when progress is reported
+PROGRESS_EVERY = 5.0   # s between progress lines
+
+
+def lifted_in_chunks(variant: Variant, world: World, rel: np.ndarray, say: Optional[Callable[[str], None]] = None,
+                     what: str = "lift tests") -> np.ndarray:
+    """(n,) bool: the lift test of each relative grasp of ``variant``. With ``say``, run in batches
+    of LIFT_CHUNK and report "what: k/n done, about s left" at most every PROGRESS_EVERY seconds
+    (each grasp's test is independent of the batch, so the verdicts are the same)."""
+    if say is None or len(rel) <= LIFT_CHUNK:
+        return np.asarray(variant.simulate(world, rel, lift=True, quality=False).lifted, bool)
+    out = np.empty(len(rel), dtype=bool)
+    start = last = time.monotonic()
+    for s in range(0, len(rel), LIFT_CHUNK):
+        e = min(s + LIFT_CHUNK, len(rel))
+        out[s:e] = np.asarray(variant.simulate(world, rel[s:e], lift=True, quality=False).lifted, bool)
+        now = time.monotonic()
+        if now - last >= PROGRESS_EVERY and e < len(rel):
+            say(f"  {what}: {e}/{len(rel)} done, about {(now - start) / e * (len(rel) - e):.0f} s left")
+            last = now
+    return out
+
+
+def lift_outcomes(world: World, rel: np.ndarray, spread, say: Optional[Callable[[str], None]] = None) -> np.ndarray:
     """(n,) bool: each relative grasp (of the family of ``spread``, a number for top grasps or a
     Variant) held in the lift test. A grasp whose hand touches nothing of the object cannot hold
-    it and is not simulated."""
+    it and is not simulated. ``say``: progress lines for long batches (:func:`lifted_in_chunks`)."""
     variant = spread if isinstance(spread, Variant) else Variant("top", float(spread))
     rel = np.atleast_2d(np.asarray(rel, dtype=float))
     b = variant.simulate(world, rel, quality=False)
@@ -58,14 +82,16 @@ def lift_outcomes(world: World, rel: np.ndarray, spread) -> np.ndarray:
     lifted = np.zeros(len(rel), dtype=bool)
     idx = np.flatnonzero(touches)
     if len(idx):
-        lifted[idx] = np.asarray(variant.simulate(world, rel[idx], lift=True, quality=False).lifted, bool)
+        lifted[idx] = lifted_in_chunks(variant, world, rel[idx], say)
     return lifted
 
 
-def success_labels(world: World, settings: ModelSettings, rel: np.ndarray, eps: np.ndarray, spread) -> np.ndarray:
-    """S for each grasp under the settings' success criterion (lift test or epsilon)."""
+def success_labels(world: World, settings: ModelSettings, rel: np.ndarray, eps: np.ndarray, spread,
+                   say: Optional[Callable[[str], None]] = None) -> np.ndarray:
+    """S for each grasp under the settings' success criterion (lift test or epsilon); ``say``:
+    progress lines for the lift tests."""
     if settings.success == "lift":
-        return lift_outcomes(world, rel, as_variant(settings, spread))
+        return lift_outcomes(world, rel, as_variant(settings, spread), say)
     return np.asarray(eps) > settings.eps_stable
 
 
@@ -116,7 +142,7 @@ def choose_variant(world: World, settings: ModelSettings, variants, say=lambda m
             ok = free & (np.asarray(b.epsilon) > settings.eps_stable)
             what = "stable"
         idx = np.flatnonzero(ok)[:settings.n_pilot_lifts]
-        lifted = int(np.sum(v.simulate(world, rel[idx], lift=True, quality=False).lifted)) if len(idx) else 0
+        lifted = int(np.sum(lifted_in_chunks(v, world, rel[idx], say))) if len(idx) else 0
         frac = float(np.mean(ok))
         table.append((frac, lifted, int(len(idx))))
         scores.append((frac * (lifted / len(idx) if len(idx) else 0.0), frac))
