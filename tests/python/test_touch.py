@@ -125,6 +125,9 @@ def test_the_stop_level_ends_the_search_early_and_changes_nothing_at_zero(cube):
     for bad in (-0.1, float("nan"), float("inf")):
         with pytest.raises(ValueError, match="stop_fitness"):
             cube.estimate(grasp, readings, guess, stop_fitness=bad)
+    # the loop's settings carry it to the search
+    planner = T.TouchPlanner(cube, guess, T.TouchSettings(seed=3, stop_fitness=s))
+    assert planner.update(grasp, readings).evaluations == part.evaluations
 
 
 def test_bad_input(cube):
