@@ -30,6 +30,15 @@ def grasp_file(tmp_path_factory):
     return f, grasps
 
 
+def test_generation_reports_each_batch_before_it_runs():
+    lines = []
+    tiny = TaskGraspSettings(candidates=20, spreads=(0.0, float(np.radians(60))), lift_tests=1, keep=1)
+    generate_task_grasps("mug/1", task_rule("mug", "top"), settings=tiny, say=lines.append)
+    assert [x.split(": ", 1)[1] for x in lines[:2]] == ["closing 20 approaches at spread 0 deg (1/2)",
+                                                         "closing 20 approaches at spread 60 deg (2/2)"]
+    assert "candidates obey the rule" in lines[2] and len(lines) == 3
+
+
 def test_generated_grasps_obey_their_rule_and_the_lift_test(grasp_file):
     _, grasps = grasp_file
     assert grasps, "a mug has stable top grasps"

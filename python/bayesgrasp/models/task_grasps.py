@@ -151,7 +151,9 @@ def generate_task_grasps(obj: Union[str, ObjectModel], rule: TaskRule, hand: str
     rng = np.random.default_rng([s.seed, zlib.crc32(f"{o.name}/{rule.name}".encode())])
     found = []   # (epsilon, spread, pose) of grasps that satisfy the rule
     jaws = bool(world.hand.prismatic_joints.any())
-    for spread in s.spreads:
+    for k, spread in enumerate(s.spreads):
+        say(f"task grasps {o.name}/{rule.name}: closing {s.candidates} approaches at spread "
+            f"{np.degrees(spread):.0f} deg ({k + 1}/{len(s.spreads)})")
         d = sample_directions(rule, s.candidates, rng)
         t = sample_targets(o, rule.targets, s.candidates, rng)
         roll = sample_rolls(world.hand, d, rng)
