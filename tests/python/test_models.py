@@ -65,8 +65,8 @@ def test_long_lift_batches_report_progress_and_keep_their_verdicts(monkeypatch):
     np.testing.assert_array_equal(chunked, whole)
     assert 0 < whole.sum() < len(whole)   # both verdicts occur
     touching = len(lines) and int(lines[-1].split("/")[1].split()[0])
-    assert touching > training.LIFT_CHUNK and all("done, about" in x for x in lines)
-    assert len(lines) == -(-touching // training.LIFT_CHUNK) - 1   # one line per batch but the last
+    assert touching > training.lift_chunk() and all("done, about" in x for x in lines)
+    assert len(lines) == -(-touching // training.lift_chunk()) - 1   # one line per batch but the last
 
 
 def test_bad_settings():

@@ -4,6 +4,7 @@ chooses the finger spread (and, for side grasps, the height and roll) and the lo
 calibration of P(S)."""
 from __future__ import annotations
 
+import os
 import time
 from typing import Callable, Optional
 
@@ -48,21 +49,27 @@ def simulate_training_data(world: World, settings: ModelSettings, seed_offset: i
     return rel[ok], np.asarray(b.joint_angles)[ok], np.asarray(b.epsilon)[ok]
 
 
-LIFT_CHUNK = 32        # lift tests per batch when progress is reported
 PROGRESS_EVERY = 5.0   # s between progress lines
+
+
+def lift_chunk() -> int:
+    """Lift tests per batch when progress is reported: 4 per core (a test of a concave object
+    can take a second, so a batch stays within a few seconds and every core stays busy)."""
+    return 4 * (os.cpu_count() or 1)
 
 
 def lifted_in_chunks(variant: Variant, world: World, rel: np.ndarray, say: Optional[Callable[[str], None]] = None,
                      what: str = "lift tests") -> np.ndarray:
     """(n,) bool: the lift test of each relative grasp of ``variant``. With ``say``, run in batches
-    of LIFT_CHUNK and report "what: k/n done, about s left" at most every PROGRESS_EVERY seconds
-    (each grasp's test is independent of the batch, so the verdicts are the same)."""
-    if say is None or len(rel) <= LIFT_CHUNK:
+    of :func:`lift_chunk` and report "what: k/n done, about s left" at most every PROGRESS_EVERY
+    seconds (each grasp's test is independent of the batch, so the verdicts are the same)."""
+    chunk = lift_chunk()
+    if say is None or len(rel) <= chunk:
         return np.asarray(variant.simulate(world, rel, lift=True, quality=False).lifted, bool)
     out = np.empty(len(rel), dtype=bool)
     start = last = time.monotonic()
-    for s in range(0, len(rel), LIFT_CHUNK):
-        e = min(s + LIFT_CHUNK, len(rel))
+    for s in range(0, len(rel), chunk):
+        e = min(s + chunk, len(rel))
         out[s:e] = np.asarray(variant.simulate(world, rel[s:e], lift=True, quality=False).lifted, bool)
         now = time.monotonic()
         if now - last >= PROGRESS_EVERY and e < len(rel):
