@@ -17,8 +17,10 @@ import time
 
 import numpy as np
 
-from bayesgrasp.experiments import EpisodeSettings, RunContext, run_episode
 from bayesgrasp.planners import ExplorationPlanner, PlannerSettings, StabilityPlanner, get_models
+
+sys.path.insert(0, __file__.rsplit("/", 1)[0])
+from planner_decision import problem  # noqa: E402
 
 SIZES = (500, 5000, 50000)
 
@@ -41,12 +43,7 @@ def main() -> None:
     for obj in a.objects.split(","):
         models = get_models(obj)
         for r in range(a.reps):
-            pose = np.array([rng.uniform(-0.08, 0.08), rng.uniform(-0.08, 0.08), rng.uniform(-np.pi, np.pi)])
-            est = pose + rng.uniform(-1, 1, 3) * np.array([0.04, 0.04, np.radians(45)])
-            ep = run_episode(obj, pose, EpisodeSettings(method="stability", attempts=1, stop_when_stable=False),
-                             RunContext(success="epsilon", lift=False), seed=r, estimate=est, models=models)
-            a0 = ep["attempts"][0]
-            obs = (np.array(a0["action"]), np.array(a0["joint_angles"]), a0["stable"])
+            est, obs = problem(obj, models, rng, r)
             for belief, observe in (("initial", None), ("after a failed grasp", obs)):
                 for n in SIZES:
                     for name, cls in (("stability", StabilityPlanner), ("explore", ExplorationPlanner)):

@@ -58,10 +58,10 @@ def lift_chunk() -> int:
     return 4 * (os.cpu_count() or 1)
 
 
-def lifted_in_chunks(variant: Variant, world: World, rel: np.ndarray, say: Optional[Callable[[str], None]] = None,
-                     what: str = "lift tests") -> np.ndarray:
+def lifted_in_chunks(variant: Variant, world: World, rel: np.ndarray,
+                     say: Optional[Callable[[str], None]] = None) -> np.ndarray:
     """(n,) bool: the lift test of each relative grasp of ``variant``. With ``say``, run in batches
-    of :func:`lift_chunk` and report "what: k/n done, about s left" at most every PROGRESS_EVERY
+    of :func:`lift_chunk` and report "lift tests: k/n done, about s left" at most every PROGRESS_EVERY
     seconds (each grasp's test is independent of the batch, so the verdicts are the same)."""
     chunk = lift_chunk()
     if say is None or len(rel) <= chunk:
@@ -73,7 +73,7 @@ def lifted_in_chunks(variant: Variant, world: World, rel: np.ndarray, say: Optio
         out[s:e] = np.asarray(variant.simulate(world, rel[s:e], lift=True, quality=False).lifted, bool)
         now = time.monotonic()
         if now - last >= PROGRESS_EVERY and e < len(rel):
-            say(f"  {what}: {e}/{len(rel)} done, about {(now - start) / e * (len(rel) - e):.0f} s left")
+            say(f"  lift tests: {e}/{len(rel)} done, about {(now - start) / e * (len(rel) - e):.0f} s left")
             last = now
     return out
 
