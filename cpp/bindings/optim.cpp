@@ -10,6 +10,7 @@
 #include "bayesgrasp/optim/firefly.hpp"
 #include "bayesgrasp/optim/pso.hpp"
 #include "bayesgrasp/optim/trust_region.hpp"
+#include "options.hpp"
 #include "validate.hpp"
 
 namespace bayesgrasp::bind {
@@ -124,117 +125,88 @@ void bind_result(py::module_& m) {
 
 /// The fields every population optimiser's options share (op::PopulationOptions).
 template <class Options>
-void def_population_fields(py::class_<Options>& c, const char* size_name) {
-  c.def_readwrite("seed", &Options::seed, "seed : int\n    Seed of the optimiser's generator.")
-      .def_readwrite("target", &Options::target, "target : float\n    Stop once the best value is <= target.")
-      .def_readwrite("record_history", &Options::record_history,
-                     "record_history : bool\n    Record the best value after each iteration.")
-      .def_readwrite("init", &Options::init,
-                     (std::string("init : numpy.ndarray\n    Optional (") + size_name +
-                      ", D) starting points, clipped into the box; empty = uniform in the box.")
-                         .c_str());
+void finish_population(OptionClass<Options>& c, const char* size_name) {
+  c.field("seed", &Options::seed, "int", "Seed of the optimiser's generator.")
+      .field("target", &Options::target, "float", "Stop once the best value is <= target.")
+      .field("record_history", &Options::record_history, "bool", "Record the best value after each iteration.")
+      .field("init", &Options::init, "numpy.ndarray",
+             (std::string("Optional (") + size_name + ", D) starting points, clipped into the box; empty = uniform in "
+                                                      "the box.").c_str())
+      .validator([](const Options& o) { op::validate(o); })
+      .finish();
 }
 
 void bind_global_options(py::module_& m) {
-  py::class_<op::PSOOptions> pso(m, "PSOOptions", "Options of pso (defaults: Clerc & Kennedy's constriction).");
-  pso.def(py::init<>())
-      .def_readwrite("n_particles", &op::PSOOptions::n_particles, "n_particles : int\n    Swarm size, >= 1.")
-      .def_readwrite("max_iter", &op::PSOOptions::max_iter,
-                     "max_iter : int\n    Swarm updates after the initial evaluation, >= 0.")
-      .def_readwrite("inertia", &op::PSOOptions::inertia, "inertia : float\n    Velocity inertia weight.")
-      .def_readwrite("c1", &op::PSOOptions::c1, "c1 : float\n    Cognitive (own best) weight.")
-      .def_readwrite("c2", &op::PSOOptions::c2, "c2 : float\n    Social (swarm best) weight.")
-      .def_readwrite("vmax_fraction", &op::PSOOptions::vmax_fraction,
-                     "vmax_fraction : float\n    Velocity bound as a fraction of the range, > 0.")
-      .def_readwrite("stall_iter", &op::PSOOptions::stall_iter,
-                     "stall_iter : int\n    Stop after this many iterations improving by at most ftol (0: off).")
-      .def_readwrite("ftol", &op::PSOOptions::ftol, "ftol : float\n    Improvement that resets the stall count.");
-  def_population_fields(pso, "n_particles");
+  OptionClass<op::PSOOptions> pso(m, "PSOOptions", "Options of pso (defaults: Clerc & Kennedy's constriction).");
+  pso.field("n_particles", &op::PSOOptions::n_particles, "int", "Swarm size, >= 1.")
+      .field("max_iter", &op::PSOOptions::max_iter, "int", "Swarm updates after the initial evaluation, >= 0.")
+      .field("inertia", &op::PSOOptions::inertia, "float", "Velocity inertia weight.")
+      .field("c1", &op::PSOOptions::c1, "float", "Cognitive (own best) weight.")
+      .field("c2", &op::PSOOptions::c2, "float", "Social (swarm best) weight.")
+      .field("vmax_fraction", &op::PSOOptions::vmax_fraction, "float", "Velocity bound as a fraction of the range, > 0.")
+      .field("stall_iter", &op::PSOOptions::stall_iter, "int", "Stop after this many iterations improving by at most ftol (0: off).")
+      .field("ftol", &op::PSOOptions::ftol, "float", "Improvement that resets the stall count.");
+  finish_population(pso, "n_particles");
 
-  py::class_<op::AnnealingOptions> sa(m, "AnnealingOptions", "Options of simulated_annealing.");
-  sa.def(py::init<>())
-      .def_readwrite("n_chains", &op::AnnealingOptions::n_chains, "n_chains : int\n    Metropolis chains, >= 1.")
-      .def_readwrite("max_iter", &op::AnnealingOptions::max_iter,
-                     "max_iter : int\n    Proposals per chain after the initial evaluation, >= 0.")
-      .def_readwrite("t0", &op::AnnealingOptions::t0,
-                     "t0 : float\n    Initial temperature; <= 0: the std of f over the initial points.")
-      .def_readwrite("cooling", &op::AnnealingOptions::cooling,
-                     "cooling : float\n    Geometric cooling factor T_k = t0 cooling^k, in (0, 1].")
-      .def_readwrite("step", &op::AnnealingOptions::step,
-                     "step : float\n    Initial proposal std as a fraction of the range, > 0.")
-      .def_readwrite("step_min", &op::AnnealingOptions::step_min,
-                     "step_min : float\n    Lower bound of the adapted step (fraction of the range), > 0.")
-      .def_readwrite("step_max", &op::AnnealingOptions::step_max,
-                     "step_max : float\n    Upper bound of the adapted step, >= step_min.")
-      .def_readwrite("adapt_interval", &op::AnnealingOptions::adapt_interval,
-                     "adapt_interval : int\n    Iterations between step adaptations (0 = fixed step).")
-      .def_readwrite("target_acceptance", &op::AnnealingOptions::target_acceptance,
-                     "target_acceptance : float\n    Acceptance rate the step adapts towards, in (0, 1).")
-      .def_readwrite("adapt_factor", &op::AnnealingOptions::adapt_factor,
-                     "adapt_factor : float\n    Step growth / shrink factor, > 1.");
-  def_population_fields(sa, "n_chains");
+  OptionClass<op::AnnealingOptions> sa(m, "AnnealingOptions", "Options of simulated_annealing.");
+  sa.field("n_chains", &op::AnnealingOptions::n_chains, "int", "Metropolis chains, >= 1.")
+      .field("max_iter", &op::AnnealingOptions::max_iter, "int", "Proposals per chain after the initial evaluation, >= 0.")
+      .field("t0", &op::AnnealingOptions::t0, "float", "Initial temperature; <= 0: the std of f over the initial points.")
+      .field("cooling", &op::AnnealingOptions::cooling, "float", "Geometric cooling factor T_k = t0 cooling^k, in (0, 1].")
+      .field("step", &op::AnnealingOptions::step, "float", "Initial proposal std as a fraction of the range, > 0.")
+      .field("step_min", &op::AnnealingOptions::step_min, "float", "Lower bound of the adapted step (fraction of the range), > 0.")
+      .field("step_max", &op::AnnealingOptions::step_max, "float", "Upper bound of the adapted step, >= step_min.")
+      .field("adapt_interval", &op::AnnealingOptions::adapt_interval, "int", "Iterations between step adaptations (0 = fixed step).")
+      .field("target_acceptance", &op::AnnealingOptions::target_acceptance, "float", "Acceptance rate the step adapts towards, in (0, 1).")
+      .field("adapt_factor", &op::AnnealingOptions::adapt_factor, "float", "Step growth / shrink factor, > 1.");
+  finish_population(sa, "n_chains");
 
-  py::class_<op::FireflyOptions> ff(m, "FireflyOptions", "Options of firefly (Yang 2008).");
-  ff.def(py::init<>())
-      .def_readwrite("n_fireflies", &op::FireflyOptions::n_fireflies, "n_fireflies : int\n    Population, >= 1.")
-      .def_readwrite("max_iter", &op::FireflyOptions::max_iter,
-                     "max_iter : int\n    Generations after the initial evaluation, >= 0.")
-      .def_readwrite("beta0", &op::FireflyOptions::beta0, "beta0 : float\n    Attractiveness at distance 0, >= 0.")
-      .def_readwrite("gamma", &op::FireflyOptions::gamma,
-                     "gamma : float\n    Light absorption (unit-box coordinates), >= 0.")
-      .def_readwrite("alpha", &op::FireflyOptions::alpha,
-                     "alpha : float\n    Initial random step (fraction of the range), >= 0.")
-      .def_readwrite("alpha_decay", &op::FireflyOptions::alpha_decay,
-                     "alpha_decay : float\n    alpha_k = alpha alpha_decay^k, in (0, 1].");
-  def_population_fields(ff, "n_fireflies");
+  OptionClass<op::FireflyOptions> ff(m, "FireflyOptions", "Options of firefly (Yang 2008).");
+  ff.field("n_fireflies", &op::FireflyOptions::n_fireflies, "int", "Population, >= 1.")
+      .field("max_iter", &op::FireflyOptions::max_iter, "int", "Generations after the initial evaluation, >= 0.")
+      .field("beta0", &op::FireflyOptions::beta0, "float", "Attractiveness at distance 0, >= 0.")
+      .field("gamma", &op::FireflyOptions::gamma, "float", "Light absorption (unit-box coordinates), >= 0.")
+      .field("alpha", &op::FireflyOptions::alpha, "float", "Initial random step (fraction of the range), >= 0.")
+      .field("alpha_decay", &op::FireflyOptions::alpha_decay, "float", "alpha_k = alpha alpha_decay^k, in (0, 1].");
+  finish_population(ff, "n_fireflies");
 }
 
 void bind_local_options(py::module_& m) {
-  py::class_<op::DescentOptions>(m, "DescentOptions", "Options of steepest_descent.")
-      .def(py::init<>())
-      .def_readwrite("max_iter", &op::DescentOptions::max_iter, "max_iter : int\n    Iterations, >= 0.")
-      .def_readwrite("h", &op::DescentOptions::h, "h : float\n    Relative finite-difference step, > 0.")
-      .def_readwrite("t0", &op::DescentOptions::t0, "t0 : float\n    First trial step length, > 0.")
-      .def_readwrite("armijo", &op::DescentOptions::armijo,
-                     "armijo : float\n    Sufficient-decrease constant, in (0, 1).")
-      .def_readwrite("backtrack", &op::DescentOptions::backtrack,
-                     "backtrack : float\n    Step shrink factor, in (0, 1).")
-      .def_readwrite("max_backtrack", &op::DescentOptions::max_backtrack,
-                     "max_backtrack : int\n    Line-search trials per iteration.")
-      .def_readwrite("gtol", &op::DescentOptions::gtol,
-                     "gtol : float\n    Stop when the projected gradient's max-norm is below gtol.")
-      .def_readwrite("ftol", &op::DescentOptions::ftol,
-                     "ftol : float\n    Stop when the relative decrease is below ftol.")
-      .def_readwrite("record_history", &op::DescentOptions::record_history,
-                     "record_history : bool\n    Record the value after each iteration.");
+  OptionClass<op::DescentOptions>(m, "DescentOptions", "Options of steepest_descent.")
+      .field("max_iter", &op::DescentOptions::max_iter, "int", "Iterations, >= 0.")
+      .field("h", &op::DescentOptions::h, "float", "Relative finite-difference step, > 0.")
+      .field("t0", &op::DescentOptions::t0, "float", "First trial step length, > 0.")
+      .field("armijo", &op::DescentOptions::armijo, "float", "Sufficient-decrease constant, in (0, 1).")
+      .field("backtrack", &op::DescentOptions::backtrack, "float", "Step shrink factor, in (0, 1).")
+      .field("max_backtrack", &op::DescentOptions::max_backtrack, "int", "Line-search trials per iteration.")
+      .field("gtol", &op::DescentOptions::gtol, "float", "Stop when the projected gradient's max-norm is below gtol.")
+      .field("ftol", &op::DescentOptions::ftol, "float", "Stop when the relative decrease is below ftol.")
+      .field("record_history", &op::DescentOptions::record_history, "bool", "Record the value after each iteration.")
+      .validator([](const op::DescentOptions& o) { op::validate(o); })
+      .finish();
 
-  py::class_<op::LMOptions>(m, "LMOptions", "Options of levenberg_marquardt.")
-      .def(py::init<>())
-      .def_readwrite("max_iter", &op::LMOptions::max_iter, "max_iter : int\n    Iterations, >= 0.")
-      .def_readwrite("h", &op::LMOptions::h, "h : float\n    Relative finite-difference step, > 0.")
-      .def_readwrite("lambda0", &op::LMOptions::lambda0,
-                     "lambda0 : float\n    Initial damping relative to max diag(J^T J), > 0.")
-      .def_readwrite("gtol", &op::LMOptions::gtol, "gtol : float\n    Stop when max |J^T r| < gtol.")
-      .def_readwrite("xtol", &op::LMOptions::xtol, "xtol : float\n    Stop when |dx| < xtol (|x| + xtol).")
-      .def_readwrite("ftol", &op::LMOptions::ftol, "ftol : float\n    Stop when 1/2 |r|^2 < ftol.")
-      .def_readwrite("record_history", &op::LMOptions::record_history,
-                     "record_history : bool\n    Record the value after each iteration.");
+  OptionClass<op::LMOptions>(m, "LMOptions", "Options of levenberg_marquardt.")
+      .field("max_iter", &op::LMOptions::max_iter, "int", "Iterations, >= 0.")
+      .field("h", &op::LMOptions::h, "float", "Relative finite-difference step, > 0.")
+      .field("lambda0", &op::LMOptions::lambda0, "float", "Initial damping relative to max diag(J^T J), > 0.")
+      .field("gtol", &op::LMOptions::gtol, "float", "Stop when max |J^T r| < gtol.")
+      .field("xtol", &op::LMOptions::xtol, "float", "Stop when |dx| < xtol (|x| + xtol).")
+      .field("ftol", &op::LMOptions::ftol, "float", "Stop when 1/2 |r|^2 < ftol.")
+      .field("record_history", &op::LMOptions::record_history, "bool", "Record the value after each iteration.")
+      .validator([](const op::LMOptions& o) { op::validate(o); })
+      .finish();
 
-  py::class_<op::TrustRegionOptions>(m, "TrustRegionOptions", "Options of trust_region.")
-      .def(py::init<>())
-      .def_readwrite("max_iter", &op::TrustRegionOptions::max_iter, "max_iter : int\n    Iterations, >= 0.")
-      .def_readwrite("h", &op::TrustRegionOptions::h, "h : float\n    Relative finite-difference step, > 0.")
-      .def_readwrite("radius0", &op::TrustRegionOptions::radius0, "radius0 : float\n    Initial trust radius, > 0.")
-      .def_readwrite("max_radius", &op::TrustRegionOptions::max_radius,
-                     "max_radius : float\n    Largest trust radius.")
-      .def_readwrite("eta", &op::TrustRegionOptions::eta,
-                     "eta : float\n    Accept a step when actual / predicted reduction > eta, in [0, 0.25).")
-      .def_readwrite("gtol", &op::TrustRegionOptions::gtol,
-                     "gtol : float\n    Stop when the gradient's max-norm < gtol.")
-      .def_readwrite("xtol", &op::TrustRegionOptions::xtol,
-                     "xtol : float\n    Stop when the trust radius < xtol (|x| + xtol).")
-      .def_readwrite("record_history", &op::TrustRegionOptions::record_history,
-                     "record_history : bool\n    Record the value after each iteration.");
+  OptionClass<op::TrustRegionOptions>(m, "TrustRegionOptions", "Options of trust_region.")
+      .field("max_iter", &op::TrustRegionOptions::max_iter, "int", "Iterations, >= 0.")
+      .field("h", &op::TrustRegionOptions::h, "float", "Relative finite-difference step, > 0.")
+      .field("radius0", &op::TrustRegionOptions::radius0, "float", "Initial trust radius, > 0.")
+      .field("max_radius", &op::TrustRegionOptions::max_radius, "float", "Largest trust radius.")
+      .field("eta", &op::TrustRegionOptions::eta, "float", "Accept a step when actual / predicted reduction > eta, in [0, 0.25).")
+      .field("gtol", &op::TrustRegionOptions::gtol, "float", "Stop when the gradient's max-norm < gtol.")
+      .field("xtol", &op::TrustRegionOptions::xtol, "float", "Stop when the trust radius < xtol (|x| + xtol).")
+      .field("record_history", &op::TrustRegionOptions::record_history, "bool", "Record the value after each iteration.")
+      .validator([](const op::TrustRegionOptions& o) { op::validate(o); })
+      .finish();
 }
 
 /// Binds a global optimiser f(objective, bounds, options) as name(objective, low, high, options).

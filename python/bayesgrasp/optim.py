@@ -20,7 +20,7 @@ from __future__ import annotations
 
 from typing import Callable, Optional, Sequence, Tuple, Union
 
-from bayesgrasp._args import c_int, c_seed
+from bayesgrasp._args import with_fields
 import numpy as np
 
 from bayesgrasp import _core
@@ -30,7 +30,8 @@ _c = _core.optim
 Objective = Union[str, Callable[[np.ndarray], np.ndarray]]
 Bounds = Union[Tuple[Sequence[float], Sequence[float]], np.ndarray]
 
-__all__ = ["OptimizeResult", "pso", "simulated_annealing", "firefly", "steepest_descent",
+__all__ = ["OptimizeResult", "PSOOptions", "AnnealingOptions", "FireflyOptions", "DescentOptions", "LMOptions",
+           "TrustRegionOptions", "pso", "simulated_annealing", "firefly", "steepest_descent",
            "levenberg_marquardt", "trust_region", "rastrigin", "ackley", "sphere", "rosenbrock"]
 
 #: What every optimiser returns (bound C++ class): x (D,) best point; fun (for
@@ -38,24 +39,12 @@ __all__ = ["OptimizeResult", "pso", "simulated_annealing", "firefly", "steepest_
 #: best value after each iteration (if ``record_history``); converged (a tolerance or the target was
 #: met); message (why it stopped).
 OptimizeResult = _c.OptimizeResult
-
-
-def _options(cls, settings: dict):
-    """An options object of the bound class ``cls`` with the given fields (None keeps the default),
-    each value converted to the type of the field's default."""
-    o = cls()
-    for name, value in settings.items():
-        if value is None:
-            continue
-        default = getattr(o, name)
-        if isinstance(default, bool):
-            value = bool(value)
-        elif isinstance(default, int):
-            value = c_seed(value, name) if name == "seed" else c_int(value, name)
-        elif isinstance(default, float):
-            value = float(value)
-        setattr(o, name, value)
-    return o
+PSOOptions = _c.PSOOptions
+AnnealingOptions = _c.AnnealingOptions
+FireflyOptions = _c.FireflyOptions
+DescentOptions = _c.DescentOptions
+LMOptions = _c.LMOptions
+TrustRegionOptions = _c.TrustRegionOptions
 
 
 def _bounds(bounds, name="bounds"):
@@ -83,97 +72,74 @@ def _objective(fun: Objective, name="objective"):
     raise ValueError(f"{name}: expected a vectorised callable (N, D) -> (N,) or a built-in name, got {type(fun)}")
 
 
-def pso(fun: Objective, bounds: Bounds, *, n_particles: int = 40, max_iter: int = 200,
-        inertia: float = 0.7298, c1: float = 1.49618, c2: float = 1.49618, vmax_fraction: float = 0.5,
-        seed: int = 0, target: float = -np.inf, stall_iter: int = 0, ftol: float = 0.0,
-        init: Optional[np.ndarray] = None, record_history: bool = False) -> OptimizeResult:
+def pso(fun: Objective, bounds: Bounds, options: Optional["PSOOptions"] = None, **fields) -> OptimizeResult:
     """Particle swarm optimisation (global best) of ``fun`` over the box ``bounds``.
 
-    Constriction-equivalent defaults (Clerc & Kennedy): inertia 0.7298, c1 = c2 = 1.49618.
+    ``options``: a :class:`PSOOptions` (defaults: Clerc & Kennedy's constriction, inertia 0.7298,
+    c1 = c2 = 1.49618); its fields may also be given by keyword (``n_particles=80, seed=3``).
     Velocities are clamped to ``vmax_fraction`` of the range; particles leaving the box are put on
     its face with that velocity component zeroed. Stops after ``max_iter`` swarm updates, when the
     best value reaches ``target``, or after ``stall_iter`` iterations improving by at most ``ftol``.
     nfev = n_particles * (nit + 1).
     """
     low, high = _bounds(bounds)
-    o = _options(_c.PSOOptions, dict(n_particles=n_particles, max_iter=max_iter, inertia=inertia, c1=c1, c2=c2,
-                                     vmax_fraction=vmax_fraction, seed=seed, target=target, stall_iter=stall_iter,
-                                     ftol=ftol, init=init, record_history=record_history))
-    return _c.pso(_objective(fun), low, high, o)
+    return _c.pso(_objective(fun), low, high, with_fields(PSOOptions, options, fields))
 
 
-def simulated_annealing(fun: Objective, bounds: Bounds, *, n_chains: int = 16, max_iter: int = 1000,
-                        t0: float = -1.0, cooling: float = 0.98, step: float = 0.1, step_min: float = 1e-9,
-                        step_max: float = 0.5, adapt_interval: int = 10, target_acceptance: float = 0.2,
-                        adapt_factor: float = 1.5, seed: int = 0, target: float = -np.inf,
-                        init: Optional[np.ndarray] = None, record_history: bool = False) -> OptimizeResult:
+def simulated_annealing(fun: Objective, bounds: Bounds, options: Optional["AnnealingOptions"] = None,
+                        **fields) -> OptimizeResult:
     """Simulated annealing: ``n_chains`` Metropolis chains evaluated as one batch per iteration.
 
-    Gaussian random-walk proposals (std ``step`` x range, reflected into the box), each chain
-    adapting its step every ``adapt_interval`` iterations towards ``target_acceptance``; geometric
-    cooling T_k = t0 * cooling^k (t0 <= 0: the std of f over the initial points).
-    nfev = n_chains * (nit + 1).
+    ``options``: an :class:`AnnealingOptions`, its fields also by keyword. Gaussian random-walk
+    proposals (std ``step`` x range, reflected into the box), each chain adapting its step every
+    ``adapt_interval`` iterations towards ``target_acceptance``; geometric cooling
+    T_k = t0 * cooling^k (t0 <= 0: the std of f over the initial points). nfev = n_chains * (nit + 1).
     """
     low, high = _bounds(bounds)
-    o = _options(_c.AnnealingOptions, dict(n_chains=n_chains, max_iter=max_iter, t0=t0, cooling=cooling, step=step,
-                                           step_min=step_min, step_max=step_max, adapt_interval=adapt_interval,
-                                           target_acceptance=target_acceptance, adapt_factor=adapt_factor,
-                                           seed=seed, target=target, init=init, record_history=record_history))
-    return _c.simulated_annealing(_objective(fun), low, high, o)
+    return _c.simulated_annealing(_objective(fun), low, high, with_fields(AnnealingOptions, options, fields))
 
 
-def firefly(fun: Objective, bounds: Bounds, *, n_fireflies: int = 25, max_iter: int = 100, beta0: float = 1.0,
-            gamma: float = 1.0, alpha: float = 0.2, alpha_decay: float = 0.97, seed: int = 0,
-            target: float = -np.inf, init: Optional[np.ndarray] = None,
-            record_history: bool = False) -> OptimizeResult:
-    """The firefly algorithm (Yang 2008).
+def firefly(fun: Objective, bounds: Bounds, options: Optional["FireflyOptions"] = None, **fields) -> OptimizeResult:
+    """The firefly algorithm (Yang 2008). ``options``: a :class:`FireflyOptions`, its fields also by keyword.
 
     Firefly i moves towards each brighter j by beta0 exp(-gamma r_ij^2)(x_j - x_i) plus
     alpha (u - 1/2); alpha decays by ``alpha_decay`` per generation. Distances and steps are in
     unit-box coordinates (each dimension divided by its range). nfev = n_fireflies * (nit + 1).
     """
     low, high = _bounds(bounds)
-    o = _options(_c.FireflyOptions, dict(n_fireflies=n_fireflies, max_iter=max_iter, beta0=beta0, gamma=gamma,
-                                         alpha=alpha, alpha_decay=alpha_decay, seed=seed, target=target, init=init,
-                                         record_history=record_history))
-    return _c.firefly(_objective(fun), low, high, o)
+    return _c.firefly(_objective(fun), low, high, with_fields(FireflyOptions, options, fields))
 
 
-def steepest_descent(fun: Objective, x0, bounds: Optional[Bounds] = None, *, max_iter: int = 500,
-                     h: float = 1e-6, t0: float = 1.0, armijo: float = 1e-4, backtrack: float = 0.5,
-                     max_backtrack: int = 40, gtol: float = 1e-8, ftol: float = 1e-14,
-                     record_history: bool = False) -> OptimizeResult:
+def steepest_descent(fun: Objective, x0, bounds: Optional[Bounds] = None, options: Optional["DescentOptions"] = None,
+                     **fields) -> OptimizeResult:
     """Steepest descent from ``x0``: central-difference gradients (one batch of 2D rows, step
-    h * max(1, |x_k|)) and Armijo backtracking; projected onto ``bounds`` if given."""
+    h * max(1, |x_k|)) and Armijo backtracking; projected onto ``bounds`` if given.
+    ``options``: a :class:`DescentOptions`, its fields also by keyword."""
     low, high = _bounds(bounds)
-    o = _options(_c.DescentOptions, dict(max_iter=max_iter, h=h, t0=t0, armijo=armijo, backtrack=backtrack,
-                                         max_backtrack=max_backtrack, gtol=gtol, ftol=ftol,
-                                         record_history=record_history))
-    return _c.steepest_descent(_objective(fun), np.asarray(x0, dtype=float), low, high, o)
+    return _c.steepest_descent(_objective(fun), np.asarray(x0, dtype=float), low, high,
+                               with_fields(DescentOptions, options, fields))
 
 
-def levenberg_marquardt(residuals: Callable[[np.ndarray], np.ndarray], x0, bounds: Optional[Bounds] = None, *,
-                        max_iter: int = 200, h: float = 1e-6, lambda0: float = 1e-3, gtol: float = 1e-10,
-                        xtol: float = 1e-12, ftol: float = 1e-15, record_history: bool = False) -> OptimizeResult:
+def levenberg_marquardt(residuals: Callable[[np.ndarray], np.ndarray], x0, bounds: Optional[Bounds] = None,
+                        options: Optional["LMOptions"] = None, **fields) -> OptimizeResult:
     """Levenberg-Marquardt on 1/2 |r(x)|^2. ``residuals`` maps (N, D) -> (N, R); the Jacobian is
-    taken by central differences in one batch call. ``fun`` in the result is 1/2 |r|^2."""
+    taken by central differences in one batch call. ``fun`` in the result is 1/2 |r|^2.
+    ``options``: an :class:`LMOptions`, its fields also by keyword."""
     if not callable(residuals):
         raise ValueError("residuals: expected a vectorised callable (N, D) -> (N, R)")
     low, high = _bounds(bounds)
-    o = _options(_c.LMOptions, dict(max_iter=max_iter, h=h, lambda0=lambda0, gtol=gtol, xtol=xtol, ftol=ftol,
-                                    record_history=record_history))
-    return _c.levenberg_marquardt(residuals, np.asarray(x0, dtype=float), low, high, o)
+    return _c.levenberg_marquardt(residuals, np.asarray(x0, dtype=float), low, high,
+                                  with_fields(LMOptions, options, fields))
 
 
-def trust_region(fun: Objective, x0, bounds: Optional[Bounds] = None, *, max_iter: int = 200, h: float = 1e-6,
-                 radius0: float = 1.0, max_radius: float = 1e6, eta: float = 1e-4, gtol: float = 1e-8,
-                 xtol: float = 1e-12, record_history: bool = False) -> OptimizeResult:
+def trust_region(fun: Objective, x0, bounds: Optional[Bounds] = None, options: Optional["TrustRegionOptions"] = None,
+                 **fields) -> OptimizeResult:
     """Dogleg trust region with central-difference gradients and BFGS Hessian updates, for scalar
-    objectives such as a negative log posterior of a pose (Eq. 4.4)."""
+    objectives such as a negative log posterior of a pose (Eq. 4.4). ``options``: a
+    :class:`TrustRegionOptions`, its fields also by keyword."""
     low, high = _bounds(bounds)
-    o = _options(_c.TrustRegionOptions, dict(max_iter=max_iter, h=h, radius0=radius0, max_radius=max_radius,
-                                             eta=eta, gtol=gtol, xtol=xtol, record_history=record_history))
-    return _c.trust_region(_objective(fun), np.asarray(x0, dtype=float), low, high, o)
+    return _c.trust_region(_objective(fun), np.asarray(x0, dtype=float), low, high,
+                           with_fields(TrustRegionOptions, options, fields))
 
 
 def _builtin(name):

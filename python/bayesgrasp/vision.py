@@ -47,7 +47,7 @@ import math
 from dataclasses import dataclass, field
 from typing import Any, Callable, Dict, List, Optional, Sequence, Tuple, Union
 
-from bayesgrasp._args import c_int, c_seed
+from bayesgrasp._args import c_int, c_seed, with_fields
 import numpy as np
 
 from bayesgrasp import _core as _bgcore
@@ -57,7 +57,7 @@ __all__ = [
     "Camera", "SegmentationResult", "RegistrationResult", "Registrar", "segment_table", "register",
     "model_samples", "rotation_error", "as_cloud", "as_mesh", "registration_options",
     "RegistrationOptions", "FeatureOptions", "CorrespondenceOptions", "RansacOptions", "IcpOptions", "UpPrior",
-    "FeatureEstimator", "RegistrationStatus",
+    "FeatureEstimator", "RegistrationStatus", "Intrinsics", "Table", "NoiseModel", "SegmentationOptions",
 ]
 
 _v = _bgcore.vision
@@ -70,6 +70,11 @@ IcpOptions = _v.IcpOptions
 UpPrior = _v.UpPrior
 FeatureEstimator = _v.FeatureEstimator
 RegistrationStatus = _v.RegistrationStatus
+Intrinsics = _v.Intrinsics
+Table = _v.Table
+NoiseModel = _v.NoiseModel
+SegmentationOptions = _v.SegmentationOptions
+SegmentationResult = _v.SegmentationResult
 
 
 # ---------------------------------------------------------------------------------------------
@@ -144,24 +149,28 @@ class Camera:
     def K(self) -> np.ndarray:
         return np.array([[self.fx, 0, self.cx], [0, self.fy, self.cy], [0, 0, 1.0]])
 
-    def _intr(self) -> dict:
-        return dict(fx=float(self.fx), fy=float(self.fy), cx=float(self.cx), cy=float(self.cy))
+    @property
+    def intrinsics(self) -> "Intrinsics":
+        """The core's :class:`Intrinsics` of this camera."""
+        return Intrinsics(width=c_int(self.width, "width"), height=c_int(self.height, "height"), fx=float(self.fx),
+                          fy=float(self.fy), cx=float(self.cx), cy=float(self.cy))
 
-    def render(self, meshes: Sequence, table: Union[bool, dict] = False, noise: bool = True, seed: int = 0,
-               **noise_params) -> Tuple[np.ndarray, np.ndarray]:
+    def render(self, meshes: Sequence, table: Union[bool, dict, "Table"] = False, noise: Union[bool, "NoiseModel"] = True,
+               seed: int = 0, **noise_fields) -> Tuple[np.ndarray, np.ndarray]:
         """Ray-casts ``meshes`` (world frame; (V, F) tuples or mesh objects) and optionally the table
-        (True: 1 x 1 m at z = 0 centred at the origin; or a dict with ``z``, ``center`` (x, y),
-        ``half_extents`` (hx, hy), inf allowed). Returns (depth (H, W) in metres with NaN where
-        nothing is measured, label (H, W): index of the mesh seen, -2 table, -1 nothing).
-        ``noise_params``: sigma_a, sigma_b, baseline, disparity_step, max_incidence_deg, edge_jump,
-        edge_drop_prob, min_depth, max_depth (see ``_core.vision.render``)."""
+        (True: 1 x 1 m at z = 0 centred at the origin; a dict with ``z``, ``center`` (x, y),
+        ``half_extents`` (hx, hy), inf allowed; or a :class:`Table`). Returns (depth (H, W) in metres
+        with NaN where nothing is measured, label (H, W): index of the mesh seen, -2 table, -1 nothing).
+        ``noise``: on/off or a :class:`NoiseModel`; ``noise_fields`` set its fields (sigma_a, sigma_b,
+        baseline, disparity_step, max_incidence (rad), edge_jump, edge_drop_prob, min_depth, max_depth)."""
         ms = [as_mesh(m, f"meshes[{i}]") for i, m in enumerate(meshes)]
-        tb = {} if table is True or table is False else dict(table)
-        kw = dict(table=bool(table), table_z=float(tb.get("z", 0.0)),
-                  table_center=np.asarray(tb.get("center", (0.0, 0.0)), float),
-                  table_half_extents=np.asarray(tb.get("half_extents", (0.5, 0.5)), float))
-        depth, label = _v.render(ms, self.pose, width=c_int(self.width, "width"), height=c_int(self.height, "height"), **self._intr(),
-                                      noise=bool(noise), seed=c_seed(seed, "seed"), **kw, **noise_params)
+        nm = noise.__copy__() if isinstance(noise, NoiseModel) else NoiseModel(enabled=bool(noise))
+        nm.seed = c_seed(seed, "seed")
+        for key, value in noise_fields.items():
+            if key not in NoiseModel.fields:
+                raise ValueError(f"{key}: not a field of NoiseModel")
+            setattr(nm, key, value)
+        depth, label = _v.render(ms, self.pose, self.intrinsics, _table(table), nm)
         return np.asarray(depth), np.asarray(label)
 
     def points(self, depth: np.ndarray, world: bool = True, organised: bool = False) -> np.ndarray:
@@ -170,7 +179,7 @@ class Camera:
         depth = np.asarray(depth, dtype=np.float64)
         if depth.shape != (self.height, self.width):
             raise ValueError(f"depth: expected shape ({self.height}, {self.width}), got {depth.shape}")
-        P = np.asarray(_v.depth_to_points(depth, self.pose, **self._intr(), world=world, organised=organised))
+        P = np.asarray(_v.depth_to_points(depth, self.pose, self.intrinsics, world=world, organised=organised))
         return P.reshape(self.height, self.width, 3) if organised else P
 
     def capture(self, meshes: Sequence, table: Union[bool, dict] = False, noise: bool = True, seed: int = 0,
@@ -180,28 +189,31 @@ class Camera:
         return self.points(depth, world=world, organised=organised)
 
 
+def _table(table) -> "Table":
+    """A :class:`Table` from False / True / a dict (z, center, half_extents) / a Table."""
+    if isinstance(table, Table):
+        return table
+    if table is True or table is False:
+        return Table(enabled=bool(table))
+    tb = dict(table)
+    unknown = set(tb) - {"z", "center", "half_extents"}
+    if unknown:
+        raise ValueError(f"table: unknown keys {sorted(unknown)} (known: z, center, half_extents)")
+    cx, cy = (float(v) for v in tb.get("center", (0.0, 0.0)))
+    hx, hy = (float(v) for v in tb.get("half_extents", (0.5, 0.5)))
+    return Table(enabled=True, z=float(tb.get("z", 0.0)), center_x=cx, center_y=cy, half_x=hx, half_y=hy)
+
+
 # ---------------------------------------------------------------------------------------------
-@dataclass
-class SegmentationResult:
-    plane: np.ndarray                 # (a, b, c, d): a x + b y + c z + d = 0, unit normal along `up`
-    plane_inliers: np.ndarray         # row indices into the (flattened) input cloud
-    clusters: List[np.ndarray]        # row indices per object, largest first
-    cluster_points: List[np.ndarray]  # (n_i, 3) points per object
-
-
-def segment_table(cloud, plane_threshold: float = 0.006, min_height: float = 0.008, max_height: float = 1.0,
-                  cluster_tolerance: float = 0.01, min_cluster_size: int = 50, up=(0.0, 0.0, 1.0),
-                  plane_iterations: int = 1000) -> SegmentationResult:
+def segment_table(cloud, options: Optional[SegmentationOptions] = None, **fields) -> SegmentationResult:
     """Table plane by RANSAC, the points ``min_height``..``max_height`` above it, Euclidean
     clusters of those (largest first). ``cloud``: (N, 3), organised (H, W, 3) or an Open3D cloud;
-    NaN rows are ignored. ValueError if fewer than 3 finite points or no plane."""
-    P = as_cloud(cloud)
-    r = _v.segment_table(P, plane_threshold=plane_threshold, plane_iterations=plane_iterations,
-                              min_height=min_height, max_height=max_height, cluster_tolerance=cluster_tolerance,
-                              min_cluster_size=min_cluster_size, up=np.asarray(up, float))
-    clusters = [np.asarray(c, dtype=np.int64) for c in r["clusters"]]
-    return SegmentationResult(plane=np.asarray(r["plane"]), plane_inliers=np.asarray(r["plane_inliers"], np.int64),
-                              clusters=clusters, cluster_points=[P[c] for c in clusters])
+    NaN rows are ignored. ``options``: a :class:`SegmentationOptions`, its fields also given by
+    keyword (plane_threshold, plane_iterations, min_height, max_height, cluster_tolerance,
+    min_cluster_size, max_cluster_size, up). Returns a :class:`SegmentationResult` (plane,
+    plane_inliers, clusters, cluster_points). ValueError for a bad field (naming it), fewer than 3
+    finite points or no plane."""
+    return _v.segment_table(as_cloud(cloud), with_fields(SegmentationOptions, options, fields))
 
 
 # ---------------------------------------------------------------------------------------------

@@ -7,19 +7,25 @@
 
 namespace bayesgrasp::optim {
 
+void validate(const AnnealingOptions& o) {
+  require_at_least(o.n_chains, 1, "n_chains");
+  require_at_least(o.max_iter, 0, "max_iter");
+  require_finite(o.t0, "t0");  // <= 0: from the initial points
+  if (!(o.cooling > 0.0 && o.cooling <= 1.0)) bad_field("cooling", "in (0, 1]", number_str(o.cooling));
+  require_positive(o.step, "step");
+  require_positive(o.step_min, "step_min");
+  if (!(o.step_max >= o.step_min) || !std::isfinite(o.step_max))
+    bad_field("step_max", "finite and >= step_min", number_str(o.step_max));
+  require_at_least(o.adapt_interval, 0, "adapt_interval");
+  if (!(o.adapt_factor > 1.0) || !std::isfinite(o.adapt_factor))
+    bad_field("adapt_factor", "finite and > 1", number_str(o.adapt_factor));
+  require_open(o.target_acceptance, 0, 1, "target_acceptance");
+  validate_shared(o);
+}
+
 Result simulated_annealing(const BatchObjective& fun, const Bounds& b, const AnnealingOptions& o) {
   validate_bounds(b);
-  if (o.n_chains < 1) throw std::invalid_argument("n_chains: must be at least 1");
-  if (std::isnan(o.t0) || std::isinf(o.t0)) throw std::invalid_argument("t0: must be finite (<= 0: from the initial points)");
-  if (o.max_iter < 0) throw std::invalid_argument("max_iter: must be >= 0");
-  if (!(o.cooling > 0.0 && o.cooling <= 1.0)) throw std::invalid_argument("cooling: must be in (0, 1]");
-  if (!(o.step > 0.0)) throw std::invalid_argument("step: must be positive");
-  if (!(o.step_min > 0.0) || !(o.step_max >= o.step_min))
-    throw std::invalid_argument("step_min, step_max: need 0 < step_min <= step_max");
-  if (o.adapt_interval < 0) throw std::invalid_argument("adapt_interval: must be >= 0");
-  if (!(o.adapt_factor > 1.0)) throw std::invalid_argument("adapt_factor: must be > 1");
-  if (!(o.target_acceptance > 0.0 && o.target_acceptance < 1.0))
-    throw std::invalid_argument("target_acceptance: must be in (0, 1)");
+  validate(o);
   const int n = o.n_chains, d = b.dim();
   validate_population(o, n, d, "n_chains");
 

@@ -24,6 +24,9 @@ struct AnnealingOptions : PopulationOptions {
 };
 
 /// Proposals leaving the box are reflected back into it. Evaluations = n_chains * (iterations + 1).
+/// Throws std::invalid_argument naming the first bad field.
+void validate(const AnnealingOptions& o);
+
 Result simulated_annealing(const BatchObjective& fun, const Bounds& bounds, const AnnealingOptions& opt = {});
 
 }  // namespace bayesgrasp::optim

@@ -45,12 +45,21 @@ Eigen::VectorXd numerical_gradient(Evaluator& eval, const Eigen::VectorXd& x, do
   return g;
 }
 
+void validate(const DescentOptions& o) {
+  require_at_least(o.max_iter, 0, "max_iter");
+  require_positive(o.h, "h");
+  require_positive(o.t0, "t0");
+  require_open(o.armijo, 0, 1, "armijo");
+  require_open(o.backtrack, 0, 1, "backtrack");
+  require_at_least(o.max_backtrack, 0, "max_backtrack");
+  require_non_negative(o.gtol, "gtol");
+  require_non_negative(o.ftol, "ftol");
+}
+
 Result steepest_descent(const BatchObjective& fun, const Eigen::VectorXd& x0_, const Bounds& b,
                         const DescentOptions& o) {
+  validate(o);
   validate_start(x0_, b, o.h);
-  if (!(o.t0 > 0.0)) throw std::invalid_argument("t0: must be positive");
-  if (!(o.backtrack > 0.0 && o.backtrack < 1.0)) throw std::invalid_argument("backtrack: must be in (0, 1)");
-  if (!(o.armijo > 0.0 && o.armijo < 1.0)) throw std::invalid_argument("armijo: must be in (0, 1)");
   Evaluator eval(fun);
   Eigen::VectorXd x = project(x0_, b);
   double f = start_value(eval, x);

@@ -31,6 +31,9 @@ struct DescentOptions {
 
 /// bounds may be empty (size-0 vectors): unconstrained. With bounds, x0 is clipped into the box
 /// and every trial point projected onto it.
+/// Throws std::invalid_argument naming the first bad field.
+void validate(const DescentOptions& o);
+
 Result steepest_descent(const BatchObjective& fun, const Eigen::VectorXd& x0, const Bounds& bounds,
                         const DescentOptions& opt = {});
 

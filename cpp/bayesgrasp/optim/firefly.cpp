@@ -6,14 +6,19 @@
 
 namespace bayesgrasp::optim {
 
+void validate(const FireflyOptions& o) {
+  require_at_least(o.n_fireflies, 1, "n_fireflies");
+  require_at_least(o.max_iter, 0, "max_iter");
+  require_non_negative(o.beta0, "beta0");
+  require_non_negative(o.gamma, "gamma");
+  require_non_negative(o.alpha, "alpha");
+  if (!(o.alpha_decay > 0.0 && o.alpha_decay <= 1.0)) bad_field("alpha_decay", "in (0, 1]", number_str(o.alpha_decay));
+  validate_shared(o);
+}
+
 Result firefly(const BatchObjective& fun, const Bounds& b, const FireflyOptions& o) {
   validate_bounds(b);
-  if (o.n_fireflies < 1) throw std::invalid_argument("n_fireflies: must be at least 1");
-  if (o.max_iter < 0) throw std::invalid_argument("max_iter: must be >= 0");
-  if (!(o.beta0 >= 0.0) || !(o.gamma >= 0.0) || !(o.alpha >= 0.0))
-    throw std::invalid_argument("beta0, gamma, alpha: must be >= 0");
-  if (!(o.alpha_decay > 0.0 && o.alpha_decay <= 1.0))
-    throw std::invalid_argument("alpha_decay: must be in (0, 1]");
+  validate(o);
   const int n = o.n_fireflies, d = b.dim();
   validate_population(o, n, d, "n_fireflies");
 

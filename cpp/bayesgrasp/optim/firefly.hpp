@@ -21,6 +21,9 @@ struct FireflyOptions : PopulationOptions {
 /// Moves are synchronous: brightness from the start of a generation, the whole population
 /// evaluated as one batch after all moves. Positions are clipped to the box.
 /// Evaluations = n_fireflies * (iterations + 1).
+/// Throws std::invalid_argument naming the first bad field.
+void validate(const FireflyOptions& o);
+
 Result firefly(const BatchObjective& fun, const Bounds& bounds, const FireflyOptions& opt = {});
 
 }  // namespace bayesgrasp::optim

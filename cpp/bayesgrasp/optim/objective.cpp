@@ -4,6 +4,8 @@
 #include <cmath>
 #include <limits>
 
+#include "bayesgrasp/common/checks.hpp"
+
 namespace bayesgrasp::optim {
 
 void validate_bounds(const Bounds& b) {
@@ -15,6 +17,11 @@ void validate_bounds(const Bounds& b) {
   for (int i = 0; i < b.dim(); ++i)
     if (b.low[i] > b.high[i])
       throw std::invalid_argument("bounds: low > high in dimension " + std::to_string(i));
+}
+
+void validate_shared(const PopulationOptions& o) {
+  require_not_nan(o.target, "target");
+  if (!o.init.allFinite()) throw std::invalid_argument("init: contains NaN or infinity");
 }
 
 void validate_population(const PopulationOptions& o, int n, int d, const char* size_name) {

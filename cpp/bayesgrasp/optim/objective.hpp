@@ -14,6 +14,8 @@
 #include <string>
 #include <vector>
 
+#include "bayesgrasp/common/checks.hpp"
+
 namespace bayesgrasp::optim {
 
 using RowMatrixXd = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
@@ -46,6 +48,8 @@ struct PopulationOptions {
 /// Checks the shared options for a population of n in d dimensions: init empty, or (n, d) and
 /// finite. `size_name` names the population size in the message ("n_particles", ...).
 void validate_population(const PopulationOptions& o, int n, int d, const char* size_name);
+/// The shared fields on their own (target not NaN, init finite); each struct's validate calls it.
+void validate_shared(const PopulationOptions& o);
 
 /// What every optimiser reports.
 struct Result {

@@ -8,18 +8,21 @@
 
 namespace bayesgrasp::optim {
 
+void validate(const PSOOptions& o) {
+  require_at_least(o.n_particles, 1, "n_particles");
+  require_at_least(o.max_iter, 0, "max_iter");
+  require_positive(o.vmax_fraction, "vmax_fraction");
+  require_finite(o.inertia, "inertia");
+  require_finite(o.c1, "c1");
+  require_finite(o.c2, "c2");
+  require_at_least(o.stall_iter, 0, "stall_iter");
+  require_non_negative(o.ftol, "ftol");
+  validate_shared(o);
+}
+
 Result pso(const BatchObjective& fun, const Bounds& b, const PSOOptions& o) {
   validate_bounds(b);
-  if (o.n_particles < 1) throw std::invalid_argument("n_particles: must be at least 1");
-  if (o.max_iter < 0) throw std::invalid_argument("max_iter: must be >= 0");
-  if (!(o.vmax_fraction > 0.0) || !std::isfinite(o.vmax_fraction))
-    throw std::invalid_argument("vmax_fraction: must be positive and finite");
-  if (!std::isfinite(o.inertia)) throw std::invalid_argument("inertia: must be finite");
-  if (!std::isfinite(o.c1)) throw std::invalid_argument("c1: must be finite");
-  if (!std::isfinite(o.c2)) throw std::invalid_argument("c2: must be finite");
-  if (o.stall_iter < 0) throw std::invalid_argument("stall_iter: must be >= 0 (0: off), got " + std::to_string(o.stall_iter));
-  if (!(o.ftol >= 0.0)) throw std::invalid_argument("ftol: must be >= 0");
-  if (std::isnan(o.target)) throw std::invalid_argument("target: is NaN");
+  validate(o);
   const int n = o.n_particles, d = b.dim();
   validate_population(o, n, d, "n_particles");
 

@@ -18,6 +18,9 @@ struct PSOOptions : PopulationOptions {
   double ftol = 0.0;
 };
 
+/// Throws std::invalid_argument naming the first bad field.
+void validate(const PSOOptions& o);
+
 /// Minimises fun over the box. Evaluations = n_particles * (iterations + 1).
 /// Positions leaving the box are clipped to it and that velocity component set to zero.
 Result pso(const BatchObjective& fun, const Bounds& bounds, const PSOOptions& opt = {});

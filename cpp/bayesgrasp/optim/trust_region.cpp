@@ -70,10 +70,29 @@ void bfgs_update(Eigen::MatrixXd& B, const Eigen::VectorXd& s, const Eigen::Vect
 
 }  // namespace
 
+void validate(const LMOptions& o) {
+  require_at_least(o.max_iter, 0, "max_iter");
+  require_positive(o.h, "h");
+  require_positive(o.lambda0, "lambda0");
+  require_non_negative(o.gtol, "gtol");
+  require_non_negative(o.xtol, "xtol");
+  require_non_negative(o.ftol, "ftol");
+}
+
+void validate(const TrustRegionOptions& o) {
+  require_at_least(o.max_iter, 0, "max_iter");
+  require_positive(o.h, "h");
+  require_positive(o.radius0, "radius0");
+  if (!(o.max_radius >= o.radius0)) bad_field("max_radius", ">= radius0", number_str(o.max_radius));
+  if (!(o.eta >= 0.0 && o.eta < 0.25)) bad_field("eta", "in [0, 0.25)", number_str(o.eta));
+  require_non_negative(o.gtol, "gtol");
+  require_non_negative(o.xtol, "xtol");
+}
+
 Result levenberg_marquardt(const BatchResiduals& fun, const Eigen::VectorXd& x0, const Bounds& b,
                            const LMOptions& o) {
+  validate(o);
   validate_start(x0, b, o.h);
-  if (!(o.lambda0 > 0.0)) throw std::invalid_argument("lambda0: must be positive");
   const int d = static_cast<int>(x0.size());
   ResidualEvaluator ev{fun};
   Eigen::VectorXd x = project(x0, b);
@@ -132,9 +151,8 @@ Result levenberg_marquardt(const BatchResiduals& fun, const Eigen::VectorXd& x0,
 
 Result trust_region(const BatchObjective& fun, const Eigen::VectorXd& x0, const Bounds& b,
                     const TrustRegionOptions& o) {
+  validate(o);
   validate_start(x0, b, o.h);
-  if (!(o.radius0 > 0.0)) throw std::invalid_argument("radius0: must be positive");
-  if (!(o.eta >= 0.0 && o.eta < 0.25)) throw std::invalid_argument("eta: must be in [0, 0.25)");
   const int d = static_cast<int>(x0.size());
   Evaluator eval(fun);
   Eigen::VectorXd x = project(x0, b);

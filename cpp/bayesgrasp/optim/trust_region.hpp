@@ -20,6 +20,9 @@ struct LMOptions {
   bool record_history = false;
 };
 
+/// Throws std::invalid_argument naming the first bad field.
+void validate(const LMOptions& o);
+
 /// Minimises 1/2 ||r(x)||^2; residual callback sizes R to (N, n_residuals). Trial points are
 /// projected onto the box if bounds are given (non-empty).
 Result levenberg_marquardt(const BatchResiduals& residuals, const Eigen::VectorXd& x0,
@@ -35,6 +38,9 @@ struct TrustRegionOptions {
   double xtol = 1e-12;      ///< stop when the trust radius < xtol (||x|| + xtol)
   bool record_history = false;
 };
+
+/// Throws std::invalid_argument naming the first bad field.
+void validate(const TrustRegionOptions& o);
 
 /// Dogleg trust region with BFGS updates (skipped when s.y <= 0, so the model stays convex).
 Result trust_region(const BatchObjective& fun, const Eigen::VectorXd& x0, const Bounds& bounds,

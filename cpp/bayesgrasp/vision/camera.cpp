@@ -5,15 +5,41 @@
 #include <numeric>
 #include <stdexcept>
 
+#include "bayesgrasp/common/checks.hpp"
 #include "bayesgrasp/common/random.hpp"
 
 namespace bayesgrasp::vision {
 
-void validate_intrinsics(const Intrinsics& K) {
-  if (K.width <= 0 || K.height <= 0) throw std::invalid_argument("image width and height must be positive");
-  if (!(K.fx > 0) || !(K.fy > 0) || !std::isfinite(K.fx) || !std::isfinite(K.fy))
-    throw std::invalid_argument("focal lengths must be positive and finite");
-  if (!std::isfinite(K.cx) || !std::isfinite(K.cy)) throw std::invalid_argument("principal point must be finite");
+void validate(const Intrinsics& K) {
+  require_at_least(K.width, 1, "width");
+  require_at_least(K.height, 1, "height");
+  if (static_cast<long long>(K.width) * K.height > 50'000'000)
+    throw std::invalid_argument("width * height: image too large");
+  require_positive(K.fx, "fx");
+  require_positive(K.fy, "fy");
+  require_finite(K.cx, "cx");
+  require_finite(K.cy, "cy");
+}
+
+void validate(const Table& t) {
+  require_finite(t.z, "z");
+  require_finite(t.center_x, "center_x");
+  require_finite(t.center_y, "center_y");
+  if (!(t.half_x > 0)) bad_field("half_x", "positive (inf allowed)", number_str(t.half_x));
+  if (!(t.half_y > 0)) bad_field("half_y", "positive (inf allowed)", number_str(t.half_y));
+}
+
+void validate(const NoiseModel& n) {
+  require_non_negative(n.sigma_a, "sigma_a");
+  require_non_negative(n.sigma_b, "sigma_b");
+  require_finite(n.sigma_z0, "sigma_z0");
+  require_positive(n.baseline, "baseline");
+  require_non_negative(n.disparity_step, "disparity_step");
+  require_finite(n.max_incidence, "max_incidence");
+  require_positive(n.edge_jump, "edge_jump");
+  require_in(n.edge_drop_prob, 0, 1, "edge_drop_prob");
+  require_finite(n.min_depth, "min_depth");
+  require_positive(n.max_depth, "max_depth");
 }
 
 Iso3 look_at(const Vec3& eye, const Vec3& target, const Vec3& up) {
@@ -304,7 +330,9 @@ void add_noise(const Intrinsics& K, const NoiseModel& noise, const DepthImage& c
 
 RenderResult render(const Intrinsics& K, const Iso3& pose, const RayCaster& caster, const Table& table,
                     const NoiseModel& noise) {
-  validate_intrinsics(K);
+  validate(K);
+  validate(table);
+  validate(noise);
   if (!pose.matrix().allFinite()) throw std::invalid_argument("camera pose must be finite");
   RenderResult out;
   out.depth = DepthImage::Constant(K.height, K.width, std::numeric_limits<double>::quiet_NaN());
@@ -317,7 +345,7 @@ RenderResult render(const Intrinsics& K, const Iso3& pose, const RayCaster& cast
 
 Points depth_to_points(const Intrinsics& K, const DepthImage& depth, const Iso3& pose, bool world,
                        bool organised) {
-  validate_intrinsics(K);
+  validate(K);
   if (depth.rows() != K.height || depth.cols() != K.width)
     throw std::invalid_argument("depth image size does not match the intrinsics");
   const int H = K.height, W = K.width;

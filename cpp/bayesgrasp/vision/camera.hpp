@@ -32,7 +32,8 @@ struct Intrinsics {
 
 /// Throws std::invalid_argument if sizes are not positive or the focal lengths are not
 /// positive and finite.
-void validate_intrinsics(const Intrinsics& K);
+/// Each throws std::invalid_argument naming the first bad field.
+void validate(const Intrinsics& K);
 
 /// Camera-to-world pose looking from `eye` at `target`, with image "up" (-y_cam) as close
 /// as possible to `up`. Throws if eye == target or the view direction is parallel to `up`.
@@ -46,6 +47,7 @@ struct Table {
   double center_x = 0.0, center_y = 0.0;
   double half_x = 0.5, half_y = 0.5;
 };
+void validate(const Table& table);
 
 /// Structured-light noise (defaults: Kinect v1). All effects are switched off by `enabled = false`.
 ///  - axial noise: Gaussian, sigma(z) = sigma_a + sigma_b (z - sigma_z0)^2 (Nguyen et al. 2012);
@@ -70,6 +72,7 @@ struct NoiseModel {
   double max_depth = 4.0;        // m, farther is not measured
   std::uint64_t seed = 0;
 };
+void validate(const NoiseModel& noise);
 
 /// Bounding-volume hierarchy over the triangles of several meshes (median split), with
 /// closest-hit ray queries. Built once per scene; queries are thread-safe.

@@ -4,6 +4,8 @@
 // voxels). validate() checks them all; the Registrar calls it once, at construction.
 #pragma once
 
+#include <string>
+
 #include "bayesgrasp/geometry/mesh.hpp"
 
 namespace bayesgrasp::vision {
@@ -75,7 +77,13 @@ struct RegistrationOptions {
   UpPrior up_prior;
 };
 
-/// Throws std::invalid_argument naming the first bad field (e.g. "ransac.iterations: ...").
+/// Each throws std::invalid_argument naming the first bad field, prefixed by `prefix` (the
+/// whole struct's validate names them "ransac.iterations: ...").
+void validate(const FeatureOptions& o, const std::string& prefix = "");
+void validate(const CorrespondenceOptions& o, const std::string& prefix = "");
+void validate(const RansacOptions& o, const std::string& prefix = "");
+void validate(const IcpOptions& o, const std::string& prefix = "");
+void validate(const UpPrior& o, const std::string& prefix = "");
 void validate(const RegistrationOptions& options);
 
 }  // namespace bayesgrasp::vision

@@ -16,12 +16,24 @@
 #include <cmath>
 #include <stdexcept>
 
+#include "bayesgrasp/common/checks.hpp"
+
 namespace bayesgrasp::vision {
 
-SegmentationResult segment_table(const Points& cloud, const SegmentationParams& P) {
-  if (!(P.plane_threshold > 0) || !(P.cluster_tolerance > 0) || P.plane_iterations < 1 || P.min_cluster_size < 1 ||
-      P.max_cluster_size < P.min_cluster_size || !(P.max_height > P.min_height) || !(P.up.norm() > 0))
-    throw std::invalid_argument("invalid segmentation parameters");
+void validate(const SegmentationOptions& P) {
+  require_positive(P.plane_threshold, "plane_threshold");
+  require_at_least(P.plane_iterations, 1, "plane_iterations");
+  require_finite(P.min_height, "min_height");
+  require_finite(P.max_height, "max_height");
+  if (!(P.max_height > P.min_height)) bad_field("max_height", "above min_height", number_str(P.max_height));
+  require_positive(P.cluster_tolerance, "cluster_tolerance");
+  require_at_least(P.min_cluster_size, 1, "min_cluster_size");
+  require_at_least(P.max_cluster_size, P.min_cluster_size, "max_cluster_size");
+  if (!P.up.allFinite() || !(P.up.norm() > 0)) throw std::invalid_argument("up: must be finite and non-zero");
+}
+
+SegmentationResult segment_table(const Points& cloud, const SegmentationOptions& P) {
+  validate(P);
   pcl::PointCloud<pcl::PointXYZ>::Ptr c(new pcl::PointCloud<pcl::PointXYZ>);
   std::vector<int> rows;  // cloud row of each finite point
   c->reserve(cloud.rows());

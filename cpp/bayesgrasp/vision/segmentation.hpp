@@ -10,7 +10,7 @@
 
 namespace bayesgrasp::vision {
 
-struct SegmentationParams {
+struct SegmentationOptions {
   double plane_threshold = 0.006;   // m, RANSAC inlier distance of the table plane
   int plane_iterations = 1000;      // RANSAC iterations (PCL's SACSegmentation, fixed internal seed)
   double min_height = 0.008;        // m, points kept must be at least this far above the plane
@@ -29,8 +29,12 @@ struct SegmentationResult {
   std::vector<Points> cluster_points;                 // the clusters' points
 };
 
+/// Throws std::invalid_argument naming the first bad field.
+void validate(const SegmentationOptions& options);
+
 /// Segments an (N, 3) cloud. Rows with NaN are ignored (an organised cloud can be passed as is).
-/// Throws std::invalid_argument if fewer than 3 finite points remain or no plane is found.
-SegmentationResult segment_table(const Points& cloud, const SegmentationParams& params = {});
+/// Throws std::invalid_argument if the options are bad (validate), fewer than 3 finite points
+/// remain or no plane is found.
+SegmentationResult segment_table(const Points& cloud, const SegmentationOptions& options = {});
 
 }  // namespace bayesgrasp::vision
