@@ -14,6 +14,7 @@
 #include "bayesgrasp/belief/particles.hpp"
 #include "bayesgrasp/belief/pose_grid.hpp"
 #include "bayesgrasp/belief/relative_pose.hpp"
+#include "options.hpp"
 #include "validate.hpp"
 
 namespace bayesgrasp::bind {
@@ -380,14 +381,15 @@ void bind_pose_grid(py::module_& m) {
 }
 
 void bind_model_mixture(py::module_& m) {
-  py::class_<bl::ModelPoseOptions>(m, "ModelPoseOptions", "Options of Eq. 4.4's per-model MAP pose update.")
-      .def(py::init<>())
-      .def_readwrite("prior_std", &bl::ModelPoseOptions::prior_std,
-                     "prior_std : ndarray (3,)\n    sd of the Gaussian prior around the previous pose (m, m, rad)")
-      .def_readwrite("measurement_noise", &bl::ModelPoseOptions::measurement_noise,
-                     "measurement_noise : float\n    joint-angle noise sd (rad) added to the predictive variance")
-      .def_readwrite("trust_region", &bl::ModelPoseOptions::trust_region,
-                     "trust_region : TrustRegionOptions\n    the dogleg trust region's options (scaled coordinates)");
+  OptionClass<bl::ModelPoseOptions>(m, "ModelPoseOptions", "Options of Eq. 4.4's per-model MAP pose update.")
+      .field("prior_std", &bl::ModelPoseOptions::prior_std, "ndarray (3,)",
+             "sd of the Gaussian prior around the previous pose (m, m, rad)")
+      .field("measurement_noise", &bl::ModelPoseOptions::measurement_noise, "float",
+             "joint-angle noise sd (rad) added to the predictive variance")
+      .field("trust_region", &bl::ModelPoseOptions::trust_region, "TrustRegionOptions",
+             "the dogleg trust region's options (scaled coordinates)")
+      .validator([](const bl::ModelPoseOptions& o) { o.validate(); })
+      .finish();
   py::class_<bl::ModelPoseUpdate>(m, "ModelPoseUpdate", "One model's MAP pose after a grasp (Eq. 4.4).")
       .def_readonly("pose", &bl::ModelPoseUpdate::pose, "pose : ndarray (3,)\n    p_i(t) = (x, y, yaw), yaw in [-pi, pi)")
       .def_readonly("log_likelihood", &bl::ModelPoseUpdate::log_likelihood,

@@ -9,6 +9,7 @@
 #include <random>
 
 #include "bayesgrasp/gp/gp.hpp"
+#include "options.hpp"
 #include "validate.hpp"
 
 namespace bayesgrasp::bind {
@@ -43,50 +44,42 @@ py::array_t<double> stack(const std::vector<Eigen::MatrixXd>& s) {
 }
 
 void bind_options(py::module_& m) {
-  py::class_<GPOptions>(m, "GPOptions",
-                        "Options of ExactGP and SparseGP: the kernel, initial hyper-parameters, the fit and\n"
-                        "(SparseGP) the inducing inputs. Checked when a model is built from them.")
-      .def(py::init<>())
-      .def_property(
+  OptionClass<GPOptions>(m, "GPOptions",
+                         "Options of ExactGP and SparseGP: the kernel, initial hyper-parameters, the fit and\n"
+                         "(SparseGP) the inducing inputs. Checked when a model is built from them.")
+      .property(
           "kernel", [](const GPOptions& o) { return kernel_type_name(o.kernel); },
-          [](GPOptions& o, const std::string& s) { o.kernel = kernel_type_from_string(s); },
-          "kernel : str\n    'se' (squared exponential) or 'matern52'.")
-      .def_readwrite("lengthscale", &GPOptions::lengthscale,
-                     "lengthscale : numpy.ndarray\n    Initial lengthscales (D,) or (1,) (isotropic start); empty = 1.")
-      .def_readwrite("variance", &GPOptions::variance, "variance : float\n    Initial signal variance, > 0.")
-      .def_readwrite("noise", &GPOptions::noise,
-                     "noise : float\n    Initial noise variance, >= 0 (0 = noise-free, with jitter).")
-      .def_property(
+          [](GPOptions& o, const std::string& s) { o.kernel = kernel_type_from_string(s); }, "str",
+          "'se' (squared exponential) or 'matern52'.")
+      .field("lengthscale", &GPOptions::lengthscale, "numpy.ndarray",
+             "Initial lengthscales (D,) or (1,) (isotropic start); empty = 1.")
+      .field("variance", &GPOptions::variance, "float", "Initial signal variance, > 0.")
+      .field("noise", &GPOptions::noise, "float", "Initial noise variance, >= 0 (0 = noise-free, with jitter).")
+      .property(
           "mean", [](const GPOptions& o) { return mean_type_name(o.mean); },
-          [](GPOptions& o, const std::string& s) { o.mean = mean_type_from_string(s); },
-          "mean : str\n    'zero' or 'constant' (one fitted constant per output).")
-      .def_readwrite("mean_constant", &GPOptions::mean_constant,
-                     "mean_constant : numpy.ndarray\n"
-                     "    Initial mean constants (P,) for mean 'constant'; empty = automatic.")
-      .def_readwrite("optimize", &GPOptions::optimize,
-                     "optimize : bool\n    Maximise the log marginal likelihood in fit (L-BFGS-B).")
-      .def_readwrite("max_iter", &GPOptions::max_iter, "max_iter : int\n    L-BFGS-B iterations, >= 0.")
-      .def_readwrite("normalize_x", &GPOptions::normalize_x,
-                     "normalize_x : bool\n    Standardise the inputs before the fit.")
-      .def_readwrite("normalize_y", &GPOptions::normalize_y,
-                     "normalize_y : bool\n    Standardise the outputs before the fit.")
-      .def_readwrite("jitter", &GPOptions::jitter,
-                     "jitter : float\n    Initial diagonal jitter relative to the signal variance, >= 0.")
-      .def_readwrite("threads", &GPOptions::threads,
-                     "threads : int\n    OpenMP threads for prediction batches of >= 2048 inputs (0 = all cores).")
-      .def_readwrite("n_inducing", &GPOptions::n_inducing,
-                     "n_inducing : int\n"
-                     "    SparseGP: inducing inputs M, >= 1 (capped at the distinct training inputs).")
-      .def_readwrite("optimize_inducing", &GPOptions::optimize_inducing,
-                     "optimize_inducing : bool\n    SparseGP: optimise the inducing inputs too.")
-      .def_readwrite("profile_scale", &GPOptions::profile_scale,
-                     "profile_scale : bool\n    SparseGP: optimise with the signal variance profiled out.")
-      .def_readwrite("seed", &GPOptions::seed, "seed : int\n    SparseGP: k-means++ seed for the inducing inputs.")
-      .def_readwrite("inducing", &GPOptions::inducing,
-                     "inducing : numpy.ndarray\n"
-                     "    SparseGP: initial inducing inputs (M, D) in input units; empty = k-means++.")
-      .def_readwrite("kmeans_iter", &GPOptions::kmeans_iter,
-                     "kmeans_iter : int\n    SparseGP: Lloyd iterations after the k-means++ seeding, >= 0.");
+          [](GPOptions& o, const std::string& s) { o.mean = mean_type_from_string(s); }, "str",
+          "'zero' or 'constant' (one fitted constant per output).")
+      .field("mean_constant", &GPOptions::mean_constant, "numpy.ndarray",
+             "Initial mean constants (P,) for mean 'constant'; empty = automatic.")
+      .field("optimize", &GPOptions::optimize, "bool", "Maximise the log marginal likelihood in fit (L-BFGS-B).")
+      .field("max_iter", &GPOptions::max_iter, "int", "L-BFGS-B iterations, >= 0.")
+      .field("normalize_x", &GPOptions::normalize_x, "bool", "Standardise the inputs before the fit.")
+      .field("normalize_y", &GPOptions::normalize_y, "bool", "Standardise the outputs before the fit.")
+      .field("jitter", &GPOptions::jitter, "float", "Initial diagonal jitter relative to the signal variance, >= 0.")
+      .field("threads", &GPOptions::threads, "int",
+             "OpenMP threads for prediction batches of >= 2048 inputs (0 = all cores).")
+      .field("n_inducing", &GPOptions::n_inducing, "int",
+             "SparseGP: inducing inputs M, >= 1 (capped at the distinct training inputs).")
+      .field("optimize_inducing", &GPOptions::optimize_inducing, "bool", "SparseGP: optimise the inducing inputs too.")
+      .field("profile_scale", &GPOptions::profile_scale, "bool",
+             "SparseGP: optimise with the signal variance profiled out.")
+      .field("seed", &GPOptions::seed, "int", "SparseGP: k-means++ seed for the inducing inputs.")
+      .field("inducing", &GPOptions::inducing, "numpy.ndarray",
+             "SparseGP: initial inducing inputs (M, D) in input units; empty = k-means++.")
+      .field("kmeans_iter", &GPOptions::kmeans_iter, "int",
+             "SparseGP: Lloyd iterations after the k-means++ seeding, >= 0.")
+      .validator([](const GPOptions& o) { validate(o); })
+      .finish();
 
   py::class_<FitInfo>(m, "FitInfo", "How a fit went (a snapshot, taken when fit_info is read).")
       .def_readonly("iterations", &FitInfo::iterations,

@@ -30,6 +30,8 @@ struct Submodule {
 PYBIND11_MODULE(_core, m) {
   m.doc() = "bayesgrasp C++ core: contact simulation, grasp quality, GPs, beliefs, optimisers.";
   using namespace bayesgrasp::bind;
+  // In dependency order: an option class is bound before any class that holds one (optim before
+  // belief: ModelPoseOptions holds TrustRegionOptions; sim before touch).
   const Submodule submodules[] = {
       {"geometry", "Triangle meshes and mass properties.", bind_geometry},
       {"hand", "Hand models and kinematics.", bind_hand},
@@ -37,8 +39,8 @@ PYBIND11_MODULE(_core, m) {
       {"quality", "Grasp wrench space, epsilon and volume.", bind_quality},
       {"physics", "Physical lift test (Bullet).", bind_physics},
       {"gp", "Exact and sparse (FITC) Gaussian-process regression.", bind_gp},
-      {"belief", "Particle beliefs, resampling, Metropolis moves, entropy.", bind_belief},
       {"optim", "PSO, steepest descent, simulated annealing, firefly, trust region.", bind_optim},
+      {"belief", "Particle beliefs, resampling, Metropolis moves, entropy.", bind_belief},
       {"vision", "Simulated depth camera, table segmentation, FPFH + RANSAC + ICP registration.", bind_vision},
       {"task", "Task grasping (Eq. 4.1): pose densities, grasp mixtures, hand clearance.", bind_task},
       {"touch", "One touch (Pub. I): the executed grasp re-simulated against candidate object states.", bind_touch},

@@ -143,21 +143,29 @@ void bind_global_options(py::module_& m) {
       .field("inertia", &op::PSOOptions::inertia, "float", "Velocity inertia weight.")
       .field("c1", &op::PSOOptions::c1, "float", "Cognitive (own best) weight.")
       .field("c2", &op::PSOOptions::c2, "float", "Social (swarm best) weight.")
-      .field("vmax_fraction", &op::PSOOptions::vmax_fraction, "float", "Velocity bound as a fraction of the range, > 0.")
-      .field("stall_iter", &op::PSOOptions::stall_iter, "int", "Stop after this many iterations improving by at most ftol (0: off).")
+      .field("vmax_fraction", &op::PSOOptions::vmax_fraction, "float",
+             "Velocity bound as a fraction of the range, > 0.")
+      .field("stall_iter", &op::PSOOptions::stall_iter, "int",
+             "Stop after this many iterations improving by at most ftol (0: off).")
       .field("ftol", &op::PSOOptions::ftol, "float", "Improvement that resets the stall count.");
   finish_population(pso, "n_particles");
 
   OptionClass<op::AnnealingOptions> sa(m, "AnnealingOptions", "Options of simulated_annealing.");
   sa.field("n_chains", &op::AnnealingOptions::n_chains, "int", "Metropolis chains, >= 1.")
-      .field("max_iter", &op::AnnealingOptions::max_iter, "int", "Proposals per chain after the initial evaluation, >= 0.")
-      .field("t0", &op::AnnealingOptions::t0, "float", "Initial temperature; <= 0: the std of f over the initial points.")
-      .field("cooling", &op::AnnealingOptions::cooling, "float", "Geometric cooling factor T_k = t0 cooling^k, in (0, 1].")
+      .field("max_iter", &op::AnnealingOptions::max_iter, "int",
+             "Proposals per chain after the initial evaluation, >= 0.")
+      .field("t0", &op::AnnealingOptions::t0, "float",
+             "Initial temperature; <= 0: the std of f over the initial points.")
+      .field("cooling", &op::AnnealingOptions::cooling, "float",
+             "Geometric cooling factor T_k = t0 cooling^k, in (0, 1].")
       .field("step", &op::AnnealingOptions::step, "float", "Initial proposal std as a fraction of the range, > 0.")
-      .field("step_min", &op::AnnealingOptions::step_min, "float", "Lower bound of the adapted step (fraction of the range), > 0.")
+      .field("step_min", &op::AnnealingOptions::step_min, "float",
+             "Lower bound of the adapted step (fraction of the range), > 0.")
       .field("step_max", &op::AnnealingOptions::step_max, "float", "Upper bound of the adapted step, >= step_min.")
-      .field("adapt_interval", &op::AnnealingOptions::adapt_interval, "int", "Iterations between step adaptations (0 = fixed step).")
-      .field("target_acceptance", &op::AnnealingOptions::target_acceptance, "float", "Acceptance rate the step adapts towards, in (0, 1).")
+      .field("adapt_interval", &op::AnnealingOptions::adapt_interval, "int",
+             "Iterations between step adaptations (0 = fixed step).")
+      .field("target_acceptance", &op::AnnealingOptions::target_acceptance, "float",
+             "Acceptance rate the step adapts towards, in (0, 1).")
       .field("adapt_factor", &op::AnnealingOptions::adapt_factor, "float", "Step growth / shrink factor, > 1.");
   finish_population(sa, "n_chains");
 
@@ -201,10 +209,12 @@ void bind_local_options(py::module_& m) {
       .field("h", &op::TrustRegionOptions::h, "float", "Relative finite-difference step, > 0.")
       .field("radius0", &op::TrustRegionOptions::radius0, "float", "Initial trust radius, > 0.")
       .field("max_radius", &op::TrustRegionOptions::max_radius, "float", "Largest trust radius.")
-      .field("eta", &op::TrustRegionOptions::eta, "float", "Accept a step when actual / predicted reduction > eta, in [0, 0.25).")
+      .field("eta", &op::TrustRegionOptions::eta, "float",
+             "Accept a step when actual / predicted reduction > eta, in [0, 0.25).")
       .field("gtol", &op::TrustRegionOptions::gtol, "float", "Stop when the gradient's max-norm < gtol.")
       .field("xtol", &op::TrustRegionOptions::xtol, "float", "Stop when the trust radius < xtol (|x| + xtol).")
-      .field("record_history", &op::TrustRegionOptions::record_history, "bool", "Record the value after each iteration.")
+      .field("record_history", &op::TrustRegionOptions::record_history, "bool",
+             "Record the value after each iteration.")
       .validator([](const op::TrustRegionOptions& o) { op::validate(o); })
       .finish();
 }

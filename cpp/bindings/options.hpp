@@ -20,6 +20,17 @@ inline std::string field_doc(const char* name, const char* type, const char* doc
   return std::string(name) + " : " + type + "\n    " + doc;
 }
 
+// repr of one field; "..." if its type is not bound (yet).
+inline std::string field_repr(const py::object& self, const std::string& name) {
+  try {
+    return py::repr(self.attr(name.c_str()));
+  } catch (const py::error_already_set&) {
+    return "...";
+  } catch (const py::cast_error&) {
+    return "...";
+  }
+}
+
 template <typename C>
 class OptionClass {
  public:
@@ -33,8 +44,17 @@ class OptionClass {
     return *this;
   }
 
-  /// Binds validate() to the core's check of the struct.
-  OptionClass& validator(void (*check)(const C&)) {
+  /// A read-write field converted on the way (an enum as its name, say).
+  template <typename Get, typename Set>
+  OptionClass& property(const char* name, Get get, Set set, const char* type, const char* doc) {
+    cls_.def_property(name, get, set, field_doc(name, type, doc).c_str());
+    fields_->push_back(name);
+    return *this;
+  }
+
+  /// Binds validate() to the core's check of the struct (a callable taking const C&).
+  template <typename Check>
+  OptionClass& validator(Check check) {
     cls_.def("validate", [check](const C& c) { check(c); }, "Raises ValueError naming the first bad field.");
     return *this;
   }
@@ -61,7 +81,7 @@ class OptionClass {
              [fields, cname](const py::object& self) {
                std::string s = cname + "(";
                for (std::size_t i = 0; i < fields->size(); ++i)
-                 s += (i ? ", " : "") + (*fields)[i] + "=" + std::string(py::repr(self.attr((*fields)[i].c_str())));
+                 s += (i ? ", " : "") + (*fields)[i] + "=" + field_repr(self, (*fields)[i]);
                return s + ")";
              })
         .def("__copy__", [](const C& c) { return C(c); })

@@ -3,6 +3,7 @@
 #include <pybind11/stl.h>
 
 #include "bayesgrasp/physics/lift_test.hpp"
+#include "options.hpp"
 #include "validate.hpp"
 
 namespace bayesgrasp::bind {
@@ -73,52 +74,49 @@ std::vector<Eigen::MatrixX3d> pieces_arg(const py::object& pieces) {
 }
 
 void bind_options(py::module_& m) {
-  py::class_<LiftOptions>(m, "LiftOptions", R"doc(Options of the lift test (SI units). See ``lift_test``.)doc")
-      .def(py::init<>())
-      .def_readwrite("mu", &LiftOptions::mu, "mu : float\n    Friction coefficient hand-object (>= 0).")
-      .def_readwrite("table_mu", &LiftOptions::table_mu, "table_mu : float\n    Friction coefficient object-table (>= 0).")
-      .def_readwrite("density", &LiftOptions::density, "density : float\n    Object density, kg/m^3 (mass from the mesh).")
-      .def_readwrite("time_step", &LiftOptions::time_step, "time_step : float\n    Fixed time step, s (default 1/480).")
-      .def_readwrite("solver_iterations", &LiftOptions::solver_iterations,
-                     "solver_iterations : int\n    Bullet's constraint solver iterations per step (>= 1, default 100).")
-      .def_readwrite("solver_residual", &LiftOptions::solver_residual,
-                     "solver_residual : float\n    a step's solver iterations end once Bullet's least-squares "
-                     "residual is below this (its units); 0 (default) runs them all.")
-      .def_readwrite("squeeze_time", &LiftOptions::squeeze_time,
-                     "squeeze_time : float\n    s, the palm still while the fingers tighten.")
-      .def_readwrite("lift_height", &LiftOptions::lift_height, "lift_height : float\n    m the palm rises.")
-      .def_readwrite("lift_time", &LiftOptions::lift_time, "lift_time : float\n    s the rise takes.")
-      .def_readwrite("shake_amplitude", &LiftOptions::shake_amplitude, "shake_amplitude : float\n    m, per axis.")
-      .def_readwrite("shake_frequency", &LiftOptions::shake_frequency, "shake_frequency : float\n    Hz.")
-      .def_readwrite("shake_time", &LiftOptions::shake_time, "shake_time : float\n    s of shaking.")
-      .def_readwrite("hold_time", &LiftOptions::hold_time, "hold_time : float\n    s held still at the end.")
-      .def_readwrite("finger_torque", &LiftOptions::finger_torque,
-                     "finger_torque : float\n    N m; > 0: the torque limit of each finger's one motor at every joint it "
-                     "drives (the proximal, the distal after breakaway; coupled phalanges load the same motor); 0 "
-                     "(default): each joint's torque from the hand file (torque_nm, the hand's published strength).")
-      .def_readwrite("closing_speed", &LiftOptions::closing_speed,
-                     "closing_speed : float\n    rad/s, the finger motors' target velocity (closing).")
-      .def_readwrite("drive_inertia", &LiftOptions::drive_inertia,
-                     "drive_inertia : float\n    kg m^2 added to each phalanx about its joint axis (the drive's "
-                     "reflected rotor inertia).")
-      .def_readwrite("worm_backlash", &LiftOptions::worm_backlash,
-                     "worm_backlash : float\n    rad a driven or locked finger joint may open below the largest angle "
-                     "it reached (the worm drive's backlash; 0: a rigid ratchet).")
-      .def_readwrite("link_mass", &LiftOptions::link_mass, "link_mass : float\n    kg per phalanx.")
-      .def_readwrite("success_distance", &LiftOptions::success_distance,
-                     "success_distance : float\n    m; lifted = the object rose at least lift_height minus this, and "
-                     "moved less than this in the palm frame from the end of the lift to the end.")
-      .def_readwrite("table", &LiftOptions::table, "table : bool\n    A table plane at z = 0.")
-      .def_property(
+  OptionClass<LiftOptions>(m, "LiftOptions", R"doc(Options of the lift test (SI units). See ``lift_test``.)doc")
+      .field("mu", &LiftOptions::mu, "float", "Friction coefficient hand-object (>= 0).")
+      .field("table_mu", &LiftOptions::table_mu, "float", "Friction coefficient object-table (>= 0).")
+      .field("density", &LiftOptions::density, "float", "Object density, kg/m^3 (mass from the mesh).")
+      .field("time_step", &LiftOptions::time_step, "float", "Fixed time step, s (default 1/480).")
+      .field("solver_iterations", &LiftOptions::solver_iterations, "int",
+             "Bullet's constraint solver iterations per step (>= 1, default 100).")
+      .field("solver_residual", &LiftOptions::solver_residual, "float",
+             "a step's solver iterations end once Bullet's least-squares residual is below this (its units); 0 "
+             "(default) runs them all.")
+      .field("squeeze_time", &LiftOptions::squeeze_time, "float", "s, the palm still while the fingers tighten.")
+      .field("lift_height", &LiftOptions::lift_height, "float", "m the palm rises.")
+      .field("lift_time", &LiftOptions::lift_time, "float", "s the rise takes.")
+      .field("shake_amplitude", &LiftOptions::shake_amplitude, "float", "m, per axis.")
+      .field("shake_frequency", &LiftOptions::shake_frequency, "float", "Hz, of the shake.")
+      .field("shake_time", &LiftOptions::shake_time, "float", "s of shaking.")
+      .field("hold_time", &LiftOptions::hold_time, "float", "s held still at the end.")
+      .field("finger_torque", &LiftOptions::finger_torque, "float",
+             "N m; > 0: the torque limit of each finger's one motor at every joint it drives (the proximal, the distal "
+             "after breakaway; coupled phalanges load the same motor); 0 (default): each joint's torque from the hand "
+             "file (torque_nm, the hand's published strength).")
+      .field("closing_speed", &LiftOptions::closing_speed, "float",
+             "rad/s, the finger motors' target velocity (closing).")
+      .field("drive_inertia", &LiftOptions::drive_inertia, "float",
+             "kg m^2 added to each phalanx about its joint axis (the drive's reflected rotor inertia).")
+      .field("worm_backlash", &LiftOptions::worm_backlash, "float",
+             "rad a driven or locked finger joint may open below the largest angle it reached (the worm drive's "
+             "backlash; 0: a rigid ratchet).")
+      .field("link_mass", &LiftOptions::link_mass, "float", "kg per phalanx.")
+      .field("success_distance", &LiftOptions::success_distance, "float",
+             "m; lifted = the object rose at least lift_height minus this, and moved less than this in the palm frame "
+             "from the end of the lift to the end.")
+      .field("table", &LiftOptions::table, "bool", "A table plane at z = 0.")
+      .property(
           "shape", [](const LiftOptions& o) { return shape_name(o.shape); },
-          [](LiftOptions& o, const std::string& s) { o.shape = shape_from(s); },
-          "shape : str\n    Object collision shape: 'auto', 'hull', 'tetrahedra' or 'decomposition' (needs "
-          "convex pieces).")
-      .def_readwrite("tet_depth", &LiftOptions::tet_depth, "tet_depth : float\n    m, depth of the tetrahedra skin.")
-      .def_readwrite("margin", &LiftOptions::margin, "margin : float\n    m, collision margin of every shape.")
-      .def_readwrite("skip_separated_pairs", &LiftOptions::skip_separated_pairs,
-                     "skip_separated_pairs : bool\n    Skip Bullet's narrowphase for shape pairs proven apart "
-                     "(same results, faster).");
+          [](LiftOptions& o, const std::string& s) { o.shape = shape_from(s); }, "str",
+          "Object collision shape: 'auto', 'hull', 'tetrahedra' or 'decomposition' (needs convex pieces).")
+      .field("tet_depth", &LiftOptions::tet_depth, "float", "m, depth of the tetrahedra skin.")
+      .field("margin", &LiftOptions::margin, "float", "m, collision margin of every shape.")
+      .field("skip_separated_pairs", &LiftOptions::skip_separated_pairs, "bool",
+             "Skip Bullet's narrowphase for shape pairs proven apart (same results, faster).")
+      .validator([](const LiftOptions& o) { validate(o); })
+      .finish();
 }
 
 void bind_trace(py::module_& m) {

@@ -103,7 +103,8 @@ void bind_options(py::module_& m) {
   icp.field("distance", &IcpOptions::distance, "float", "x voxel: correspondence distance")
       .field("iterations", &IcpOptions::iterations, "int", "full ICP of the chosen hypothesis")
       .field("tolerance", &IcpOptions::tolerance, "float", "stop when the update is below this (rad, m)")
-      .field("coarse_points", &IcpOptions::coarse_points, "int", "scene subsample for the coarse ICP of every hypothesis")
+      .field("coarse_points", &IcpOptions::coarse_points, "int",
+             "scene subsample for the coarse ICP of every hypothesis")
       .field("coarse_iterations", &IcpOptions::coarse_iterations, "int", "iterations of the coarse ICP")
       .validator([](const IcpOptions& o) { validate(o); })
       .finish();

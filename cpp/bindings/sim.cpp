@@ -7,6 +7,7 @@
 #include <type_traits>
 
 #include "bayesgrasp/sim/grasp_simulator.hpp"
+#include "options.hpp"
 #include "validate.hpp"
 
 namespace bayesgrasp::bind {
@@ -97,42 +98,41 @@ concatenated: grasp i's contacts are rows offsets[i]:offsets[i+1].)doc")
 }
 
 void bind_options(py::module_& m) {
-  py::class_<SimOptions> o(m, "SimOptions", R"doc(Options of the grasp simulator (SI units).
+  OptionClass<SimOptions> o(m, "SimOptions", R"doc(Options of the grasp simulator (SI units).
 
 The defaults are what every caller uses; the others exist for tests and benchmarks.)doc");
-  py::enum_<SimOptions::Bv>(o, "BoundingVolume", "FCL bounding volume of the object's BVH.")
+  py::enum_<SimOptions::Bv>(o.cls(), "BoundingVolume", "FCL bounding volume of the object's BVH.")
       .value("OBBRSS", SimOptions::Bv::OBBRSS)
       .value("RSS", SimOptions::Bv::RSS);
-  py::enum_<SimOptions::LinkGeometry>(o, "LinkGeometry", "Link geometry of the FCL distance queries.")
+  py::enum_<SimOptions::LinkGeometry>(o.cls(), "LinkGeometry", "Link geometry of the FCL distance queries.")
       .value("Segments", SimOptions::LinkGeometry::Segments)
       .value("Primitives", SimOptions::LinkGeometry::Primitives)
       .value("Meshes", SimOptions::LinkGeometry::Meshes);
-  o.def(py::init<>())
-      .def_readwrite("table", &SimOptions::table, "table : bool\n    An infinite table plane at z = 0.")
-      .def_readwrite("contact_tolerance", &SimOptions::contact_tolerance,
-                     "contact_tolerance : float\n    A link touches when closer than this (m, > 0).")
-      .def_readwrite("rel_err", &SimOptions::rel_err,
-                     "rel_err : float\n    Error allowance of the advancing distance queries, relative to the "
-                     "link's lower bound on its distance (in [0, 1); 0 = exact).")
-      .def_readwrite("tie_tolerance", &SimOptions::tie_tolerance,
-                     "tie_tolerance : float\n    Triangle pairs whose distances to a link differ by less than this "
-                     "count as tied; a query keeps the first (m, in [0, contact_tolerance / 10); 0 = FCL's own "
-                     "traversal).")
-      .def_readwrite("box_skip", &SimOptions::box_skip,
-                     "box_skip : float\n    Links whose lower bound on the object distance exceeds this use the "
-                     "bound instead of an FCL query (m, > contact_tolerance).")
-      .def_readwrite("bv", &SimOptions::bv, "bv : SimOptions.BoundingVolume\n    The object's bounding volumes.")
-      .def_readwrite("links", &SimOptions::links,
-                     "links : SimOptions.LinkGeometry\n    Segments (capsule axes as sliver triangles, boxes as "
-                     "meshes), Primitives (FCL capsules and boxes) or Meshes (tessellated capsules).")
-      .def_readwrite("max_iterations", &SimOptions::max_iterations,
-                     "max_iterations : int\n    Advancement steps per finger and per approach (a safety net, >= 1).")
-      .def_readwrite("table_clearance", &SimOptions::table_clearance,
-                     "table_clearance : float\n    Approaches along -z (top grasps) with a table keep the fingers' "
-                     "closing sweep at least this far above it (m); negative: stop at the first contact.")
-      .def_readwrite("prune_queries", &SimOptions::prune_queries,
-                     "prune_queries : bool\n    Skip FCL queries whose answer cannot change the result (same "
-                     "grasps up to round-off).");
+  o.field("table", &SimOptions::table, "bool", "An infinite table plane at z = 0.")
+      .field("contact_tolerance", &SimOptions::contact_tolerance, "float",
+             "A link touches when closer than this (m, > 0).")
+      .field("rel_err", &SimOptions::rel_err, "float",
+             "Error allowance of the advancing distance queries, relative to the link's lower bound on its distance (in"
+             " [0, 1); 0 = exact).")
+      .field("tie_tolerance", &SimOptions::tie_tolerance, "float",
+             "Triangle pairs whose distances to a link differ by less than this count as tied; a query keeps the first "
+             "(m, in [0, contact_tolerance / 10); 0 = FCL's own traversal).")
+      .field("box_skip", &SimOptions::box_skip, "float",
+             "Links whose lower bound on the object distance exceeds this use the bound instead of an FCL query (m, > "
+             "contact_tolerance).")
+      .field("bv", &SimOptions::bv, "SimOptions.BoundingVolume", "The object's bounding volumes.")
+      .field("links", &SimOptions::links, "SimOptions.LinkGeometry",
+             "Segments (capsule axes as sliver triangles, boxes as meshes), Primitives (FCL capsules and boxes) or "
+             "Meshes (tessellated capsules).")
+      .field("max_iterations", &SimOptions::max_iterations, "int",
+             "Advancement steps per finger and per approach (a safety net, >= 1).")
+      .field("table_clearance", &SimOptions::table_clearance, "float",
+             "Approaches along -z (top grasps) with a table keep the fingers' closing sweep at least this far above it "
+             "(m); negative: stop at the first contact.")
+      .field("prune_queries", &SimOptions::prune_queries, "bool",
+             "Skip FCL queries whose answer cannot change the result (same grasps up to round-off).")
+      .validator([](const SimOptions& x) { validate(x); })
+      .finish();
 }
 
 py::tuple object_contacts(const Contacts& cs) {

@@ -5,6 +5,7 @@
 #include "bayesgrasp/task/grasp_mixture.hpp"
 #include "bayesgrasp/task/hand_clearance.hpp"
 #include "bayesgrasp/task/pose_density.hpp"
+#include "options.hpp"
 #include "validate.hpp"
 
 namespace bayesgrasp::bind {
@@ -17,20 +18,20 @@ void bind_task(py::module_& m) {
       .value("regularised", DensityKind::RegularisedGaussian)
       .value("laplace", DensityKind::Laplace);
 
-  py::class_<PoseDensity>(m, "PoseDensity", R"doc(A density over hand poses around a task grasp.
+  OptionClass<PoseDensity> density(m, "PoseDensity", R"doc(A density over hand poses around a task grasp.
 
 With d_t the translation distance and d_R the rotation angle between the candidate and the grasp:
 Gaussian exp(-(d_t^2/s_t^2 + d_R^2/s_R^2)/2); regularised Gaussian (1 - lambda) Gauss(s) +
-lambda Gauss(kappa s); Laplace exp(-(d_t/s_t + d_R/s_R)). 1 at the grasp.)doc")
-      .def(py::init<>())
-      .def_readwrite("kind", &PoseDensity::kind, "kind : DensityKind\n    gaussian, regularised or laplace")
-      .def_readwrite("translation_scale", &PoseDensity::translation_scale, "translation_scale : float\n    s_t (m)")
-      .def_readwrite("rotation_scale", &PoseDensity::rotation_scale, "rotation_scale : float\n    s_R (rad)")
-      .def_readwrite("wide_weight", &PoseDensity::wide_weight,
-                     "wide_weight : float\n    lambda, the wide component's weight (regularised only)")
-      .def_readwrite("wide_factor", &PoseDensity::wide_factor,
-                     "wide_factor : float\n    kappa, the wide component's scale multiple (regularised only)")
-      .def("validate", &PoseDensity::validate, "Raises ValueError naming a bad field.")
+lambda Gauss(kappa s); Laplace exp(-(d_t/s_t + d_R/s_R)). 1 at the grasp.)doc");
+  density.field("kind", &PoseDensity::kind, "DensityKind", "gaussian, regularised or laplace")
+      .field("translation_scale", &PoseDensity::translation_scale, "float", "s_t (m)")
+      .field("rotation_scale", &PoseDensity::rotation_scale, "float", "s_R (rad)")
+      .field("wide_weight", &PoseDensity::wide_weight, "float",
+             "lambda, the wide component's weight (regularised only)")
+      .field("wide_factor", &PoseDensity::wide_factor, "float",
+             "kappa, the wide component's scale multiple (regularised only)")
+      .validator([](const PoseDensity& d) { d.validate(); })
+      .finish()
       .def("__call__", [](const PoseDensity& d, double dt, double dr) { d.validate(); return d(dt, dr); },
            py::arg("dt"), py::arg("dr"), "The density at translation distance dt (m) and rotation angle dr (rad).");
 
@@ -79,10 +80,11 @@ models carried into the scene, each with weight psi(q_ik) phi(delta_i).)doc")
       py::arg("reference"), py::arg("X"),
       "Poses (N, 4, 4) from rows (t, r) of X (N, 6): rotation exp([r]) R_ref, translation t_ref + t.");
 
-  py::class_<ClearanceOptions>(m, "ClearanceOptions", "What the open hand must be clear of.")
-      .def(py::init<>())
-      .def_readwrite("table", &ClearanceOptions::table, "table : bool\n    the plane z = 0 is an obstacle")
-      .def_readwrite("margin", &ClearanceOptions::margin, "margin : float\n    shapes grown by this (m)");
+  OptionClass<ClearanceOptions>(m, "ClearanceOptions", "What the open hand must be clear of.")
+      .field("table", &ClearanceOptions::table, "bool", "the plane z = 0 is an obstacle")
+      .field("margin", &ClearanceOptions::margin, "float", "shapes grown by this (m)")
+      .validator([](const ClearanceOptions& o) { validate(o); })
+      .finish();
 
   py::class_<Clearance>(m, "Clearance", "Intrusions into the open hand at each candidate pose (m, 0 = clear).")
       .def_readonly("table", &Clearance::table, "table : ndarray (N,)\n    depth below z = 0")

@@ -5,6 +5,7 @@
 #include <pybind11/stl.h>
 
 #include "bayesgrasp/touch/estimate.hpp"
+#include "options.hpp"
 #include "validate.hpp"
 
 namespace bayesgrasp::bind {
@@ -102,44 +103,48 @@ void bind_grasp_and_readings(py::module_& m) {
 }
 
 void bind_options(py::module_& m) {
-  py::class_<TouchModelOptions>(m, "TouchModelOptions", "Options of the touch model.")
-      .def(py::init<>())
-      .def_readwrite("sim", &TouchModelOptions::sim, "sim : SimOptions\n    the simulator's options (as the world's)")
-      .def_readwrite("scale_step", &TouchModelOptions::scale_step,
-                     "scale_step : float\n    candidate scales are rounded to multiples of this (> 0)")
-      .def_readwrite("scale_min", &TouchModelOptions::scale_min, "scale_min : float\n    smallest candidate scale")
-      .def_readwrite("scale_max", &TouchModelOptions::scale_max, "scale_max : float\n    largest candidate scale");
-  py::class_<FitnessOptions>(m, "FitnessOptions", "Weights of Pub. I's fitness (see touch/fitness.hpp).")
-      .def(py::init<>())
-      .def_readwrite("joint_sigma", &FitnessOptions::joint_sigma, "joint_sigma : float\n    sigma_q (rad)")
-      .def_readwrite("joint_weights", &FitnessOptions::joint_weights,
-                     "joint_weights : numpy.ndarray (J,)\n    w_j; empty = 0 for the spread, 1 for each phalanx")
-      .def_readwrite("contact_term", &FitnessOptions::contact_term, "contact_term : ContactTerm\n    flags or surface")
-      .def_readwrite("contact_weight", &FitnessOptions::contact_weight, "contact_weight : float\n    lambda_c")
-      .def_readwrite("surface_scale", &FitnessOptions::surface_scale, "surface_scale : float\n    d_s (m)")
-      .def_readwrite("height_sigma", &FitnessOptions::height_sigma, "height_sigma : float\n    sigma_z (m)")
-      .def_readwrite("collision_penalty", &FitnessOptions::collision_penalty,
-                     "collision_penalty : float\n    added when the open hand starts inside the candidate");
-  py::class_<SearchBox>(m, "SearchBox", "The search box around the initial guess.")
-      .def(py::init<>())
-      .def_readwrite("xy", &SearchBox::xy, "xy : float\n    +- x and y (m)")
-      .def_readwrite("yaw", &SearchBox::yaw, "yaw : float\n    +- yaw (rad)")
-      .def_readwrite("scale_low", &SearchBox::scale_low, "scale_low : float\n    smallest scale")
-      .def_readwrite("scale_high", &SearchBox::scale_high, "scale_high : float\n    largest scale");
-  py::class_<EstimateOptions>(m, "EstimateOptions", "How one touch is turned into an estimate.")
-      .def(py::init<>())
-      .def_readwrite("optimizer", &EstimateOptions::optimizer, "optimizer : Optimizer")
-      .def_readwrite("unknowns", &EstimateOptions::unknowns, "unknowns : Unknowns")
-      .def_readwrite("box", &EstimateOptions::box, "box : SearchBox")
-      .def_readwrite("fitness", &EstimateOptions::fitness, "fitness : FitnessOptions")
-      .def_readwrite("budget", &EstimateOptions::budget, "budget : int\n    fitness evaluations")
-      .def_readwrite("population", &EstimateOptions::population,
-                     "population : int\n    particles / fireflies / chains; 0 = the default (20, 20, 10)")
-      .def_readwrite("seed", &EstimateOptions::seed, "seed : int")
-      .def_readwrite("threads", &EstimateOptions::threads, "threads : int\n    0 = all cores")
-      .def_readwrite("stop_fitness", &EstimateOptions::stop_fitness,
-                     "stop_fitness : float\n    end the search once the best fitness is below this (the readings "
-                     "reproduced to that level); 0 = spend the whole budget");
+  OptionClass<TouchModelOptions>(m, "TouchModelOptions", "Options of the touch model.")
+      .field("sim", &TouchModelOptions::sim, "SimOptions", "the simulator's options (as the world's)")
+      .field("scale_step", &TouchModelOptions::scale_step, "float",
+             "candidate scales are rounded to multiples of this (> 0)")
+      .field("scale_min", &TouchModelOptions::scale_min, "float", "smallest candidate scale")
+      .field("scale_max", &TouchModelOptions::scale_max, "float", "largest candidate scale")
+      .validator([](const TouchModelOptions& o) { validate(o); })
+      .finish();
+  OptionClass<FitnessOptions>(m, "FitnessOptions", "Weights of Pub. I's fitness (see touch/fitness.hpp).")
+      .field("joint_sigma", &FitnessOptions::joint_sigma, "float", "sigma_q (rad)")
+      .field("joint_weights", &FitnessOptions::joint_weights, "numpy.ndarray (J,)",
+             "w_j; empty = 0 for the spread, 1 for each phalanx")
+      .field("contact_term", &FitnessOptions::contact_term, "ContactTerm", "flags or surface")
+      .field("contact_weight", &FitnessOptions::contact_weight, "float", "lambda_c")
+      .field("surface_scale", &FitnessOptions::surface_scale, "float", "d_s (m)")
+      .field("height_sigma", &FitnessOptions::height_sigma, "float", "sigma_z (m)")
+      .field("collision_penalty", &FitnessOptions::collision_penalty, "float",
+             "added when the open hand starts inside the candidate")
+      .validator([](const FitnessOptions& o) { validate(o); })
+      .finish();
+  OptionClass<SearchBox>(m, "SearchBox", "The search box around the initial guess.")
+      .field("xy", &SearchBox::xy, "float", "+- x and y (m)")
+      .field("yaw", &SearchBox::yaw, "float", "+- yaw (rad)")
+      .field("scale_low", &SearchBox::scale_low, "float", "smallest scale")
+      .field("scale_high", &SearchBox::scale_high, "float", "largest scale")
+      .validator([](const SearchBox& o) { validate(o); })
+      .finish();
+  OptionClass<EstimateOptions>(m, "EstimateOptions", "How one touch is turned into an estimate.")
+      .field("optimizer", &EstimateOptions::optimizer, "Optimizer", "the search (PSO by default)")
+      .field("unknowns", &EstimateOptions::unknowns, "Unknowns", "pose (x, y, yaw) or pose and scale")
+      .field("box", &EstimateOptions::box, "SearchBox", "the search box around the initial guess")
+      .field("fitness", &EstimateOptions::fitness, "FitnessOptions", "the fitness' weights")
+      .field("budget", &EstimateOptions::budget, "int", "fitness evaluations")
+      .field("population", &EstimateOptions::population, "int",
+             "particles / fireflies / chains; 0 = the default (20, 20, 10)")
+      .field("seed", &EstimateOptions::seed, "int", "seed of the search")
+      .field("threads", &EstimateOptions::threads, "int", "0 = all cores")
+      .field("stop_fitness", &EstimateOptions::stop_fitness, "float",
+             "end the search once the best fitness is below this (the readings reproduced to that level); 0 = "
+             "spend the whole budget")
+      .validator([](const EstimateOptions& o) { validate(o); })
+      .finish();
   m.def("minimum_budget", &minimum_budget, py::arg("optimizer"), py::arg("dim"), py::arg("population") = 0,
         "The smallest budget the optimiser runs with in `dim` unknowns.");
 }

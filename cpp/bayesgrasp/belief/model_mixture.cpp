@@ -51,6 +51,7 @@ void ModelPoseOptions::validate() const {
     throw std::invalid_argument("prior_std: must be three positive numbers (m, m, rad)");
   if (!(measurement_noise >= 0.0) || !std::isfinite(measurement_noise))
     throw std::invalid_argument("measurement_noise: must be >= 0 and finite");
+  optim::validate(trust_region);
 }
 
 Eigen::VectorXd measurement_log_likelihood(const RelativePoseGrid& grid, const MeasurementChannels& ch,

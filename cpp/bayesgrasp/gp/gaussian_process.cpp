@@ -21,23 +21,27 @@ MeanType mean_type_from_string(const std::string& name) {
 }
 std::string mean_type_name(MeanType type) { return type == MeanType::Zero ? "zero" : "constant"; }
 
-GaussianProcess::GaussianProcess(GPOptions o) : opt_(std::move(o)) {
-  if (opt_.lengthscale.size() > 0 &&
-      (!(opt_.lengthscale.array() > 0.0).all() || !opt_.lengthscale.allFinite()))
+void validate(const GPOptions& o) {
+  if (o.lengthscale.size() > 0 &&
+      (!(o.lengthscale.array() > 0.0).all() || !o.lengthscale.allFinite()))
     throw std::invalid_argument("lengthscale: must be positive and finite");
-  if (!(opt_.variance > 0.0) || !std::isfinite(opt_.variance))
+  if (!(o.variance > 0.0) || !std::isfinite(o.variance))
     throw std::invalid_argument("variance: must be positive and finite");
-  if (!(opt_.noise >= 0.0) || !std::isfinite(opt_.noise))
+  if (!(o.noise >= 0.0) || !std::isfinite(o.noise))
     throw std::invalid_argument("noise: must be non-negative and finite");
-  if (opt_.max_iter < 0) throw std::invalid_argument("max_iter: must be >= 0");
-  if (opt_.n_inducing < 1) throw std::invalid_argument("n_inducing: must be >= 1");
-  if (!(opt_.jitter >= 0.0) || !std::isfinite(opt_.jitter)) throw std::invalid_argument("jitter: must be >= 0");
-  if (opt_.kmeans_iter < 0) throw std::invalid_argument("kmeans_iter: must be >= 0");
-  thread_count(opt_.threads, "threads");  // validates: 0 = all cores, negative is an error
-  if (opt_.mean_constant.size() > 0 && !opt_.mean_constant.allFinite())
+  if (o.max_iter < 0) throw std::invalid_argument("max_iter: must be >= 0");
+  if (o.n_inducing < 1) throw std::invalid_argument("n_inducing: must be >= 1");
+  if (!(o.jitter >= 0.0) || !std::isfinite(o.jitter)) throw std::invalid_argument("jitter: must be >= 0");
+  if (o.kmeans_iter < 0) throw std::invalid_argument("kmeans_iter: must be >= 0");
+  thread_count(o.threads, "threads");  // validates: 0 = all cores, negative is an error
+  if (o.mean_constant.size() > 0 && !o.mean_constant.allFinite())
     throw std::invalid_argument("mean_constant: contains NaN or infinity");
-  if (opt_.inducing.size() > 0 && !opt_.inducing.allFinite())
+  if (o.inducing.size() > 0 && !o.inducing.allFinite())
     throw std::invalid_argument("inducing: contains NaN or infinity");
+}
+
+GaussianProcess::GaussianProcess(GPOptions o) : opt_(std::move(o)) {
+  validate(opt_);
   noise_ = opt_.noise;
 }
 

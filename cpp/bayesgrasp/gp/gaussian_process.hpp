@@ -65,6 +65,9 @@ struct GPOptions {
   int kmeans_iter = 10;          ///< Lloyd iterations after k-means++ seeding
 };
 
+/// Throws std::invalid_argument naming the first bad field.
+void validate(const GPOptions& options);
+
 /// Result of fit(): how the optimisation went.
 struct FitInfo {
   int iterations = 0;           ///< L-BFGS-B iterations (0 without optimisation)

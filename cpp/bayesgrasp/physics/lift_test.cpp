@@ -10,6 +10,7 @@
 #include "bayesgrasp/physics/hand_bodies.hpp"
 #include "bayesgrasp/physics/lift_object.hpp"
 #include "bayesgrasp/physics/lift_script.hpp"
+#include "bayesgrasp/common/checks.hpp"
 #include "bayesgrasp/common/parallel.hpp"
 
 namespace bayesgrasp {
@@ -20,38 +21,28 @@ struct LiftTester::Impl {
   physics::LiftObject object;
 };
 
-namespace {
-
-void check_options(const LiftOptions& o) {
-  auto pos = [](double x, const char* name) {
-    if (!(x > 0.0) || !std::isfinite(x))
-      throw std::invalid_argument(std::string(name) + " must be positive and finite, got " + std::to_string(x));
-  };
-  auto nonneg = [](double x, const char* name) {
-    if (!(x >= 0.0) || !std::isfinite(x))
-      throw std::invalid_argument(std::string(name) + " must be >= 0 and finite, got " + std::to_string(x));
-  };
-  nonneg(o.mu, "mu");
-  nonneg(o.table_mu, "table_mu");
-  pos(o.density, "density");
-  pos(o.time_step, "time_step");
-  if (o.solver_iterations < 1) throw std::invalid_argument("solver_iterations must be >= 1");
-  nonneg(o.solver_residual, "solver_residual");
-  nonneg(o.squeeze_time, "squeeze_time");
-  nonneg(o.lift_height, "lift_height");
-  pos(o.lift_time, "lift_time");
-  nonneg(o.shake_amplitude, "shake_amplitude");
-  pos(o.shake_frequency, "shake_frequency");
-  nonneg(o.shake_time, "shake_time");
-  nonneg(o.hold_time, "hold_time");
-  nonneg(o.finger_torque, "finger_torque");
-  nonneg(o.closing_speed, "closing_speed");
-  nonneg(o.worm_backlash, "worm_backlash");
-  pos(o.link_mass, "link_mass");
-  nonneg(o.drive_inertia, "drive_inertia");
-  pos(o.success_distance, "success_distance");
-  pos(o.tet_depth, "tet_depth");
-  nonneg(o.margin, "margin");
+void validate(const LiftOptions& o) {
+  require_non_negative(o.mu, "mu");
+  require_non_negative(o.table_mu, "table_mu");
+  require_positive(o.density, "density");
+  require_positive(o.time_step, "time_step");
+  require_at_least(o.solver_iterations, 1, "solver_iterations");
+  require_non_negative(o.solver_residual, "solver_residual");
+  require_non_negative(o.squeeze_time, "squeeze_time");
+  require_non_negative(o.lift_height, "lift_height");
+  require_positive(o.lift_time, "lift_time");
+  require_non_negative(o.shake_amplitude, "shake_amplitude");
+  require_positive(o.shake_frequency, "shake_frequency");
+  require_non_negative(o.shake_time, "shake_time");
+  require_non_negative(o.hold_time, "hold_time");
+  require_non_negative(o.finger_torque, "finger_torque");
+  require_non_negative(o.closing_speed, "closing_speed");
+  require_non_negative(o.worm_backlash, "worm_backlash");
+  require_positive(o.link_mass, "link_mass");
+  require_non_negative(o.drive_inertia, "drive_inertia");
+  require_positive(o.success_distance, "success_distance");
+  require_positive(o.tet_depth, "tet_depth");
+  require_non_negative(o.margin, "margin");
   // The script's steps, ceil(total / time_step), must be countable and bounded.
   const double total = o.squeeze_time + o.lift_time + o.shake_time + o.hold_time;
   const double steps = total / o.time_step;
@@ -62,6 +53,8 @@ void check_options(const LiftOptions& o) {
   if (!(physics::script_steps(o) >= 1)) throw std::invalid_argument("time_step: the script has no step");
 }
 
+namespace {
+
 void check_pose(const Iso3& hand_pose, const std::string& name) {
   if (!hand_pose.matrix().allFinite()) throw std::invalid_argument(name + " contains NaN or infinity");
 }
@@ -71,7 +64,7 @@ void check_pose(const Iso3& hand_pose, const std::string& name) {
 LiftTester::LiftTester(const HandModel& hand, const TriMesh& object, const LiftOptions& options,
                        const std::vector<Eigen::MatrixX3d>& convex_pieces)
     : impl_(std::make_unique<Impl>()) {
-  check_options(options);
+  validate(options);
   validate_mesh(object);
   if (!(options.finger_torque > 0))
     for (const Finger& f : hand.fingers())

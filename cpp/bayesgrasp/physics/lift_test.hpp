@@ -160,6 +160,9 @@ struct LiftOptions {
   bool skip_separated_pairs = true;
 };
 
+/// Throws std::invalid_argument naming the first bad field (and a script of no or too many steps).
+void validate(const LiftOptions& options);
+
 /// One contact between a hand link and the object in a traced step (world frame).
 struct LiftContact {
   int sample = 0;            // index of the traced step

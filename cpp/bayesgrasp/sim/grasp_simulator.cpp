@@ -18,9 +18,7 @@ struct GraspSimulator::Impl {
   sim::SimScene scene;
 };
 
-namespace sim {
-
-void check_options(const SimOptions& o) {
+void validate(const SimOptions& o) {
   if (!(o.contact_tolerance > 0) || !std::isfinite(o.contact_tolerance))
     throw std::invalid_argument("contact_tolerance: must be positive and finite, got " +
                                 std::to_string(o.contact_tolerance));
@@ -38,9 +36,11 @@ void check_options(const SimOptions& o) {
     throw std::invalid_argument("max_iterations: must be >= 1, got " + std::to_string(o.max_iterations));
 }
 
+namespace sim {
+
 SimScene make_scene(const HandModel& hand, const TriMesh& object, const SimOptions& options) {
   validate_mesh(object);
-  check_options(options);
+  validate(options);
   SimScene s;
   s.hand = hand;
   s.mesh = object;

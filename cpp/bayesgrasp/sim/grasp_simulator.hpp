@@ -82,6 +82,9 @@ struct SimOptions {
   bool prune_queries = true;
 };
 
+/// Throws std::invalid_argument naming the first option out of range.
+void validate(const SimOptions& options);
+
 /// One approach (world frame; see GraspSimulator::approach).
 struct ApproachSpec {
   Vec3 direction = -Vec3::UnitZ();  // direction of motion = hand +z (normalised by the simulator)

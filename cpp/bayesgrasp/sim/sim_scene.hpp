@@ -25,9 +25,6 @@ struct SimScene {
   bool pruning() const { return options.prune_queries && options.rel_err == 0.0 && hand.num_links() <= 64; }
 };
 
-/// Throws std::invalid_argument naming the first option out of range.
-void check_options(const SimOptions& options);
-
 /// Validates the mesh and the options and prepares the geometry.
 SimScene make_scene(const HandModel& hand, const TriMesh& object, const SimOptions& options);
 

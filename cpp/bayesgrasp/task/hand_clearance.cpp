@@ -55,6 +55,10 @@ std::vector<PlacedShape> place(const HandModel& hand, const std::vector<Iso3>& l
 
 }  // namespace
 
+void validate(const ClearanceOptions& o) {
+  if (!(o.margin >= 0.0) || !std::isfinite(o.margin)) throw std::invalid_argument("margin: must be >= 0 and finite");
+}
+
 double shape_depth(const Shape& s, const Vec3& p, double margin) {
   if (s.type == Shape::Type::Capsule) {
     const Vec3 ab = s.p1 - s.p0;
@@ -72,8 +76,7 @@ double shape_depth(const Shape& s, const Vec3& p, double margin) {
 Clearance hand_clearance(const HandModel& hand, const Eigen::VectorXd& q, const std::vector<Iso3>& poses,
                          const CloudPoints& cloud, const ClearanceOptions& options, int threads) {
   hand.check_joints(q);
-  if (!(options.margin >= 0.0) || !std::isfinite(options.margin))
-    throw std::invalid_argument("margin: must be >= 0 and finite");
+  validate(options);
   if (!cloud.allFinite()) throw std::invalid_argument("cloud: contains NaN or infinity");
   const int N = static_cast<int>(poses.size());
   for (int i = 0; i < N; ++i)

@@ -19,6 +19,9 @@ struct ClearanceOptions {
   double margin = 0.0;   // shapes grown by this (m) for the check, >= 0
 };
 
+/// Throws std::invalid_argument naming the first bad field.
+void validate(const ClearanceOptions& options);
+
 struct Clearance {
   Eigen::VectorXd table;  // N: how deep the hand reaches below z = 0 (m), 0 if above
   Eigen::VectorXd cloud;  // N: the deepest cloud point inside a hand shape (m), 0 if none

@@ -5,6 +5,7 @@
 #include <ctime>
 #include <stdexcept>
 
+#include "bayesgrasp/common/parallel.hpp"
 #include "bayesgrasp/common/random.hpp"
 #include "bayesgrasp/optim/annealing.hpp"
 #include "bayesgrasp/optim/firefly.hpp"
@@ -108,10 +109,7 @@ int run_local(Optimizer which, BudgetedObjective& budget, const SearchSpace& spa
 }
 
 void check_options(const EstimateOptions& o, int dim) {
-  if (o.population < 0) throw std::invalid_argument("population: must be >= 0 (0 = the default)");
-  if (!(o.stop_fitness >= 0.0) || !std::isfinite(o.stop_fitness))
-    throw std::invalid_argument("stop_fitness: must be >= 0 and finite (0 = spend the whole budget), got " +
-                                std::to_string(o.stop_fitness));
+  validate(o);
   if (o.population == 1 && !is_local(o.optimizer))
     throw std::invalid_argument("population: a population optimiser needs at least 2 candidates");
   const long long min = minimum_budget(o.optimizer, dim, o.population);
@@ -122,6 +120,17 @@ void check_options(const EstimateOptions& o, int dim) {
 }
 
 }  // namespace
+
+void validate(const EstimateOptions& o) {
+  if (o.population < 0) throw std::invalid_argument("population: must be >= 0 (0 = the default)");
+  if (o.budget < 1) throw std::invalid_argument("budget: must be >= 1, got " + std::to_string(o.budget));
+  if (!(o.stop_fitness >= 0.0) || !std::isfinite(o.stop_fitness))
+    throw std::invalid_argument("stop_fitness: must be >= 0 and finite (0 = spend the whole budget), got " +
+                                std::to_string(o.stop_fitness));
+  thread_count(o.threads, "threads");
+  validate(o.box);
+  validate(o.fitness);
+}
 
 int population_size(Optimizer optimizer, int requested) {
   if (requested > 0) return requested;

@@ -38,6 +38,10 @@ struct EstimateOptions {
   double stop_fitness = 0.0; ///< end the search once the best f is below this; 0 = spend the budget
 };
 
+/// Throws std::invalid_argument naming the first bad field (its box and fitness too); the budget's
+/// minimum for the unknowns is checked by estimate().
+void validate(const EstimateOptions& options);
+
 enum class EstimateStatus {
   Estimated,  ///< the optimiser ran
   NoContact,  ///< the touch made no contact with the object: nothing learnt, the guess is kept

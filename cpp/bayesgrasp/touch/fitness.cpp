@@ -46,12 +46,18 @@ double surface_term(const TouchPredictions& p, int i, const TouchReadings& m, do
 
 }  // namespace
 
-void check_fitness_options(const FitnessOptions& o, int J) {
+void validate(const FitnessOptions& o) {
   positive_term(o.joint_sigma, "joint_sigma");
   nonnegative_term(o.contact_weight, "contact_weight");
   positive_term(o.surface_scale, "surface_scale");
   positive_term(o.height_sigma, "height_sigma");
   nonnegative_term(o.collision_penalty, "collision_penalty");
+  if (!o.joint_weights.allFinite() || (o.joint_weights.array() < 0.0).any())
+    throw std::invalid_argument("joint_weights: must be finite and >= 0");
+}
+
+void check_fitness_options(const FitnessOptions& o, int J) {
+  validate(o);
   if (o.joint_weights.size() == 0) return;
   if (o.joint_weights.size() != J)
     throw std::invalid_argument("joint_weights: expected " + std::to_string(J) + " weights (one per joint), got " +

@@ -42,6 +42,9 @@ struct FitnessOptions {
 };
 
 /// Throws std::invalid_argument naming the option out of range (J: the hand's joints).
+/// Throws std::invalid_argument naming the first bad field (joint_weights' length is checked
+/// against the hand by check_fitness_options).
+void validate(const FitnessOptions& o);
 void check_fitness_options(const FitnessOptions& o, int num_joints);
 
 /// The three terms of f per candidate, and their sum.

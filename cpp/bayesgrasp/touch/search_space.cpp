@@ -6,7 +6,7 @@
 
 namespace bayesgrasp::touch {
 
-void check_search_box(const SearchBox& b) {
+void validate(const SearchBox& b) {
   if (!(b.xy > 0.0) || !std::isfinite(b.xy))
     throw std::invalid_argument("box.xy: must be positive and finite, got " + std::to_string(b.xy));
   if (!(b.yaw > 0.0) || !(b.yaw <= M_PI))
@@ -17,7 +17,7 @@ void check_search_box(const SearchBox& b) {
 
 SearchSpace::SearchSpace(Unknowns unknowns, const State& initial, const SearchBox& box)
     : unknowns_(unknowns), initial_(initial) {
-  check_search_box(box);
+  validate(box);
   if (!initial.allFinite()) throw std::invalid_argument("initial: contains NaN or infinity");
   if (!(initial[3] > 0.0)) throw std::invalid_argument("initial: the scale must be positive");
   switch (unknowns) {

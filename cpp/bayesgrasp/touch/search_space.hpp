@@ -22,7 +22,7 @@ struct SearchBox {
 };
 
 /// Throws std::invalid_argument naming the field out of range.
-void check_search_box(const SearchBox& b);
+void validate(const SearchBox& b);
 
 /// An object state: x, y (m), yaw (rad), scale.
 using State = Eigen::Vector4d;

@@ -69,15 +69,18 @@ void check_states(const RowMatrixXd& states, const char* name) {
   if (!states.allFinite()) throw std::invalid_argument(n + ": contains NaN or infinity");
 }
 
+void validate(const TouchModelOptions& o) {
+  bayesgrasp::validate(o.sim);
+  if (!(o.scale_step > 0.0) || !std::isfinite(o.scale_step))
+    throw std::invalid_argument("scale_step: must be positive and finite, got " + std::to_string(o.scale_step));
+  if (!(o.scale_min > 0.0) || !(o.scale_max >= o.scale_min) || !std::isfinite(o.scale_max))
+    throw std::invalid_argument("scale_min, scale_max: need 0 < scale_min <= scale_max < inf");
+}
+
 TouchModel::TouchModel(const HandModel& hand, const TriMesh& object, const TouchModelOptions& options)
     : hand_(hand), object_(object), options_(options) {
   validate_mesh(object_);
-  sim::check_options(options_.sim);
-  const double step = options_.scale_step;
-  if (!(step > 0.0) || !std::isfinite(step))
-    throw std::invalid_argument("scale_step: must be positive and finite, got " + std::to_string(step));
-  if (!(options_.scale_min > 0.0) || !(options_.scale_max >= options_.scale_min) || !std::isfinite(options_.scale_max))
-    throw std::invalid_argument("scale_min, scale_max: need 0 < scale_min <= scale_max < inf");
+  validate(options_);
 }
 
 double TouchModel::quantised_scale(double scale) const {

@@ -32,6 +32,9 @@ struct TouchModelOptions {
   double scale_max = 4.0;
 };
 
+/// Throws std::invalid_argument naming the first bad field (the simulator's too).
+void validate(const TouchModelOptions& options);
+
 /// Predicted readings of N candidates (row i = candidate i).
 struct TouchPredictions {
   int num_candidates = 0;
