@@ -1,11 +1,44 @@
 // Bindings for cpp/bayesgrasp/geometry: mesh checks, mass properties and surface sampling.
 #include "bayesgrasp/geometry/mesh.hpp"
 #include "bayesgrasp/geometry/surface_sampling.hpp"
+#include "options.hpp"
 #include "validate.hpp"
 
 namespace bayesgrasp::bind {
 
 void bind_geometry(py::module_& m) {
+  py::class_<MassProperties> mp(m, "MassProperties", "Mass properties of a solid of uniform density (mesh frame).");
+  readonly(mp, "volume", &MassProperties::volume, "float", "m^3 (negative if the faces are wound inwards)");
+  readonly(mp, "mass", &MassProperties::mass, "float", "kg");
+  readonly(mp, "com", &MassProperties::com, "ndarray (3,)", "centre of mass, m");
+  readonly(mp, "inertia", &MassProperties::inertia, "ndarray (3, 3)", "inertia tensor about the centre of mass, kg m^2");
+  mp.def(
+        "to_dict",
+        [](const MassProperties& p) {
+          py::dict d;
+          d["volume"] = p.volume;
+          d["mass"] = p.mass;
+          d["com"] = Eigen::Vector3d(p.com);
+          d["inertia"] = Eigen::Matrix3d(p.inertia);
+          return d;
+        },
+        "{'volume', 'mass', 'com', 'inertia'} (new arrays).")
+      .def(py::pickle(
+          [](const MassProperties& p) {
+            return py::make_tuple(p.volume, p.mass, Eigen::Vector3d(p.com), Eigen::Matrix3d(p.inertia));
+          },
+          [](const py::tuple& t) {
+            MassProperties p;
+            p.volume = t[0].cast<double>();
+            p.mass = t[1].cast<double>();
+            p.com = t[2].cast<Eigen::Vector3d>();
+            p.inertia = t[3].cast<Eigen::Matrix3d>();
+            return p;
+          }))
+      .def("__repr__", [](const MassProperties& p) {
+        return "MassProperties(volume=" + std::to_string(p.volume) + ", mass=" + std::to_string(p.mass) + ")";
+      });
+
   m.def(
       "mass_properties",
       [](const DArray& vertices, const IArray& faces, double density) {
@@ -17,12 +50,7 @@ void bind_geometry(py::module_& m) {
         } catch (const std::invalid_argument& e) {
           throw py::value_error(std::string("mesh: ") + e.what());
         }
-        py::dict d;
-        d["volume"] = mp.volume;
-        d["mass"] = mp.mass;
-        d["com"] = Eigen::Vector3d(mp.com);
-        d["inertia"] = Eigen::Matrix3d(mp.inertia);
-        return d;
+        return mp;
       },
       py::arg("vertices"), py::arg("faces"), py::arg("density"),
       R"doc(Mass properties of a closed triangle mesh of uniform density.
@@ -33,9 +61,7 @@ Args:
     density: kg/m^3, > 0.
 
 Returns:
-    dict with ``volume`` (m^3, negative if faces are wound inwards), ``mass`` (kg),
-    ``com`` (3,) centre of mass and ``inertia`` (3, 3) inertia tensor about the centre
-    of mass (kg m^2), in the mesh frame.)doc");
+    MassProperties (volume, mass, com, inertia; ``to_dict()``), in the mesh frame.)doc");
 
   py::class_<SurfaceSamples>(m, "SurfaceSamples", "Points and unit outward normals sampled on a surface.")
       .def_readonly("points", &SurfaceSamples::points, "points : ndarray (N, 3)\n    sample positions, m")

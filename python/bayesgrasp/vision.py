@@ -8,7 +8,7 @@ correspondences, point-to-plane ICP, and a hypothesis choice that penalises upsi
 To register many clouds against the same models, prepare the models once in a :class:`Registrar`.
 The registration's settings are a :class:`RegistrationOptions` (one option class per step:
 ``features``, ``correspondences``, ``ransac``, ``icp``, ``up_prior``); :func:`register` and
-:class:`Registrar` take one, and the flat keywords listed in :func:`registration_options`.
+:class:`Registrar` take one, and its fields by keyword (see :func:`registration_options`).
 
 >>> from bayesgrasp.vision import Camera, segment_table, register
 >>> cam = Camera.looking_at(eye=(0.5, -0.5, 0.5), target=(0, 0, 0.05))
@@ -45,7 +45,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field
-from typing import Any, Callable, Dict, List, Optional, Sequence, Tuple, Union
+from typing import Any, List, Optional, Sequence, Tuple, Union
 
 from bayesgrasp._args import c_int, c_seed, with_fields
 import numpy as np
@@ -218,62 +218,42 @@ def segment_table(cloud, options: Optional[SegmentationOptions] = None, **fields
 
 # ---------------------------------------------------------------------------------------------
 # registration options
-def _set(path: str, convert: Optional[Callable] = None):
-    """A keyword's setter: assigns the (converted) value to the field at a dotted path."""
-    *parents, name = path.split(".")
-
-    def assign(options, value):
-        target = options
-        for p in parents:
-            target = getattr(target, p)
-        setattr(target, name, convert(value) if convert else value)
-
-    return assign
-
-
-# The flat keywords of register() and Registrar(), each mapped to its field.
-_KEYWORDS: Dict[str, Callable] = {
-    "voxel": _set("voxel"),
-    "inlier_distance": _set("inlier_distance"),
-    "weight_sigma": _set("weight_sigma"),
-    "min_scene_points": _set("min_scene_points"),
-    "threads": _set("threads"),
-    "normal_radius": _set("features.normal_radius"),
-    "feature_radius": _set("features.feature_radius"),
-    "pcl_features": _set("features.estimator", lambda b: FeatureEstimator.Pcl if b else FeatureEstimator.Ours),
-    "feature_neighbours": _set("correspondences.neighbours"),
-    "reverse_matches": _set("correspondences.reverse"),
-    "hellinger": _set("correspondences.hellinger"),
-    "restarts": _set("ransac.restarts"),
-    "ransac_iterations": _set("ransac.iterations"),
-    "hypotheses": _set("ransac.hypotheses"),
-    "icp_iterations": _set("icp.iterations"),
-    "icp_distance": _set("icp.distance"),
-    "up_prior": _set("up_prior.enabled"),
-    "upright": _set("up_prior.upright"),
-    "up": _set("up_prior.up", lambda u: np.asarray(u, float)),
-    "max_tilt_deg": _set("up_prior.max_tilt", lambda d: float(d) * math.pi / 180.0),
-}
+def _steps(options: RegistrationOptions) -> List[str]:
+    """The fields of RegistrationOptions that are option classes themselves (its steps)."""
+    return [f for f in RegistrationOptions.fields if hasattr(type(getattr(options, f)), "fields")]
 
 
 def registration_options(options: Optional[RegistrationOptions] = None, **keywords) -> RegistrationOptions:
-    """A validated copy of ``options`` (default: ``RegistrationOptions()``) with the flat keywords
-    applied: voxel, inlier_distance, weight_sigma, min_scene_points, threads (fields of
-    RegistrationOptions); normal_radius, feature_radius, pcl_features (``features``; pcl_features
-    True selects ``FeatureEstimator.Pcl``); feature_neighbours, reverse_matches, hellinger
-    (``correspondences``); restarts, ransac_iterations, hypotheses (``ransac``); icp_iterations,
-    icp_distance (``icp``); up_prior, upright, up, max_tilt_deg (``up_prior``: enabled, upright, up,
-    max_tilt in radians). Every other field is set on the options object itself. ValueError for an
-    unknown keyword (naming it) or a bad value (naming the field)."""
-    if options is None:
-        options = RegistrationOptions()
-    elif not isinstance(options, RegistrationOptions):
-        raise ValueError(f"options: expected a RegistrationOptions, got {type(options).__name__}")
-    out = options.__copy__()
+    """A validated copy of ``options`` (default: ``RegistrationOptions()``) with ``keywords`` set.
+    A keyword names a field of :class:`RegistrationOptions` (``voxel=0.004``, ``ransac=RansacOptions(...)``)
+    or a field of exactly one of its steps (``restarts=6`` sets ``ransac.restarts``, ``upright=False``
+    sets ``up_prior.upright``, ``estimator=FeatureEstimator.Pcl``); a field two steps share
+    (``iterations``, of ``ransac`` and ``icp``) is given through its step. A step given True or False
+    sets its ``enabled`` field (``up_prior=False``: 6-DOF, no tilt limit). The names are the bound
+    classes' own (``RegistrationOptions.fields``, ``RansacOptions.fields``, ...); angles are radians.
+    ValueError naming an unknown or shared keyword or a bad value; ``options`` is never changed."""
+    out = with_fields(RegistrationOptions, options)
+    steps = _steps(out)
     for key, value in keywords.items():
-        if key not in _KEYWORDS:
-            raise ValueError(f"{key}: unknown registration parameter (known: {', '.join(sorted(_KEYWORDS))})")
-        _KEYWORDS[key](out, value)
+        if key in steps and isinstance(value, (bool, np.bool_)):
+            key, value = f"{key}.enabled", bool(value)
+        elif key not in RegistrationOptions.fields:
+            owners = [s for s in steps if key in type(getattr(out, s)).fields]
+            if len(owners) != 1:
+                known = sorted(set(RegistrationOptions.fields) | {f for s in steps for f in type(getattr(out, s)).fields})
+                why = f"a field of {' and '.join(owners)}: give it through its step" if owners else \
+                    f"unknown registration option (known: {', '.join(known)})"
+                raise ValueError(f"{key}: {why}")
+            key = f"{owners[0]}.{key}"
+        step, _, name = key.rpartition(".")
+        if step:
+            sub = getattr(out, step)
+            try:
+                setattr(out, step, with_fields(type(sub), sub, {name: value}))
+            except ValueError as e:
+                raise ValueError(f"{step}.{e}") from None
+        else:
+            out = with_fields(RegistrationOptions, out, {name: value})
     out.validate()
     return out
 
@@ -410,7 +390,7 @@ class Registrar:
         names: a name per model (else the index), used in the results and by ``models=`` of
             :meth:`register`.
         model_seed: seeds the surface sampling of the meshes (model i: model_seed + i).
-        keywords: flat option keywords (see :func:`registration_options`), applied over ``options``;
+        keywords: option fields by keyword (see :func:`registration_options`), applied over ``options``;
             ``seed`` and ``viewpoint`` are given per call, to :meth:`register`.
     """
 
@@ -485,11 +465,9 @@ def register(cloud, models: Sequence, options: Optional[RegistrationOptions] = N
         viewpoint: the camera centre in the cloud's frame (scene normals point towards it); without
             it they point away from the cloud's centroid.
         names: a name per model (else the index), in the results.
-        keywords: flat option keywords applied over ``options`` (see :func:`registration_options`):
-            voxel, up_prior, up, upright, restarts, ransac_iterations, hypotheses, icp_iterations,
-            feature_neighbours, normal_radius, feature_radius, inlier_distance, icp_distance,
-            weight_sigma, max_tilt_deg, min_scene_points, threads, reverse_matches, hellinger,
-            pcl_features (PCL's normal and FPFH estimators instead of ours: same definitions, slower).
+        keywords: fields of the options or of one of its steps, applied over ``options`` (see
+            :func:`registration_options`): voxel, restarts, upright, up_prior=False, estimator (PCL's
+            normal and FPFH estimators, FeatureEstimator.Pcl: same definitions, slower), ...
 
     Returns one :class:`RegistrationResult` per model, in order (``time_features`` includes the
     model's preparation). A model with no surface, or a cloud with too few points for the features,

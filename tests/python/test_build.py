@@ -1,3 +1,5 @@
+import pickle
+
 import numpy as np
 import pytest
 
@@ -14,10 +16,15 @@ def _unit_cube():
 def test_mass_properties_of_unit_cube():
     V, F = _unit_cube()
     mp = _core.geometry.mass_properties(V, F, 1000.0)
-    assert mp["volume"] == pytest.approx(1.0)
-    assert mp["mass"] == pytest.approx(1000.0)
-    np.testing.assert_allclose(mp["com"], [0.5, 0.5, 0.5])
-    np.testing.assert_allclose(np.diag(mp["inertia"]), [1000 / 6] * 3)
+    assert isinstance(mp, _core.geometry.MassProperties)
+    assert mp.volume == pytest.approx(1.0)
+    assert mp.mass == pytest.approx(1000.0)
+    np.testing.assert_allclose(mp.com, [0.5, 0.5, 0.5])
+    np.testing.assert_allclose(np.diag(mp.inertia), [1000 / 6] * 3)
+    d = mp.to_dict()
+    assert set(d) == {"volume", "mass", "com", "inertia"} and d["com"].shape == (3,) and d["inertia"].shape == (3, 3)
+    back = pickle.loads(pickle.dumps(mp))  # objects holding it go to spawned workers
+    assert back.mass == mp.mass and np.array_equal(back.inertia, mp.inertia)
 
 
 @pytest.mark.parametrize("bad, match", [

@@ -364,19 +364,20 @@ def test_option_fields_take_effect():
 
 
 def test_keywords_map_to_fields():
+    # A keyword is a field of RegistrationOptions or of exactly one of its steps, named as the
+    # bound classes name them (no list of aliases in Python).
     cases = {
         "voxel": (0.004, "voxel", 0.004), "inlier_distance": (2.0, "inlier_distance", 2.0),
         "weight_sigma": (0.7, "weight_sigma", 0.7), "min_scene_points": (12, "min_scene_points", 12),
         "threads": (1, "threads", 1), "normal_radius": (2.5, "features.normal_radius", 2.5),
         "feature_radius": (4.0, "features.feature_radius", 4.0),
-        "pcl_features": (True, "features.estimator", FeatureEstimator.Pcl),
-        "feature_neighbours": (3, "correspondences.neighbours", 3),
-        "reverse_matches": (False, "correspondences.reverse", False),
+        "estimator": (FeatureEstimator.Pcl, "features.estimator", FeatureEstimator.Pcl),
+        "neighbours": (3, "correspondences.neighbours", 3),
+        "reverse": (False, "correspondences.reverse", False),
         "hellinger": (False, "correspondences.hellinger", False), "restarts": (6, "ransac.restarts", 6),
-        "ransac_iterations": (500, "ransac.iterations", 500), "hypotheses": (2, "ransac.hypotheses", 2),
-        "icp_iterations": (12, "icp.iterations", 12), "icp_distance": (1.1, "icp.distance", 1.1),
+        "hypotheses": (2, "ransac.hypotheses", 2), "distance": (1.1, "icp.distance", 1.1),
         "up_prior": (False, "up_prior.enabled", False), "upright": (False, "up_prior.upright", False),
-        "up": ((0, 0, 2.0), "up_prior.up", (0, 0, 2.0)), "max_tilt_deg": (30.0, "up_prior.max_tilt", math.pi / 6),
+        "up": ((0, 0, 2.0), "up_prior.up", (0, 0, 2.0)), "max_tilt": (math.pi / 6, "up_prior.max_tilt", math.pi / 6),
     }
     for kw, (value, path, want) in cases.items():
         got = _get(registration_options(**{kw: value}), path)
@@ -384,7 +385,11 @@ def test_keywords_map_to_fields():
             assert got == want, kw
         else:
             np.testing.assert_allclose(np.asarray(got, float), np.asarray(want, float), rtol=1e-15, err_msg=kw)
-    assert registration_options(pcl_features=False).features.estimator == FeatureEstimator.Ours
+    # A field two steps share goes through its step; a step's options object replaces it.
+    with pytest.raises(ValueError, match="iterations: a field of ransac and icp"):
+        registration_options(iterations=12)
+    o = registration_options(icp=_core.vision.IcpOptions(iterations=12))
+    assert (o.icp.iterations, o.ransac.iterations) == (12, RegistrationOptions().ransac.iterations)
     # Keywords apply over a given options object, which is not changed.
     o = RegistrationOptions(voxel=0.006)
     k = registration_options(o, restarts=4)
@@ -402,7 +407,7 @@ def test_keywords_map_to_fields():
     with pytest.raises(ValueError, match="threads"):
         vision.Registrar([l_block()], threads=-1)
     with pytest.raises(ValueError, match="up_prior.max_tilt"):
-        registration_options(max_tilt_deg=0)
+        registration_options(max_tilt=0.0)
 
 
 def test_typed_failures_and_model_info():

@@ -34,16 +34,11 @@ class MeshWarning(UserWarning):
     """A mesh problem that does not stop loading (e.g. it is not watertight)."""
 
 
-def _core_mass_properties(V: np.ndarray, F: np.ndarray, density: float) -> dict:
+def _core_mass_properties(V: np.ndarray, F: np.ndarray, density: float):
+    """The core's MassProperties of a closed mesh."""
     from bayesgrasp import _core
 
-    mp = _core.geometry.mass_properties(V, F, float(density))
-    return {
-        "volume": float(mp["volume"]),
-        "mass": float(mp["mass"]),
-        "com": np.asarray(mp["com"], dtype=np.float64).reshape(3),
-        "inertia": np.asarray(mp["inertia"], dtype=np.float64).reshape(3, 3),
-    }
+    return _core.geometry.mass_properties(V, F, float(density))
 
 
 def _edge_use_counts(F: np.ndarray) -> np.ndarray:
@@ -228,23 +223,23 @@ class ObjectModel:
     @property
     def mass_properties(self) -> dict:
         """dict with ``volume`` (m^3), ``mass`` (kg), ``com`` (3,), ``inertia`` (3, 3) about com."""
-        return {k: (v.copy() if isinstance(v, np.ndarray) else v) for k, v in self._mp.items()}
+        return self._mp.to_dict()
 
     @property
     def volume(self) -> float:
-        return self._mp["volume"]
+        return self._mp.volume
 
     @property
     def mass(self) -> float:
-        return self._mp["mass"]
+        return self._mp.mass
 
     @property
     def com(self) -> np.ndarray:
-        return self._mp["com"].copy()
+        return np.array(self._mp.com)
 
     @property
     def inertia(self) -> np.ndarray:
-        return self._mp["inertia"].copy()
+        return np.array(self._mp.inertia)
 
     # ---- geometry --------------------------------------------------------------------------
     @property
@@ -266,7 +261,7 @@ class ObjectModel:
     @property
     def max_radius_from_com(self) -> float:
         """Largest distance from the centre of mass to a vertex: the torque scale of the GWS."""
-        return float(np.linalg.norm(self.vertices - self._mp["com"], axis=1).max())
+        return float(np.linalg.norm(self.vertices - self._mp.com, axis=1).max())
 
     @property
     def n_faces(self) -> int:
