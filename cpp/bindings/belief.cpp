@@ -14,7 +14,7 @@
 #include "bayesgrasp/belief/particles.hpp"
 #include "bayesgrasp/belief/pose_grid.hpp"
 #include "bayesgrasp/belief/relative_pose.hpp"
-#include "options.hpp"
+#include "belief_args.hpp"
 #include "validate.hpp"
 
 namespace bayesgrasp::bind {
@@ -23,6 +23,8 @@ namespace py = pybind11;
 using namespace py::literals;
 namespace bl = bayesgrasp::belief;
 
+void bind_pose_beliefs(py::module_& m);
+
 namespace {
 
 /// A belief with its own seeded generator (Python-side object).
@@ -30,72 +32,6 @@ struct PyBelief {
   bl::ParticleBelief belief;
   bl::Rng rng;
 };
-
-/// Runs f without the GIL (the core's exceptions pass through to pybind11's translation).
-template <class F>
-auto released(F&& f) -> decltype(f()) {
-  py::gil_scoped_release release;
-  return f();
-}
-
-/// The state space; StateSpace validates the bounds and flags.
-bl::StateSpace space_from(const DArray& low, const DArray& high, const py::object& wraps) {
-  std::vector<bool> w;
-  if (!wraps.is_none()) w = py::cast<std::vector<bool>>(wraps);
-  return bl::StateSpace(vector(low, "low"), vector(high, "high"), w);
-}
-
-/// A 1-D array of log-weights or log-likelihoods (-inf allowed: zero weight; the core rejects
-/// NaN and +inf).
-Eigen::VectorXd log_weights_from(const DArray& a, const char* name) {
-  if (a.ndim() != 1) throw py::value_error(std::string(name) + ": expected a 1-D array, got " + shape_str(a));
-  return Eigen::Map<const Eigen::VectorXd>(a.data(), a.shape(0));
-}
-
-/// A vectorised Python callable (N, D) -> (N,) as a batch log-likelihood (GIL taken per call).
-bl::BatchLogLikelihood likelihood_from(const py::object& obj, const char* name) {
-  if (!PyCallable_Check(obj.ptr()))
-    throw py::value_error(std::string(name) + ": expected a callable (N, D) -> (N,) of log-likelihoods");
-  py::function fn = py::reinterpret_borrow<py::function>(obj);
-  std::string nm(name);
-  return [fn, nm](const bl::RowMatrixXd& X, Eigen::VectorXd& ll) {
-    py::gil_scoped_acquire gil;
-    py::array_t<double> arr({X.rows(), X.cols()});
-    std::copy(X.data(), X.data() + X.size(), arr.mutable_data());
-    DArray a = py::cast<DArray>(fn(arr));
-    if (!(a.ndim() == 1 || (a.ndim() == 2 && a.shape(1) == 1)) || a.shape(0) != X.rows())
-      throw py::value_error(nm + ": must return an array of shape (" + std::to_string(X.rows()) + ",), got " +
-                            shape_str(a));
-    ll = Eigen::Map<const Eigen::VectorXd>(a.data(), X.rows());
-  };
-}
-
-/// mean/var as (A, N, K) or (N, K) (A = 1) arrays -> (A*N, K) matrices (the core checks the
-/// rows against the particles and the values).
-bl::RowMatrixXd stacked(const DArray& a, const char* name, py::ssize_t& n_actions) {
-  if (a.ndim() == 2) {
-    n_actions = 1;
-    return Eigen::Map<const bl::RowMatrixXd>(a.data(), a.shape(0), a.shape(1));
-  }
-  if (a.ndim() != 3) throw py::value_error(std::string(name) + ": expected shape (A, N, K) or (N, K), got " + shape_str(a));
-  n_actions = a.shape(0);
-  return Eigen::Map<const bl::RowMatrixXd>(a.data(), a.shape(0) * a.shape(1), a.shape(2));
-}
-
-py::array_t<double> to_np(const bl::RowMatrixXd& m) { return to_numpy(m); }
-
-py::tuple estimates(const std::vector<bl::EntropyEstimate>& est) {
-  Eigen::VectorXd h(est.size()), se(est.size());
-  for (size_t i = 0; i < est.size(); ++i) {
-    h[i] = est[i].mean;
-    se[i] = est[i].std_error;
-  }
-  return py::make_tuple(h, se);
-}
-
-}  // namespace
-
-namespace {
 
 void def_belief_state(py::class_<PyBelief>& c) {
   c.def(py::init([](const DArray& particles, const DArray& low, const DArray& high, const py::object& wraps,
@@ -295,154 +231,12 @@ void bind_entropy(py::module_& m) {
       "then expected_posterior_entropy. particles (N, 3) planar poses; actions (A, input_dim).");
 }
 
-/// Binds a planar pose map f(grasps (R, 3 + extra), poses (N, 3)) under `name`.
-using PoseMap = bl::RowMatrixXd (*)(const bl::RowMatrixXd&, const bl::RowMatrixXd&);
-void def_pose_map(py::module_& m, const char* name, PoseMap f, const char* grasps, const char* doc) {
-  m.def(
-      name,
-      [f, grasps](const DArray& g, const DArray& poses) { return to_np(f(matrix(g, grasps), matrix(poses, "poses"))); },
-      py::arg(grasps), "poses"_a, doc);
-}
-
-void bind_planar_pose(py::module_& m) {
-  def_pose_map(m, "relative_planar_pose", bl::relative_planar_pose, "actions",
-               "Grasp poses relative to object poses, for all pairs: actions (A, 3 + extra), poses (N, 3) ->\n"
-               "(A*N, 3 + extra), row a*N + j = (R(-yaw_j)(a_xy - o_xy), wrap(a_yaw - yaw_j), extra_a).");
-  def_pose_map(m, "compose_planar_pose", bl::compose_planar_pose, "relative",
-               "The inverse of relative_planar_pose, for all pairs: relative grasps (R, 3 + extra) in object\n"
-               "frames, poses (N, 3) -> world grasps (R*N, 3 + extra), row r*N + j =\n"
-               "(o_xy_j + R(yaw_j) r_xy, wrap(r_yaw + yaw_j), extra_r).");
-  def_pose_map(m, "compose_planar_pose_paired", bl::compose_planar_pose_paired, "relative",
-               "compose_planar_pose one to one: relative (N, 3 + extra) and poses (N, 3) -> (N, 3 + extra),\n"
-               "row i = (o_xy_i + R(yaw_i) r_xy_i, wrap(r_yaw_i + yaw_i), extra_i).");
-}
-
-void bind_pose_grid(py::module_& m) {
-  py::class_<bl::RelativePoseGrid>(m, "RelativePoseGrid",
-                                   "A regular grid over relative grasp poses (x, y, yaw) with C channels,\n"
-                                   "trilinear interpolation, yaw periodic (a tabulated planning model).")
-      .def(py::init([](const DArray& lo, const DArray& hi, int nx, int ny, int nyaw, const DArray& values,
-                       const DArray& outside) {
-             const Eigen::VectorXd l = vector(lo, "lo", 2), h = vector(hi, "hi", 2);
-             bl::RowMatrixXd V = matrix(values, "values");
-             if (outside.ndim() != 1) throw py::value_error("outside: expected a 1-D array");
-             Eigen::Map<const Eigen::VectorXd> o(outside.data(), outside.shape(0));
-             return new bl::RelativePoseGrid({l[0], l[1]}, {h[0], h[1]}, nx, ny, nyaw, std::move(V), Eigen::VectorXd(o));
-           }),
-           "lo"_a, "hi"_a, "nx"_a, "ny"_a, "nyaw"_a, "values"_a, "outside"_a,
-           "Nodes x_i = lo[0] + i (hi[0]-lo[0])/(nx-1), likewise y, yaw_k = -pi + 2 pi k / nyaw; values\n"
-           "(nx*ny*nyaw, C), row (ix*ny + iy)*nyaw + k; outside (C,): value where x or y is outside the\n"
-           "grid, NaN to clamp to the edge.")
-      .def_property_readonly("channels", &bl::RelativePoseGrid::channels)
-      .def_property_readonly("shape", [](const bl::RelativePoseGrid& g) {
-        return py::make_tuple(g.nx(), g.ny(), g.nyaw(), g.channels());
-      })
-      .def(
-          "interpolate",
-          [](const bl::RelativePoseGrid& g, const DArray& rel) {
-            const bl::RowMatrixXd R = matrix(rel, "rel", -1, true);
-            return to_np(released([&] { return g.interpolate(R); }));
-          },
-          "rel"_a, "Values at relative poses (P, 3) -> (P, C).")
-      .def(
-          "interpolate_pairs",
-          [](const bl::RelativePoseGrid& g, const DArray& actions, const DArray& poses, int c0, int nc, int n_threads) {
-            const bl::RowMatrixXd A = matrix(actions, "actions"), P = matrix(poses, "poses");
-            return to_np(released([&] { return g.interpolate_pairs(A, P, c0, nc, n_threads); }));
-          },
-          "actions"_a, "poses"_a, "c0"_a = 0, "nc"_a = 1, "n_threads"_a = 1,
-          "Channels [c0, c0+nc) at every action (A, 3) relative to every pose (N, 3): (A*N, nc),\n"
-          "row a*N + j. n_threads: threads over the actions (0 = all cores).")
-      .def(
-          "expected",
-          [](const bl::RelativePoseGrid& g, const DArray& actions, const DArray& poses, const DArray& weights,
-             int channel, int n_threads) {
-            const bl::RowMatrixXd A = matrix(actions, "actions"), P = matrix(poses, "poses");
-            const Eigen::VectorXd w = vector(weights, "weights");
-            return released([&] { return g.expected(A, P, w, channel, n_threads); });
-          },
-          "actions"_a, "poses"_a, "weights"_a, "channel"_a = 0, "n_threads"_a = 1,
-          "sum_j w_j value(action relative to pose_j) for every action (A,): Eq. 3.1's integral over\n"
-          "a particle belief when the channel is P(S | A, O).")
-      .def(
-          "expected_posterior_entropy",
-          [](const bl::RelativePoseGrid& g, const DArray& actions, const DArray& poses, const DArray& log_weights,
-             int mean_c0, int var_c0, int k, int n_samples, std::uint64_t seed, int n_threads) {
-            const bl::RowMatrixXd A = matrix(actions, "actions"), P = matrix(poses, "poses");
-            const Eigen::VectorXd lw = log_weights_from(log_weights, "log_weights");
-            return estimates(released([&] {
-              return g.expected_posterior_entropy(A, P, lw, mean_c0, var_c0, k, n_samples, seed, n_threads);
-            }));
-          },
-          "actions"_a, "poses"_a, "log_weights"_a, "mean_c0"_a, "var_c0"_a, "k"_a, "n_samples"_a = 100,
-          "seed"_a = 0, "n_threads"_a = 1,
-          "Expected posterior weight entropy (Eq. 3.2) of every action with the measurement mean in\n"
-          "channels [mean_c0, mean_c0+k) and its variance in [var_c0, var_c0+k). Returns (h (A,), se (A,)).");
-}
-
-void bind_model_mixture(py::module_& m) {
-  OptionClass<bl::ModelPoseOptions>(m, "ModelPoseOptions", "Options of Eq. 4.4's per-model MAP pose update.")
-      .field("prior_std", &bl::ModelPoseOptions::prior_std, "ndarray (3,)",
-             "sd of the Gaussian prior around the previous pose (m, m, rad)")
-      .field("measurement_noise", &bl::ModelPoseOptions::measurement_noise, "float",
-             "joint-angle noise sd (rad) added to the predictive variance")
-      .field("trust_region", &bl::ModelPoseOptions::trust_region, "TrustRegionOptions",
-             "the dogleg trust region's options (scaled coordinates)")
-      .validator([](const bl::ModelPoseOptions& o) { o.validate(); })
-      .finish();
-  py::class_<bl::ModelPoseUpdate>(m, "ModelPoseUpdate", "One model's MAP pose after a grasp (Eq. 4.4).")
-      .def_readonly("pose", &bl::ModelPoseUpdate::pose, "pose : ndarray (3,)\n    p_i(t) = (x, y, yaw), yaw in [-pi, pi)")
-      .def_readonly("log_likelihood", &bl::ModelPoseUpdate::log_likelihood,
-                    "log_likelihood : float\n    log L_i of the measurement at p_i(t)")
-      .def_readonly("log_prior", &bl::ModelPoseUpdate::log_prior,
-                    "log_prior : float\n    log N(p_i(t); p_i(t-1), S) up to its constant")
-      .def_readonly("evaluations", &bl::ModelPoseUpdate::evaluations, "evaluations : int\n    objective evaluations")
-      .def_readonly("converged", &bl::ModelPoseUpdate::converged, "converged : bool\n    a tolerance was met");
-  py::class_<bl::ModelWeightUpdate>(m, "ModelWeightUpdate", "Eq. 4.5's weights.")
-      .def_readonly("weights", &bl::ModelWeightUpdate::weights, "weights : ndarray (M,)\n    normalised weights")
-      .def_readonly("underflow", &bl::ModelWeightUpdate::underflow,
-                    "underflow : bool\n    every likelihood was zero: the previous weights were kept");
-  m.def(
-      "map_model_poses",
-      [](const std::vector<const bl::RelativePoseGrid*>& grids, int mean_c0, int var_c0, int k, const DArray& grasp,
-         const DArray& measurement, const DArray& prior_poses, const bl::ModelPoseOptions& o, int threads) {
-        const Eigen::Vector3d g = vector(grasp, "grasp", 3);
-        const Eigen::VectorXd mv = vector(measurement, "measurement");
-        const RowMatrixXd P = matrix(prior_poses, "prior_poses", 3, true);
-        py::gil_scoped_release release;
-        return bl::map_model_poses(grids, bl::MeasurementChannels{mean_c0, var_c0, k}, g, mv, P, o, threads);
-      },
-      "grids"_a, "mean_c0"_a, "var_c0"_a, "k"_a, "grasp"_a, "measurement"_a, "prior_poses"_a,
-      "options"_a = bl::ModelPoseOptions(), "threads"_a = 1,
-      "Eq. 4.4 for every model: its MAP pose after the top grasp `grasp` (x, y, yaw) read `measurement`.");
-  m.def(
-      "measurement_log_likelihood",
-      [](const bl::RelativePoseGrid& g, int mean_c0, int var_c0, int k, const DArray& grasp, const DArray& measurement,
-         const DArray& poses, double noise) {
-        return bl::measurement_log_likelihood(g, bl::MeasurementChannels{mean_c0, var_c0, k}, vector(grasp, "grasp", 3),
-                                              vector(measurement, "measurement"), matrix(poses, "poses", 3, true), noise);
-      },
-      "grid"_a, "mean_c0"_a, "var_c0"_a, "k"_a, "grasp"_a, "measurement"_a, "poses"_a, "measurement_noise"_a = 0.0,
-      "log N(m; mu(G - p), var(G - p) + s_n^2) for poses p (N, 3).");
-  m.def(
-      "update_model_weights",
-      [](const DArray& ll, const DArray& previous, bool recursive) {
-        Eigen::Map<const Eigen::VectorXd> l(ll.data(), ll.ndim() == 1 ? ll.shape(0) : 0);
-        if (ll.ndim() != 1) throw py::value_error("log_likelihoods: expected shape (M,), got " + shape_str(ll));
-        return bl::update_model_weights(l, vector(previous, "previous"), recursive);
-      },
-      "log_likelihoods"_a, "previous"_a, "recursive"_a = false,
-      "Eq. 4.5: w_i = L_i / sum_j L_j (recursive: w_i ~ w_i(t-1) L_i); all zero keeps the previous weights.");
-}
-
 }  // namespace
 
 void bind_belief(py::module_& m) {
   bind_particle_belief(m);
   bind_entropy(m);
-  bind_planar_pose(m);
-  bind_pose_grid(m);
-  bind_model_mixture(m);
+  bind_pose_beliefs(m);
 }
 
 }  // namespace bayesgrasp::bind

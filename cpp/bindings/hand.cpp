@@ -113,24 +113,9 @@ void def_kinematics(py::class_<HandModel>& hand) {
           "Per link, its collision shapes (Shape) in the link frame.");
 }
 
-}  // namespace
-
-void bind_hand(py::module_& m) {
-  bind_shape(m);
-  py::class_<HandModel> hand(m, "Hand", R"doc(A multi-fingered hand described by a JSON file.
-
-Frames: the hand frame has its origin at the centre of the palm face and +z along the
-approach direction. Joint vector q (radians): [spread, finger 0 phalanx 0, finger 0
-phalanx 1, ..., finger 1 phalanx 0, ...]; phalanx angles are relative to the previous
-phalanx. Each finger closes by one actuator parameter t: phalanx j follows
-offset_j + ratio_j * t, clamped to its limits (the coupling), with breakaway.)doc");
-  hand.def_static(
-          "from_file", [](const std::string& path) { return HandModel::from_file(path); },
-          py::arg("path"), "Loads a hand file; ValueError naming the problem if it is missing or invalid.")
-      .def_static(
-          "from_json", [](const std::string& text) { return HandModel::from_json(text); },
-          py::arg("text"), "Parses the JSON text of a hand file; ValueError naming the problem.")
-      .def_property_readonly("name", &HandModel::name, "The hand's name.")
+/// Names and the link layout.
+void def_layout(py::class_<HandModel>& hand) {
+  hand.def_property_readonly("name", &HandModel::name, "The hand's name.")
       .def_property_readonly("num_joints", &HandModel::num_joints, "Length of the joint vector q.")
       .def_property_readonly("num_links", &HandModel::num_links, "Number of links (0 = palm).")
       .def_property_readonly("num_fingers", [](const HandModel& h) { return static_cast<int>(h.fingers().size()); },
@@ -143,8 +128,12 @@ offset_j + ratio_j * t, clamped to its limits (the coupling), with breakaway.)do
           "Finger index of each link (-1 for the palm).")
       .def_property_readonly(
           "link_phalanges", [](const HandModel& h) { return per_link(h, [](const Link& l) { return l.phalanx; }); },
-          "Phalanx index of each link within its finger (-1 for palm and knuckles).")
-      .def_property_readonly(
+          "Phalanx index of each link within its finger (-1 for palm and knuckles).");
+}
+
+/// The joint vector: names, limits, torques, which links each finger drives.
+void def_joints(py::class_<HandModel>& hand) {
+  hand.def_property_readonly(
           "joint_names",
           [](const HandModel& h) {
             std::vector<std::string> n(h.num_joints());
@@ -191,8 +180,12 @@ offset_j + ratio_j * t, clamped to its limits (the coupling), with breakaway.)do
           "Per finger, the link indices of its phalanges (base to tip).")
       .def_property_readonly(
           "spread_limits", [](const HandModel& h) { return std::make_pair(h.spread_lower(), h.spread_upper()); },
-          "(lower, upper) spread limits (rad).")
-      .def_static(
+          "(lower, upper) spread limits (rad).");
+}
+
+/// Hand poses from grasp parameters, and repr.
+void def_poses(py::class_<HandModel>& hand) {
+  hand.def_static(
           "top_grasp_pose",
           [](double x, double y, double yaw, double z) {
             finite(x, "x"), finite(y, "y"), finite(yaw, "yaw"), finite(z, "z");
@@ -215,6 +208,28 @@ ValueError naming `direction` (zero or not finite), `roll` or `palm`.)doc")
         return "<Hand '" + h.name() + "': " + std::to_string(h.fingers().size()) + " fingers, " +
                std::to_string(h.num_joints()) + " joints>";
       });
+}
+
+}  // namespace
+
+void bind_hand(py::module_& m) {
+  bind_shape(m);
+  py::class_<HandModel> hand(m, "Hand", R"doc(A multi-fingered hand described by a JSON file.
+
+Frames: the hand frame has its origin at the centre of the palm face and +z along the
+approach direction. Joint vector q (radians): [spread, finger 0 phalanx 0, finger 0
+phalanx 1, ..., finger 1 phalanx 0, ...]; phalanx angles are relative to the previous
+phalanx. Each finger closes by one actuator parameter t: phalanx j follows
+offset_j + ratio_j * t, clamped to its limits (the coupling), with breakaway.)doc");
+  hand.def_static(
+          "from_file", [](const std::string& path) { return HandModel::from_file(path); },
+          py::arg("path"), "Loads a hand file; ValueError naming the problem if it is missing or invalid.")
+      .def_static(
+          "from_json", [](const std::string& text) { return HandModel::from_json(text); },
+          py::arg("text"), "Parses the JSON text of a hand file; ValueError naming the problem.");
+  def_layout(hand);
+  def_joints(hand);
+  def_poses(hand);
   def_kinematics(hand);
 }
 

@@ -12,7 +12,10 @@ namespace bayesgrasp::bind {
 
 using namespace bayesgrasp::task;
 
-void bind_task(py::module_& m) {
+namespace {
+
+/// Eq. 4.1's pose density (an option class: its kind and scales).
+void bind_density(py::module_& m) {
   py::enum_<DensityKind>(m, "DensityKind", "Form of the pose density around a task grasp (Eq. 4.1).")
       .value("gaussian", DensityKind::Gaussian)
       .value("regularised", DensityKind::RegularisedGaussian)
@@ -34,7 +37,10 @@ lambda Gauss(kappa s); Laplace exp(-(d_t/s_t + d_R/s_R)). 1 at the grasp.)doc");
       .finish()
       .def("__call__", [](const PoseDensity& d, double dt, double dr) { d.validate(); return d(dt, dr); },
            py::arg("dt"), py::arg("dr"), "The density at translation distance dt (m) and rotation angle dr (rad).");
+}
 
+/// Eq. 4.1's grasp mixture and its values, and the local pose coordinates it plans in.
+void bind_mixture(py::module_& m) {
   py::class_<MixtureValues>(m, "MixtureValues", "Eq. 4.1's objective at a batch of candidate hand poses.")
       .def_readonly("value", &MixtureValues::value, "value : ndarray (N,)\n    J(A)")
       .def_readonly("per_model", &MixtureValues::per_model,
@@ -79,7 +85,10 @@ models carried into the scene, each with weight psi(q_ik) phi(delta_i).)doc")
       },
       py::arg("reference"), py::arg("X"),
       "Poses (N, 4, 4) from rows (t, r) of X (N, 6): rotation exp([r]) R_ref, translation t_ref + t.");
+}
 
+/// The open hand's clearance of the table and the cloud.
+void bind_clearance(py::module_& m) {
   OptionClass<ClearanceOptions>(m, "ClearanceOptions", "What the open hand must be clear of.")
       .field("table", &ClearanceOptions::table, "bool", "the plane z = 0 is an obstacle")
       .field("margin", &ClearanceOptions::margin, "float", "shapes grown by this (m)")
@@ -102,6 +111,14 @@ models carried into the scene, each with weight psi(q_ik) phi(delta_i).)doc")
       },
       py::arg("hand"), py::arg("q"), py::arg("poses"), py::arg("cloud"), py::arg("options") = ClearanceOptions(),
       py::arg("threads") = 1, "Intrusions of the table and the cloud (K, 3) into the hand at joints q, per pose.");
+}
+
+}  // namespace
+
+void bind_task(py::module_& m) {
+  bind_density(m);
+  bind_mixture(m);
+  bind_clearance(m);
 }
 
 }  // namespace bayesgrasp::bind
