@@ -89,16 +89,27 @@ def output_file(path: Optional[str], what: str) -> Optional[Path]:
     return Path(path)
 
 
+def add_hand_option(p: argparse.ArgumentParser) -> None:
+    """--hand, as every command takes it (RunContext.hand)."""
+    p.add_argument("--hand", type=hand_name, default="barrett_bh8",
+                   help="built-in hand name, hand file or URDF (with its NAME.hand.json sidecar)")
+
+
+def add_seed_option(p: argparse.ArgumentParser, help: str = "seed of every random draw (same seed, same result)") -> None:
+    """--seed, as every command takes it (RunContext.seed)."""
+    p.add_argument("--seed", type=bounded_int(0, SEED_MAX), default=0, help=help)
+
+
 def add_context_options(p: argparse.ArgumentParser, lift: bool = False, seed: bool = True) -> None:
     """The options every run context is built from: --hand, --cache, --success (and --seed, --no-lift)."""
-    p.add_argument("--hand", type=hand_name, default="barrett_bh8", help="built-in hand name, hand file or URDF (with its NAME.hand.json sidecar)")
+    add_hand_option(p)
     p.add_argument("--success", default="lift", choices=["lift", "epsilon"],
                    help="what a successful grasp is: held in the lift test (default) or epsilon above the "
                         "models' eps_stable (the thesis's simulation criterion)")
     p.add_argument("--cache", default=None, help="model cache directory (default: $BAYESGRASP_CACHE/models, "
                                                  "$BAYESGRASP_CACHE defaulting to ~/.cache/bayesgrasp)")
     if seed:
-        p.add_argument("--seed", type=bounded_int(0, SEED_MAX), default=0, help="seed of every random draw (same seed, same result)")
+        add_seed_option(p)
     p.add_argument("--set", action="append", default=[], metavar="GROUP.FIELD=VALUE",
                    help="override a setting: models.FIELD (bayesgrasp.models.ModelSettings, e.g. models.n_samples=500), "
                         "planner.FIELD (bayesgrasp.planners.PlannerSettings, e.g. planner.n_particles=1000) "
@@ -136,6 +147,11 @@ def task_grasps_arg(args: argparse.Namespace):
     return load_task_grasp_file(args.task_grasps)
 
 
+#: The command-line option of each RunContext field whose check can fail.
+CONTEXT_OPTIONS = {"lift": "--no-lift", "success": "--success", "families": "--families",
+                   "measurement_noise": "--set episode.measurement_noise", "planner": "--set planner"}
+
+
 def context(args: argparse.Namespace, progress: bool = True):
     """The :class:`~bayesgrasp.experiments.context.RunContext` of a command, built once from its options."""
     from ..experiments.context import RunContext, stderr_progress
@@ -143,15 +159,17 @@ def context(args: argparse.Namespace, progress: bool = True):
     if getattr(args, "cache", None):
         out_dir(args.cache, "--cache")  # before minutes of model building
     success, lift = getattr(args, "success", "lift"), not getattr(args, "no_lift", False)
-    if success == "lift" and not lift:
-        raise CliError("--no-lift: needs --success epsilon (success 'lift' is decided by the lift test)")
-    return RunContext(hand=getattr(args, "hand", "barrett_bh8"), cache_dir=getattr(args, "cache", None),
-                      success=success, lift=lift, seed=getattr(args, "seed", 0),
-                      progress=stderr_progress if progress else None,
-                      model_settings=model_settings(getattr(args, "set", []), success),
-                      families=families_arg(getattr(args, "families", "top")),
-                      planner=planner_settings(getattr(args, "set", [])),
-                      measurement_noise=measurement_noise(getattr(args, "set", [])))
+    try:  # RunContext checks the settings (the success/lift rule among them); errors name the option
+        return RunContext(hand=getattr(args, "hand", "barrett_bh8"), cache_dir=getattr(args, "cache", None),
+                          success=success, lift=lift, seed=getattr(args, "seed", 0),
+                          progress=stderr_progress if progress else None,
+                          model_settings=model_settings(getattr(args, "set", []), success),
+                          families=families_arg(getattr(args, "families", "top")),
+                          planner=planner_settings(getattr(args, "set", [])),
+                          measurement_noise=measurement_noise(getattr(args, "set", [])))
+    except ValueError as e:
+        field, _, why = str(e).partition(": ")
+        raise CliError(f"{CONTEXT_OPTIONS.get(field, '--' + field)}: {why}") from None
 
 
 def families_arg(text):

@@ -51,12 +51,12 @@ def run(args) -> int:
         raise CliError("--complete: not with camera data (it replaces the view by the object's whole surface)")
     exclude = args.exclude if args.exclude is not None else [m for m in [args.scene_object] if m]
     ctx = context(args)
-    ep = see(args.scene_object, pose, args.category, exclude=exclude, seed=args.seed, complete=args.complete,
+    ep = see(args.scene_object, pose, args.category, exclude=exclude, seed=ctx.seed, complete=args.complete,
              observation=None if view is None else camera_input.observation(view))
     if not any(r.success for r in ep.registrations):
         raise CliError("no training model registered to the cloud (is the object in view, is it of this category?)")
     grasps = task_grasps_arg(args)
-    out = plan_and_execute(ep, args.category, args.task, args.method, ctx, seed=args.seed, grasps=grasps)
+    out = plan_and_execute(ep, args.category, args.task, args.method, ctx, seed=ctx.seed, grasps=grasps)
     doc = {"grasp": _grasp_record(out, ctx), "planned_pose": out["pose"], "method": args.method,
            "category": args.category, "task": args.task, "scene_object": args.scene_object,
            "object_pose": pose if args.scene_object else None, "executed": out["executed"],

@@ -99,8 +99,9 @@ def new(args) -> int:
         settings = settings.with_(half_width=tuple(start.half_width.tolist()))
     if est is None:
         raise CliError("--estimate: needed (or --cloud / --depth to register the object to)")
-    ep = PoseEpisode.new(args.dir, obj, est, context(args), method=method, attempts=args.attempts,
-                         seed=args.seed, planner=settings)
+    ctx = context(args)
+    ep = PoseEpisode.new(args.dir, obj, est, ctx, method=method, attempts=args.attempts, seed=ctx.seed,
+                         planner=settings)
     _print_next(ep, fmt)
     return 0
 
@@ -126,12 +127,12 @@ def _new_category(args, fmt: str) -> int:
     else:
         raise CliError("--cloud, --depth or --object: the view to plan from")
     exclude = args.exclude if args.exclude is not None else [m for m in [args.object] if m]
-    common = dict(exclude=exclude, seed=args.seed, grasps=task_grasps_arg(args))
+    ctx = context(args)
+    common = dict(exclude=exclude, seed=ctx.seed, grasps=task_grasps_arg(args))
     if method == "fusion":
-        ep = FusionEpisode.new(args.dir, obs, args.category, args.task, context(args), attempts=args.attempts,
-                               **common)
+        ep = FusionEpisode.new(args.dir, obs, args.category, args.task, ctx, attempts=args.attempts, **common)
     else:
-        ep = CategoryTaskEpisode.new(args.dir, obs, args.category, args.task, context(args), method=method, **common)
+        ep = CategoryTaskEpisode.new(args.dir, obs, args.category, args.task, ctx, method=method, **common)
     _print_next(ep, fmt)
     return 0
 

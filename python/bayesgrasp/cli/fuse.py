@@ -56,7 +56,7 @@ def run(args) -> int:
                               task_term=args.task_term)
     grasps = task_grasps_arg(args)
     trial = FusionTrial(args.scene_object, pose, ctx, task=args.task, settings=settings,
-                        exclude=args.exclude if args.exclude is not None else [args.scene_object], seed=args.seed,
+                        exclude=args.exclude if args.exclude is not None else [args.scene_object], seed=ctx.seed,
                         category=args.category, grasps=grasps,
                         observation=None if view is None else camera_input.observation(view))
     from ..hand import Hand

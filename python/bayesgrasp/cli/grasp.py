@@ -21,7 +21,7 @@ from pathlib import Path
 
 import numpy as np
 
-from .args import CliError, Renamed, add_format_options, add_view_option, floats, hand_name, output_file, output_format
+from .args import CliError, Renamed, add_format_options, add_hand_option, add_view_option, floats, output_file, output_format
 
 
 def add(sub) -> None:
@@ -44,7 +44,7 @@ def add(sub) -> None:
     g.add_argument("--spread", type=float, default=None, help="finger spread (radians); default: the hand's")
     g.add_argument("--standoff", type=float, default=0.0,
                    help="with --top / --approach: back off this far from the first contact before closing (m)")
-    g.add_argument("--hand", type=hand_name, default="barrett_bh8", help="built-in hand name or hand file path")
+    add_hand_option(g)
     g.add_argument("--keep-origin", action="store_true", help="keep a loaded mesh's own origin")
     g.add_argument("--no-lift", action="store_true", help="skip the physical lift test")
     g.add_argument("--lift-trace", action="store_true",

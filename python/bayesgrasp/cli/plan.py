@@ -79,7 +79,7 @@ def _loop(args, pose, attempts: int = 4, estimate=None, noise: float = 0.0, quie
     planner = planner if half_width is None else replace(planner, half_width=tuple(half_width))
     episode = EpisodeSettings(method=args.method, attempts=attempts, measurement_noise=noise or ctx.measurement_noise,
                               planner=planner)
-    return run_episode(obj, pose, episode, ctx, seed=args.seed, estimate=estimate, models=models,
+    return run_episode(obj, pose, episode, ctx, seed=ctx.seed, estimate=estimate, models=models,
                        keep_planner=True, on_attempt=None if quiet else _print_attempt)
 
 

@@ -7,7 +7,7 @@ import json
 import numpy as np
 
 from . import camera_input
-from .args import SEED_MAX, CliError, Renamed, add_view_option, bounded_int, floats, output_file
+from .args import CliError, Renamed, add_seed_option, add_view_option, floats, output_file
 
 
 def add(sub) -> None:
@@ -21,7 +21,7 @@ def add(sub) -> None:
                    metavar="X,Y,YAW", help="its pose on the table (--pose: the old spelling, deprecated)")
     r.add_argument("--models", required=True, nargs="+", metavar="NAME_OR_PATH", help="models to register against")
     r.add_argument("--voxel", type=float, default=0.005, help="voxel size (m); all radii scale from it")
-    r.add_argument("--seed", type=bounded_int(0, SEED_MAX), default=0, help="seed of the registration's random draws")
+    add_seed_option(r, "seed of the registration's random draws")
     r.add_argument("--png", default=None, help="write a PNG of the cloud over each registered model")
     r.add_argument("--json", action="store_true", help="print one JSON object")
     add_view_option(r)

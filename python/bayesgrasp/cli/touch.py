@@ -11,7 +11,8 @@ import json
 
 import numpy as np
 
-from .args import SEED_MAX, CliError, add_format_options, add_view_option, bounded_int, floats, hand_name, output_file, output_format
+from .args import (CliError, add_format_options, add_hand_option, add_seed_option, add_view_option, bounded_int,
+                   context, floats, output_file, output_format)
 
 
 def add(sub) -> None:
@@ -30,8 +31,8 @@ def add(sub) -> None:
     t.add_argument("--contact-term", default="flags", choices=["flags", "surface"],
                    help="0/1 contact flags, or the continuous distance of the touching links to the surface")
     t.add_argument("--spread", type=float, default=None, help="finger spread of the touch (rad); default: the hand's")
-    t.add_argument("--seed", type=bounded_int(0, SEED_MAX), default=0, help="the optimiser's seed")
-    t.add_argument("--hand", type=hand_name, default="barrett_bh8", help="built-in hand name or hand file path")
+    add_seed_option(t, "the optimiser's seed")
+    add_hand_option(t)
     add_format_options(t)
     add_view_option(t)
     t.add_argument("--png", default=None, metavar="PATH", help="write the fitness landscape to this PNG")
@@ -55,9 +56,10 @@ def run(args) -> int:
     if case == "orientation":
         guess[:2] = truth[:2]
     png = output_file(args.png, "--png")
-    settings = T.TouchSettings(optimizer=args.optimizer, unknowns=case, budget=args.budget, seed=args.seed,
+    ctx = context(args, progress=False)
+    settings = T.TouchSettings(optimizer=args.optimizer, unknowns=case, budget=args.budget, seed=ctx.seed,
                                contact_term=args.contact_term, spread=args.spread, threads=0)
-    planner = T.TouchPlanner(args.object, guess, settings, hand=args.hand)
+    planner = T.TouchPlanner(args.object, guess, settings, hand=ctx.hand)
     world = T.touch_world(args.object, truth[:3], truth[3], planner.model.hand)
     grasp = planner.touch_grasp()
     readings = T.read(world, grasp)

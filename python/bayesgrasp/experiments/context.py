@@ -36,8 +36,8 @@ class RunContext:
     """hand: hand name or file; cache_dir: the model cache (None: $BAYESGRASP_CACHE/models);
     success: what a successful grasp is, "lift" (held in the physical lift test) or "epsilon"
     (epsilon above the models' eps_stable, the thesis's simulation criterion); lift: run the lift
-    test (required by success "lift"; with "epsilon" it runs on stable grasps); threads: C++
-    threads for batches (0 = all cores); seed: the base seed; progress: a callable taking a message
+    test (required by success "lift"; with "epsilon" it runs on stable grasps); seed: the base seed
+    (a command's --seed; the experiments derive each run's seed from it); progress: a callable taking a message
     (None: silent; not sent to worker processes); model_settings: how the grasp models are built
     (None: the defaults for the success criterion); families: the grasp families the planners
     choose from ("top", as in the thesis, and "side"; :mod:`bayesgrasp.models.families`);
@@ -48,7 +48,6 @@ class RunContext:
     cache_dir: Optional[str] = None
     success: str = "lift"
     lift: bool = True
-    threads: int = 1
     seed: int = 0
     progress: Optional[Callable[[str], None]] = field(default=None, compare=False)
     model_settings: Optional[ModelSettings] = None   # None: ModelSettings(success=self.success)
@@ -69,9 +68,8 @@ class RunContext:
         if self.success not in SUCCESS_CRITERIA:
             raise ValueError(f"success: one of {', '.join(SUCCESS_CRITERIA)}; got {self.success!r}")
         if self.success == "lift" and not self.lift:
-            raise ValueError("lift: success 'lift' needs the lift test (use success 'epsilon' to skip it)")
-        if self.threads < 0:
-            raise ValueError(f"threads: must be >= 0 (0 = all cores), got {self.threads}")
+            raise ValueError("lift: off needs success 'epsilon' (--success epsilon): success 'lift' is decided by "
+                             "the lift test")
         if self.cache_dir is not None:
             object.__setattr__(self, "cache_dir", str(self.cache_dir))
 
