@@ -160,12 +160,33 @@ void bind_model_mixture(py::module_& m) {
       "Eq. 4.5: w_i = L_i / sum_j L_j (recursive: w_i ~ w_i(t-1) L_i); all zero keeps the previous weights.");
 }
 
+/// The joint particle belief over (model, pose): one model's resampling and jitter.
+void bind_model_particles(py::module_& m) {
+  m.attr("LOG_MIN_LIKELIHOOD") = bl::kLogMinLikelihood;
+  m.def(
+      "resample_and_jitter",
+      [](const DArray& poses, const DArray& log_weights, const DArray& jitter_std, double threshold,
+         std::uint64_t seed) {
+        bl::RowMatrixXd P = matrix(poses, "poses", 3);
+        Eigen::VectorXd lw = log_weights_from(log_weights, "log_weights");
+        const Eigen::Vector3d s = vec3(jitter_std, "jitter_std");
+        bl::Rng rng(seed);
+        const bool did = bl::resample_and_jitter(P, lw, s, threshold, rng);
+        return py::make_tuple(did, to_np(P), lw);
+      },
+      "poses"_a, "log_weights"_a, "jitter_std"_a, "threshold"_a = 0.5, "seed"_a = 0,
+      "One model's particles (N, 3) after an update: systematic resampling when the ESS is below\n"
+      "threshold * N, then N(0, jitter_std^2) jitter (yaw wrapped), the model's total weight kept.\n"
+      "Returns (resampled, poses, log_weights).");
+}
+
 }  // namespace
 
 void bind_pose_beliefs(py::module_& m) {
   bind_planar_pose(m);
   bind_pose_grid(m);
   bind_model_mixture(m);
+  bind_model_particles(m);
 }
 
 }  // namespace bayesgrasp::bind

@@ -272,3 +272,25 @@ def test_entropy_gp_with_one_model_per_output_matches_its_predictions():
 def test_out_of_range_integers_name_their_argument(call, name):
     with pytest.raises(ValueError, match=rf"^{name}: must be"):
         call()
+
+
+def test_model_particles_resample_and_jitter_keeps_the_model_weight():
+    """The joint (model, pose) belief's step (C++): below half the ESS the particles are drawn
+    systematically and jittered, the model's total weight kept; above it nothing moves."""
+    from bayesgrasp import _core
+
+    b = _core.belief
+    P = np.array([[0.0, 0.0, 3.1], [0.1, 0.0, 0.0], [0.2, 0.0, 0.0], [0.3, 0.0, 0.0]])
+    lw = np.log([0.97, 0.01, 0.01, 0.01]) - 2.0   # total weight e^-2; ESS ~ 1.06 < 2
+    did, Q, lw2 = b.resample_and_jitter(P, lw, np.array([0.0, 0.0, 0.1]), 0.5, 7)
+    Q, lw2 = np.asarray(Q), np.asarray(lw2)
+    assert did and Q.shape == (4, 3)
+    assert np.allclose(lw2, -2.0 - np.log(4)) and np.isclose(np.logaddexp.reduce(lw2), -2.0)
+    assert np.all(Q[:, 0] == 0.0) and np.all((Q[:, 2] >= -np.pi) & (Q[:, 2] < np.pi))   # all from row 0, yaw wrapped
+    assert np.any(np.abs(Q[:, 2]) > 3.0) and not np.allclose(Q[:, 2], 3.1)                 # jittered around 3.1
+    even = np.full(4, np.log(0.25))
+    did, Q, lw3 = b.resample_and_jitter(P, even, np.array([0.01, 0.01, 0.1]), 0.5, 7)
+    assert not did and np.array_equal(np.asarray(Q), P) and np.array_equal(np.asarray(lw3), even)
+    with pytest.raises(ValueError, match="jitter_std"):
+        b.resample_and_jitter(P, lw, np.array([-1.0, 0.0, 0.0]), 0.5, 0)
+    assert b.LOG_MIN_LIKELIHOOD == pytest.approx(np.log(np.finfo(float).tiny))

@@ -5,7 +5,8 @@ import pytest
 
 from bayesgrasp import _core
 from bayesgrasp.models import ModelTable
-from bayesgrasp.planners.fusion import FusionPlanner, FusionSettings, ModelMixtureBelief
+from bayesgrasp.belief.model_mixture import ModelMixtureBelief
+from bayesgrasp.planners.fusion import FusionPlanner, FusionSettings
 
 R = 0.06
 

@@ -125,7 +125,8 @@ def test_fusion_part_aware_takes_a_passing_grasp_and_multiplies_eq46():
     grasps 5 mm or more to its +x moves the choice there, and the round reports P there."""
     from test_fusion import analytic
 
-    from bayesgrasp.planners.fusion import FusionPlanner, FusionSettings, ModelMixtureBelief
+    from bayesgrasp.belief.model_mixture import ModelMixtureBelief
+    from bayesgrasp.planners.fusion import FusionPlanner, FusionSettings
 
     def part(C, belief):
         ok = (C[:, 0] >= 0.025)[:, None]

@@ -1,6 +1,7 @@
 #include "bayesgrasp/belief/model_mixture.hpp"
 
 #include <cmath>
+#include <random>
 #include <limits>
 #include <stdexcept>
 #include <string>
@@ -13,8 +14,6 @@ namespace bayesgrasp::belief {
 namespace {
 
 constexpr double kLog2Pi = 1.8378770664093453;
-// log of the smallest normal double: a likelihood below it underflows to zero (or subnormal)
-constexpr double kLogMinLikelihood = -708.3964185322641;
 
 void check_channels(const RelativePoseGrid& grid, const MeasurementChannels& ch) {
   const long long k = ch.k, end_mean = ch.mean_c0 + k, end_var = ch.var_c0 + k;  // 64-bit: no overflow
@@ -141,6 +140,30 @@ ModelWeightUpdate update_model_weights(const Eigen::VectorXd& log_likelihoods, c
   out.weights = (lw.array() - top).exp().matrix();
   out.weights /= out.weights.sum();
   return out;
+}
+
+bool resample_and_jitter(RowMatrixXd& poses, Eigen::VectorXd& log_weights, const Eigen::Vector3d& jitter_std,
+                         double threshold, Rng& rng) {
+  const Eigen::Index n = poses.rows();
+  if (poses.cols() != 3) throw std::invalid_argument("poses: expected (N, 3) planar poses");
+  if (log_weights.size() != n || n == 0) throw std::invalid_argument("log_weights: expected one per pose");
+  if (!poses.allFinite()) throw std::invalid_argument("poses: contains NaN or infinity");
+  if (!jitter_std.allFinite() || (jitter_std.array() < 0.0).any())
+    throw std::invalid_argument("jitter_std: must be finite and >= 0");
+  if (!(threshold >= 0.0 && threshold <= 1.0)) throw std::invalid_argument("threshold: must be in [0, 1]");
+  const double total = log_sum_exp(log_weights);
+  if (!std::isfinite(total)) return false;  // no weight (or +inf/NaN, left to the caller's checks)
+  const Eigen::VectorXd w = normalised_weights(log_weights);
+  if (1.0 / w.squaredNorm() >= threshold * static_cast<double>(n)) return false;
+  const std::vector<int> idx = resample_indices(w, static_cast<int>(n), Resampling::Systematic, rng);
+  std::normal_distribution<double> normal;
+  RowMatrixXd out(n, 3);
+  for (Eigen::Index i = 0; i < n; ++i)
+    for (int k = 0; k < 3; ++k) out(i, k) = poses(idx[static_cast<size_t>(i)], k) + jitter_std[k] * normal(rng);
+  for (Eigen::Index i = 0; i < n; ++i) out(i, 2) = wrap_angle(out(i, 2));
+  poses = std::move(out);
+  log_weights.setConstant(total - std::log(static_cast<double>(n)));
+  return true;
 }
 
 }  // namespace bayesgrasp::belief

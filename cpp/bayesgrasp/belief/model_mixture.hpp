@@ -22,6 +22,10 @@
 
 namespace bayesgrasp::belief {
 
+/// log of the smallest normal double: a likelihood below it underflows to zero (or subnormal), so
+/// a measurement whose every likelihood is below it is impossible under every model.
+constexpr double kLogMinLikelihood = -708.3964185322641;
+
 /// Where model i's measurement moments sit in its grid.
 struct MeasurementChannels {
   int mean_c0 = 1;  ///< first mean channel
@@ -67,5 +71,14 @@ struct ModelWeightUpdate {
 /// measurement): the previous weights are kept and underflow is set.
 ModelWeightUpdate update_model_weights(const Eigen::VectorXd& log_likelihoods, const Eigen::VectorXd& previous,
                                        bool recursive);
+
+/// One model's particles (rows of planar poses x, y, yaw) after a tactile update, beyond the
+/// thesis (the joint particle belief over model and pose): systematic resampling when the effective
+/// sample size is below threshold * N, then N(0, diag(jitter_std^2)) jitter with the yaw wrapped
+/// into [-pi, pi). The model's total weight, log-sum-exp of log_weights, is kept (each particle gets
+/// total - log N). All -inf log-weights (a model without weight) are left as they are. Returns
+/// whether it resampled.
+bool resample_and_jitter(RowMatrixXd& poses, Eigen::VectorXd& log_weights, const Eigen::Vector3d& jitter_std,
+                         double threshold, Rng& rng);
 
 }  // namespace bayesgrasp::belief

@@ -25,7 +25,8 @@ import numpy as np
 
 from ..models import ModelSettings, relative_top_grasps
 from ..models.tasks import task_rule
-from ..planners.fusion import FusionPlanner, FusionSettings, ModelMixtureBelief
+from ..belief.model_mixture import ModelMixtureBelief
+from ..planners.fusion import FusionPlanner, FusionSettings
 from ..world import World
 from . import report
 from .category import demonstrated, see, training_models
