@@ -283,6 +283,18 @@ class RegistrationResult:
     ransac_iterations: int = 0  # total over the RANSAC restarts
     cost: float = 0.0   # selection cost of the chosen hypothesis (delta / tau + up penalty)
 
+    @classmethod
+    def known(cls, model, transform, phi: float = 1.0, success: bool = True) -> "RegistrationResult":
+        """A registration given rather than computed (a model placed by hand, a known pose):
+        ``transform`` model -> scene (4x4), ``phi`` its fit weight phi(delta); the fit measures
+        are zero and ``status`` is None."""
+        T = np.asarray(transform, dtype=float)
+        if T.shape != (4, 4) or not np.all(np.isfinite(T)):
+            raise ValueError(f"transform: expected a finite 4x4 matrix, got shape {T.shape}")
+        return cls(success=bool(success), reason="" if success else "given as failed", transform=T, fitness=0.0,
+                   rmse=0.0, delta=0.0, phi=float(phi), weight=0.0, up_cos=1.0, scene_points=0, model_points=0,
+                   time_features=0.0, time_global=0.0, time_icp=0.0, model=model)
+
     def as_dict(self) -> dict:
         return {"model": self.model, "success": self.success, "reason": self.reason,
                 "transform": np.asarray(self.transform).tolist(), "fitness": self.fitness, "rmse": self.rmse,

@@ -3,7 +3,8 @@ import numpy as np
 import pytest
 
 from bayesgrasp.hand import Hand
-from bayesgrasp.planners.category import (CategoryPlanner, CategorySettings, Registration, TaskGrasp, psi)
+from bayesgrasp.vision import RegistrationResult
+from bayesgrasp.planners.category import (CategoryPlanner, CategorySettings, TaskGrasp, psi)
 
 
 def rz(yaw, t=(0, 0, 0)):
@@ -26,7 +27,7 @@ def grasp(model, pose, eps=0.2, spread=0.5):
 @pytest.mark.parametrize("method", ["laplace", "regularised", "gaussian"])
 def test_one_grasp_one_model_the_optimum_is_the_mapped_grasp(method):
     T = rz(0.4, (0.1, -0.05, 0.0))
-    p = CategoryPlanner(HAND, [grasp("a", TOP)], [Registration("a", T, phi=0.7)],
+    p = CategoryPlanner(HAND, [grasp("a", TOP)], [RegistrationResult.known("a", T, phi=0.7)],
                         settings=CategorySettings(method=method), seed=1).plan()
     assert p.ok and p.dominant_model == "a" and p.start_model == "a"
     np.testing.assert_allclose(p.pose, T @ TOP, atol=1e-9)   # PSO starts there and cannot beat J = psi * 1
@@ -38,7 +39,7 @@ def test_one_grasp_one_model_the_optimum_is_the_mapped_grasp(method):
 def test_weights_split_the_mixture_and_the_baseline_takes_the_best_fitting_model():
     # two models whose registrations disagree by 2 cm: Laplace's optimum sits on the heavier one
     Ta, Tb = rz(0.0), rz(0.0, (0.02, 0.0, 0.0))
-    regs = [Registration("a", Ta, phi=0.3), Registration("b", Tb, phi=0.9)]
+    regs = [RegistrationResult.known("a", Ta, phi=0.3), RegistrationResult.known("b", Tb, phi=0.9)]
     gs = [grasp("a", TOP, eps=0.3), grasp("b", TOP, eps=0.3)]
     plan = CategoryPlanner(HAND, gs, regs, settings=CategorySettings(method="laplace"), seed=2).plan()
     assert plan.weights["a"] == pytest.approx(0.25) and plan.weights["b"] == pytest.approx(0.75)
@@ -55,7 +56,7 @@ def test_an_obstacle_in_the_hand_pushes_the_grasp_away():
     T = rz(0.0)
     G = T @ TOP
     point = (G @ np.array([0.0, 0.0, -0.03, 1.0]))[:3]
-    p = CategoryPlanner(HAND, [grasp("a", TOP)], [Registration("a", T, phi=1.0)], cloud=point[None],
+    p = CategoryPlanner(HAND, [grasp("a", TOP)], [RegistrationResult.known("a", T, phi=1.0)], cloud=point[None],
                         settings=CategorySettings(method="regularised"), seed=3)
     assert p.intrusion(G[None], 0.5)[0] > 0.02
     plan = p.plan()
@@ -64,16 +65,16 @@ def test_an_obstacle_in_the_hand_pushes_the_grasp_away():
 
 def test_no_grasp_results_name_the_reason():
     T = rz(0.0)
-    none = CategoryPlanner(HAND, [grasp("a", TOP)], [Registration("a", T, phi=0.0, success=False)]).plan()
+    none = CategoryPlanner(HAND, [grasp("a", TOP)], [RegistrationResult.known("a", T, phi=0.0, success=False)]).plan()
     assert not none.ok and "no model registered" in none.reason and np.isnan(none.pose).all()
-    other = CategoryPlanner(HAND, [grasp("z", TOP)], [Registration("a", T, phi=1.0)]).plan()
+    other = CategoryPlanner(HAND, [grasp("z", TOP)], [RegistrationResult.known("a", T, phi=1.0)]).plan()
     assert "no demonstrated grasps" in other.reason
     with pytest.raises(ValueError, match="registrations"):
         CategoryPlanner(HAND, [grasp("a", TOP)], [])
     with pytest.raises(ValueError, match="method"):
         CategorySettings(method="uniform")
     with pytest.raises(ValueError, match="cloud"):
-        CategoryPlanner(HAND, [grasp("a", TOP)], [Registration("a", T, phi=1.0)], cloud=np.full((2, 3), np.nan))
+        CategoryPlanner(HAND, [grasp("a", TOP)], [RegistrationResult.known("a", T, phi=1.0)], cloud=np.full((2, 3), np.nan))
 
 
 def test_psi_by_hand():

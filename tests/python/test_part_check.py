@@ -9,7 +9,8 @@ from hypothesis import strategies as st
 
 from bayesgrasp.hand import Hand
 from bayesgrasp.models.tasks import task_rule
-from bayesgrasp.planners.category import CategoryPlanner, CategorySettings, Registration, TaskGrasp
+from bayesgrasp.vision import RegistrationResult
+from bayesgrasp.planners.category import CategoryPlanner, CategorySettings, TaskGrasp
 from bayesgrasp.planners.part_check import PartCheck, check_candidates, choose, choose_lazily, model_world
 
 HAND = Hand.load("barrett_bh8")
@@ -48,7 +49,7 @@ def test_the_oracle_grasps_touch_what_they_should():
 @pytest.mark.parametrize("yaw, t", [(0.0, (0, 0, 0)), (2.1, (0.07, -0.04, 0.0)), (-0.8, (-0.05, 0.03, 0.0))])
 def test_handle_and_body_grasps_score_the_rules_one_and_zero_wherever_the_model_is_registered(yaw, t):
     T = placed(yaw, t)
-    regs = [Registration(MUG, T, phi=0.9), Registration("mug/2", placed(0.3, (0.2, 0.2, 0)), phi=0.0)]
+    regs = [RegistrationResult.known(MUG, T, phi=0.9), RegistrationResult.known("mug/2", placed(0.3, (0.2, 0.2, 0)), phi=0.0)]
     A = np.array([T @ HANDLE, T @ BODY])                     # the candidates in the scene
     handle = check_candidates(HAND, task_rule("mug", "handle"), A, 0.0, regs, [1.0, 0.0])
     side = check_candidates(HAND, task_rule("mug", "side"), A, 0.0, regs, [1.0, 0.0])
@@ -64,14 +65,14 @@ def test_a_side_grasp_from_an_allowed_side_that_touches_the_handle_fails_on_its_
     assert side.approach_ok(np.array([ACROSS[:3, 2], BODY[:3, 2]])).all()      # both directions are allowed
     assert "handle" in parts_on_model(ACROSS, roll=np.pi / 2)
     T = placed(-2.4, (0.04, 0.06, 0.0))
-    c = check_candidates(HAND, side, np.array([T @ ACROSS, T @ BODY]), 0.0, [Registration(MUG, T, phi=1.0)], [1.0])
+    c = check_candidates(HAND, side, np.array([T @ ACROSS, T @ BODY]), 0.0, [RegistrationResult.known(MUG, T, phi=1.0)], [1.0])
     np.testing.assert_array_equal(c.p_rule, [0.0, 1.0])
     assert "handle" in c.parts[0][0] and set(c.parts[1][0]) == {"body"}
 
 
 def test_the_weights_add_over_the_models_where_the_rule_holds():
     T0, T1 = placed(0.0, (0, 0, 0)), placed(np.pi, (0, 0, 0))    # the second copy turned half a turn
-    regs = [Registration(MUG, T0, phi=1.0), Registration(MUG, T1, phi=1.0)]
+    regs = [RegistrationResult.known(MUG, T0, phi=1.0), RegistrationResult.known(MUG, T1, phi=1.0)]
     # in the scene: from +x, which is the first copy's handle side and the second copy's far side
     c = check_candidates(HAND, task_rule("mug", "handle"), HANDLE[None], 0.0, regs, [0.7, 0.3])
     assert c.rule_ok.tolist() == [[True, False]] and c.p_rule[0] == pytest.approx(0.7)
@@ -112,12 +113,12 @@ def test_the_part_aware_plan_returns_a_checked_candidate():
     T = placed(0.5, (0.03, 0.01, 0))
     gs = [TaskGrasp(MUG, "handle", BODY, 0.0, 0.3, True), TaskGrasp(MUG, "handle", HANDLE, 0.0, 0.1, True)]
     s = CategorySettings(method="part-aware", part_candidates=12, pso_particles=6, pso_iter=3)
-    plan = CategoryPlanner(HAND, gs, [Registration(MUG, T, phi=1.0)], settings=s, seed=1,
+    plan = CategoryPlanner(HAND, gs, [RegistrationResult.known(MUG, T, phi=1.0)], settings=s, seed=1,
                            rule=task_rule("mug", "handle")).plan()
     assert plan.ok and plan.extra["passing_rule"] >= 1 and plan.extra["p_rule"] == 1.0
     assert plan.extra["contact_parts_on_models"][MUG].count("handle") >= 2
     with pytest.raises(ValueError, match="part-aware: needs the task's rule"):
-        CategoryPlanner(HAND, gs, [Registration(MUG, T, phi=1.0)], settings=s)
+        CategoryPlanner(HAND, gs, [RegistrationResult.known(MUG, T, phi=1.0)], settings=s)
 
 
 def test_fusion_part_aware_takes_a_passing_grasp_and_multiplies_eq46():

@@ -22,8 +22,8 @@ from ..models.task_grasps import TaskGraspSettings, task_grasps
 from ..models.tasks import TaskRule, task_rule
 from ..objects import CATEGORY_SIZES, category, load_object
 from ..objects.views import DEFAULT_EYE_OFFSET, capture_view
-from ..planners.category import CategoryPlan, CategoryPlanner, CategorySettings, Registration
-from ..vision import Registrar, model_samples
+from ..planners.category import CategoryPlan, CategoryPlanner, CategorySettings
+from ..vision import Registrar, RegistrationResult, model_samples
 from ..world import World
 from .context import RunContext
 
@@ -76,11 +76,10 @@ def observe(obj, pose, eye_offset=DEFAULT_EYE_OFFSET, seed: int = 0, complete: b
 
 
 def register_models(observation: Observation, models: Sequence[str], seed: int = 0,
-                    voxel: float = 0.005) -> List[Registration]:
+                    voxel: float = 0.005) -> List[RegistrationResult]:
     """Each training model registered to the cloud: transform (model -> world) and phi(delta)."""
-    res = _registrar(tuple(models), float(voxel)).register(observation.cloud, seed=seed,
-                                                            viewpoint=observation.viewpoint)
-    return [Registration(str(r.model), np.asarray(r.transform, float), float(r.phi), bool(r.success)) for r in res]
+    return _registrar(tuple(models), float(voxel)).register(observation.cloud, seed=seed,
+                                                             viewpoint=observation.viewpoint)
 
 
 def demonstrated(models: Sequence[str], rule: TaskRule, ctx: RunContext,
@@ -136,7 +135,7 @@ class CategoryEpisode:
     pose: Tuple[float, float, float]
     models: List[str]
     observation: Observation
-    registrations: List[Registration]
+    registrations: List[RegistrationResult]
     extra: Dict = field(default_factory=dict)
 
 

@@ -37,22 +37,13 @@ import numpy as np
 from .. import _core, optim
 from ..hand import Hand
 from ..models.tasks import TaskGrasp, TaskRule
+from ..vision import RegistrationResult
 from .part_check import check_candidates, choose_lazily
 
 _task = _core.task
 
 METHODS = ("laplace", "regularised", "gaussian", "baseline", "part-aware")
 THESIS_METHODS = METHODS[:4]
-
-
-@dataclass(frozen=True)
-class Registration:
-    """A training model registered to the scene: transform (model -> scene, 4x4), phi(delta), success."""
-
-    model: str
-    transform: np.ndarray
-    phi: float
-    success: bool = True
 
 
 @dataclass(frozen=True)
@@ -161,7 +152,7 @@ def voxel_points(P: np.ndarray, voxel: float) -> np.ndarray:
     return np.ascontiguousarray(P[np.sort(first)])
 
 
-def normalised_weights(registrations: Sequence[Registration]) -> np.ndarray:
+def normalised_weights(registrations: Sequence[RegistrationResult]) -> np.ndarray:
     """phi(delta_i) normalised over the models that registered (0 for the others)."""
     phi = np.array([r.phi if r.success else 0.0 for r in registrations], dtype=float)
     s = phi.sum()
@@ -171,7 +162,7 @@ def normalised_weights(registrations: Sequence[Registration]) -> np.ndarray:
 class CategoryPlanner:
     """Eq. 4.1 for one scene: the mixture of the mapped task grasps, searched in C++ batches."""
 
-    def __init__(self, hand: Hand, task_grasps: Sequence[TaskGrasp], registrations: Sequence[Registration],
+    def __init__(self, hand: Hand, task_grasps: Sequence[TaskGrasp], registrations: Sequence[RegistrationResult],
                  cloud=None, settings: Optional[CategorySettings] = None, seed: int = 0,
                  rule: Optional[TaskRule] = None):
         """``rule``: the task's rule, needed by the part-aware method (the part check)."""
