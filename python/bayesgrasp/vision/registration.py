@@ -1,219 +1,23 @@
-"""Seeing the object: a simulated RGB-D (depth) camera, table-top segmentation and registration of
-a partial cloud against object models (thesis §4.2, Publication V).
-
-The heavy lifting is in C++ (:mod:`bayesgrasp._core.vision`): a BVH ray caster with a
-structured-light noise model, PCL's plane RANSAC and Euclidean clustering, and a registration
-pipeline of voxel downsampling (PCL), normals and FPFH features, a seeded RANSAC over feature
-correspondences, point-to-plane ICP, and a hypothesis choice that penalises upside-down fits.
-To register many clouds against the same models, prepare the models once in a :class:`Registrar`.
-The registration's settings are a :class:`RegistrationOptions` (one option class per step:
-``features``, ``correspondences``, ``ransac``, ``icp``, ``up_prior``); :func:`register` and
-:class:`Registrar` take one, and its fields by keyword (see :func:`registration_options`).
-
->>> from bayesgrasp.vision import Camera, segment_table, register
->>> cam = Camera.looking_at(eye=(0.5, -0.5, 0.5), target=(0, 0, 0.05))
->>> cloud = cam.capture([(V, F)], table=True, seed=1)          # (N, 3) world frame, noisy
->>> seg = segment_table(cloud)                                 # clusters, largest first
->>> results = register(seg.cluster_points[0], [model_a, model_b], viewpoint=cam.eye)
->>> results[0].transform, results[0].fitness, results[0].weight
->>> opts = RegistrationOptions(voxel=0.004)
->>> opts.ransac.restarts = 6
->>> reg = Registrar([model_a, model_b], opts)                  # models prepared once
->>> results = reg.register(seg.cluster_points[0], viewpoint=cam.eye)
->>> [r.status for r in results]                                # RegistrationStatus.Ok, ...
-
-Conventions: metres; world frame z up with the table top at z = 0; camera frame x right, y down,
-z forward; depth images hold the camera-frame z (NaN where nothing is measured).
-
-Fitting error and weight (Eq. 4.1's phi(delta)): ``delta = sqrt(mean_i min(d_i, tau)^2)`` over
-the downsampled scene points, ``d_i`` the distance to the registered model surface and
-``tau = 1.5 voxel``; ``phi = exp(-delta^2 / (2 sigma^2))`` with ``sigma = 0.5 voxel`` (unnormalised);
-``weight = phi / sum(phi)`` over the models of one call that registered successfully
-(:func:`bayesgrasp.belief.shape_weights`).
-
-By default registration assumes the cloud is in the world frame (z up) and the models rest upright
-on the table in their own frame (+z up, as the built-in objects do): hypotheses are searched over
-yaw and translation, refined in 6 DOF by ICP, and upside-down fits are penalised. Pass
-``up_prior=False`` (``options.up_prior.enabled = False``) for arbitrary orientations (6-DOF
-search, no penalty), or ``up=`` the table normal in the cloud's frame.
-
-A model that cannot be registered gives a result with ``success=False``, a
-:class:`RegistrationStatus` (``NoSurface``, ``TooFewScenePoints``, ``NoHypothesis``, ...) and a
-human-readable ``reason``; bad input (an empty cloud, no models, bad options) is a ``ValueError``.
-"""
+"""Registration of a partial cloud against object models (C++: ``_core.vision``): its options,
+results, the :class:`Registrar` (models prepared once) and :func:`register` (one shot)."""
 from __future__ import annotations
 
-import math
-from dataclasses import dataclass, field
-from typing import Any, List, Optional, Sequence, Tuple, Union
+from dataclasses import dataclass
+from typing import Any, List, Optional, Sequence, Tuple
 
-from bayesgrasp._args import c_int, c_seed, with_fields
 import numpy as np
 
-from bayesgrasp import _core as _bgcore
+from bayesgrasp import _core
+from bayesgrasp._args import c_int, c_seed, with_fields
 from bayesgrasp.belief import shape_weights
 
-__all__ = [
-    "Camera", "SegmentationResult", "RegistrationResult", "Registrar", "segment_table", "register",
-    "model_samples", "rotation_error", "as_cloud", "as_mesh", "registration_options",
-    "RegistrationOptions", "FeatureOptions", "CorrespondenceOptions", "RansacOptions", "IcpOptions", "UpPrior",
-    "FeatureEstimator", "RegistrationStatus", "Intrinsics", "Table", "NoiseModel", "SegmentationOptions",
-]
+from .inputs import as_cloud, as_mesh
 
-_v = _bgcore.vision
+_v = _core.vision
 
 RegistrationOptions = _v.RegistrationOptions
-FeatureOptions = _v.FeatureOptions
-CorrespondenceOptions = _v.CorrespondenceOptions
-RansacOptions = _v.RansacOptions
-IcpOptions = _v.IcpOptions
-UpPrior = _v.UpPrior
 FeatureEstimator = _v.FeatureEstimator
 RegistrationStatus = _v.RegistrationStatus
-Intrinsics = _v.Intrinsics
-Table = _v.Table
-NoiseModel = _v.NoiseModel
-SegmentationOptions = _v.SegmentationOptions
-SegmentationResult = _v.SegmentationResult
-
-
-# ---------------------------------------------------------------------------------------------
-# input conversion
-def as_mesh(obj, name: str = "mesh") -> Tuple[np.ndarray, np.ndarray]:
-    """(vertices float64 (N, 3), faces int32 (M, 3)) from a (V, F) tuple or an object with
-    ``.vertices`` and ``.faces`` (ObjectModel, trimesh.Trimesh)."""
-    if hasattr(obj, "vertices") and hasattr(obj, "faces"):
-        V, F = obj.vertices, obj.faces
-    elif isinstance(obj, (tuple, list)) and len(obj) == 2:
-        V, F = obj
-    else:
-        raise ValueError(f"{name}: expected a (vertices, faces) tuple or an object with .vertices and .faces")
-    V = np.ascontiguousarray(np.asarray(V, dtype=np.float64))
-    F = np.asarray(F)
-    if V.ndim != 2 or V.shape[1] != 3:
-        raise ValueError(f"{name}: vertices must have shape (N, 3), got {V.shape}")
-    if F.ndim != 2 or F.shape[1] != 3 or (F.size and not np.issubdtype(F.dtype, np.integer)):
-        raise ValueError(f"{name}: faces must be integer with shape (M, 3), got {F.shape} {F.dtype}")
-    return V, np.ascontiguousarray(F, dtype=np.int32)
-
-
-def as_cloud(cloud, name: str = "cloud") -> np.ndarray:
-    """(N, 3) float64 from a numpy array (N, 3) or (H, W, 3) (organised), or an Open3D point cloud
-    (anything with ``.points``). NaN rows are kept (the functions below drop them)."""
-    if hasattr(cloud, "points") and not isinstance(cloud, np.ndarray):
-        cloud = np.asarray(cloud.points)
-    a = np.asarray(cloud, dtype=np.float64)
-    if a.ndim == 3 and a.shape[2] == 3:
-        a = a.reshape(-1, 3)
-    if a.ndim != 2 or a.shape[1] != 3:
-        raise ValueError(f"{name}: expected shape (N, 3) or (H, W, 3), got {a.shape}")
-    if np.isinf(a).any():
-        raise ValueError(f"{name}: contains infinity")
-    return np.ascontiguousarray(a)
-
-
-# ---------------------------------------------------------------------------------------------
-@dataclass
-class Camera:
-    """A pinhole depth camera (default: Kinect v1-like, 640 x 480, f = 525 px, principal point at
-    the image centre) with a camera-to-world ``pose`` (4x4)."""
-
-    pose: np.ndarray = field(default_factory=lambda: np.eye(4))
-    width: int = 640
-    height: int = 480
-    fx: float = 525.0
-    fy: float = 525.0
-    cx: Optional[float] = None
-    cy: Optional[float] = None
-
-    def __post_init__(self):
-        self.pose = np.asarray(self.pose, dtype=np.float64)
-        if self.pose.shape != (4, 4) or not np.all(np.isfinite(self.pose)):
-            raise ValueError(f"pose: expected a finite (4, 4) matrix, got shape {self.pose.shape}")
-        if self.cx is None:
-            self.cx = (self.width - 1) / 2.0
-        if self.cy is None:
-            self.cy = (self.height - 1) / 2.0
-
-    @classmethod
-    def looking_at(cls, eye, target, up=(0.0, 0.0, 1.0), **intrinsics) -> "Camera":
-        """A camera at ``eye`` looking at ``target`` (world frame), image up towards ``up``."""
-        pose = _v.look_at(np.asarray(eye, float), np.asarray(target, float), np.asarray(up, float))
-        return cls(pose=np.asarray(pose), **intrinsics)
-
-    @property
-    def eye(self) -> np.ndarray:
-        return self.pose[:3, 3].copy()
-
-    @property
-    def K(self) -> np.ndarray:
-        return np.array([[self.fx, 0, self.cx], [0, self.fy, self.cy], [0, 0, 1.0]])
-
-    @property
-    def intrinsics(self) -> "Intrinsics":
-        """The core's :class:`Intrinsics` of this camera."""
-        return Intrinsics(width=c_int(self.width, "width"), height=c_int(self.height, "height"), fx=float(self.fx),
-                          fy=float(self.fy), cx=float(self.cx), cy=float(self.cy))
-
-    def render(self, meshes: Sequence, table: Union[bool, dict, "Table"] = False, noise: Union[bool, "NoiseModel"] = True,
-               seed: int = 0, **noise_fields) -> Tuple[np.ndarray, np.ndarray]:
-        """Ray-casts ``meshes`` (world frame; (V, F) tuples or mesh objects) and optionally the table
-        (True: 1 x 1 m at z = 0 centred at the origin; a dict with ``z``, ``center`` (x, y),
-        ``half_extents`` (hx, hy), inf allowed; or a :class:`Table`). Returns (depth (H, W) in metres
-        with NaN where nothing is measured, label (H, W): index of the mesh seen, -2 table, -1 nothing).
-        ``noise``: on/off or a :class:`NoiseModel`; ``noise_fields`` set its fields (sigma_a, sigma_b,
-        baseline, disparity_step, max_incidence (rad), edge_jump, edge_drop_prob, min_depth, max_depth)."""
-        ms = [as_mesh(m, f"meshes[{i}]") for i, m in enumerate(meshes)]
-        nm = noise.__copy__() if isinstance(noise, NoiseModel) else NoiseModel(enabled=bool(noise))
-        nm.seed = c_seed(seed, "seed")
-        for key, value in noise_fields.items():
-            if key not in NoiseModel.fields:
-                raise ValueError(f"{key}: not a field of NoiseModel")
-            setattr(nm, key, value)
-        depth, label = _v.render(ms, self.pose, self.intrinsics, _table(table), nm)
-        return np.asarray(depth), np.asarray(label)
-
-    def points(self, depth: np.ndarray, world: bool = True, organised: bool = False) -> np.ndarray:
-        """Back-projects a depth image: organised -> (H, W, 3) with NaN for missing pixels, else
-        (N, 3) valid points; world or camera frame."""
-        depth = np.asarray(depth, dtype=np.float64)
-        if depth.shape != (self.height, self.width):
-            raise ValueError(f"depth: expected shape ({self.height}, {self.width}), got {depth.shape}")
-        P = np.asarray(_v.depth_to_points(depth, self.pose, self.intrinsics, world=world, organised=organised))
-        return P.reshape(self.height, self.width, 3) if organised else P
-
-    def capture(self, meshes: Sequence, table: Union[bool, dict] = False, noise: bool = True, seed: int = 0,
-                world: bool = True, organised: bool = False, **noise_params) -> np.ndarray:
-        """render() then points(): the cloud the camera sees."""
-        depth, _ = self.render(meshes, table=table, noise=noise, seed=seed, **noise_params)
-        return self.points(depth, world=world, organised=organised)
-
-
-def _table(table) -> "Table":
-    """A :class:`Table` from False / True / a dict (z, center, half_extents) / a Table."""
-    if isinstance(table, Table):
-        return table
-    if table is True or table is False:
-        return Table(enabled=bool(table))
-    tb = dict(table)
-    unknown = set(tb) - {"z", "center", "half_extents"}
-    if unknown:
-        raise ValueError(f"table: unknown keys {sorted(unknown)} (known: z, center, half_extents)")
-    cx, cy = (float(v) for v in tb.get("center", (0.0, 0.0)))
-    hx, hy = (float(v) for v in tb.get("half_extents", (0.5, 0.5)))
-    return Table(enabled=True, z=float(tb.get("z", 0.0)), center_x=cx, center_y=cy, half_x=hx, half_y=hy)
-
-
-# ---------------------------------------------------------------------------------------------
-def segment_table(cloud, options: Optional[SegmentationOptions] = None, **fields) -> SegmentationResult:
-    """Table plane by RANSAC, the points ``min_height``..``max_height`` above it, Euclidean
-    clusters of those (largest first). ``cloud``: (N, 3), organised (H, W, 3) or an Open3D cloud;
-    NaN rows are ignored. ``options``: a :class:`SegmentationOptions`, its fields also given by
-    keyword (plane_threshold, plane_iterations, min_height, max_height, cluster_tolerance,
-    min_cluster_size, max_cluster_size, up). Returns a :class:`SegmentationResult` (plane,
-    plane_inliers, clusters, cluster_points). ValueError for a bad field (naming it), fewer than 3
-    finite points or no plane."""
-    return _v.segment_table(as_cloud(cloud), with_fields(SegmentationOptions, options, fields))
 
 
 # ---------------------------------------------------------------------------------------------
@@ -361,7 +165,7 @@ def _model_clouds(models: Sequence, options: RegistrationOptions, model_seed: in
             given = _samples_of(m)
             if given is None:
                 V, F = as_mesh(m, "model")
-                has_area = _bgcore.geometry.surface_area(V, F) > 0
+                has_area = _core.geometry.surface_area(V, F) > 0
                 given = _mesh_samples(V, F, options, model_seed + i) if has_area else (np.zeros((0, 3)),) * 2
         except ValueError as e:
             raise ValueError(f"models[{i}]: {e}") from None
@@ -493,9 +297,3 @@ def register(cloud, models: Sequence, options: Optional[RegistrationOptions] = N
     raw = _v.register_models(P, _model_clouds(models, options, model_seed), options, seed=c_seed(seed, "seed"),
                              viewpoint=_viewpoint(viewpoint))
     return _results(raw, names)
-
-
-def rotation_error(Ra, Rb, axis=None) -> float:
-    """Angle (rad) between two rotations; with ``axis`` (model frame), rotation about it is ignored."""
-    ax = None if axis is None else np.asarray(axis, float)
-    return float(_v.rotation_error(np.asarray(Ra, float), np.asarray(Rb, float), ax))
