@@ -17,7 +17,7 @@ from pathlib import Path
 import numpy as np
 
 from bayesgrasp.hand import Hand
-from bayesgrasp.objects import library
+from bayesgrasp.objects import library, primitives
 from bayesgrasp.sim import GraspSimulator
 
 
@@ -36,7 +36,7 @@ def main(out_dir="bench/results"):
     rng = np.random.default_rng(4)
     g = np.column_stack([rng.uniform(-0.02, 0.02, n_grasps), rng.uniform(-0.02, 0.02, n_grasps),
                          rng.uniform(0, np.pi, n_grasps)])
-    meshes = [(f"box n={n}", *library.grid_box((0, 0, 0.05), (0.03, 0.02, 0.05), n)) for n in (1, 9, 18, 36, 72)]
+    meshes = [(f"box n={n}", *primitives.grid_box((0, 0, 0.05), (0.03, 0.02, 0.05), n)) for n in (1, 9, 18, 36, 72)]
     mug = library.builtin("mug")
     meshes.append(("mug", np.asarray(mug.vertices), np.asarray(mug.faces)))
     rows = []

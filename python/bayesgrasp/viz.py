@@ -156,7 +156,7 @@ def capsule_mesh(p0, p1, radius: float, n: int = 16, n_cap: int = 5):
     x /= np.linalg.norm(x)
     y = np.cross(z, x)
     # profile (r, h) from the bottom pole to the top pole, revolved about the axis
-    from bayesgrasp.objects.library import revolve
+    from bayesgrasp.objects.primitives import revolve
 
     a = np.linspace(-np.pi / 2, 0, n_cap + 1)
     prof = [(radius * np.cos(t), radius * np.sin(t)) for t in a]

@@ -7,7 +7,7 @@ import pytest
 from bayesgrasp.objects import (DEFAULT_DENSITY, MeshWarning, ObjectModel, boolean_available,
                                 builtin, category, list_objects, load_mesh, load_object,
                                 mesh_is_watertight, object_params)
-from bayesgrasp.objects.library import revolve
+from bayesgrasp.objects.primitives import revolve
 
 # ---------------------------------------------------------------------------------------------
 # mass properties against analytic values

@@ -4,7 +4,7 @@ import pytest
 from scipy.optimize import brentq
 
 from bayesgrasp.hand import Hand
-from bayesgrasp.objects.library import grid_box
+from bayesgrasp.objects.primitives import grid_box
 from bayesgrasp.sim import GraspBatch, GraspResult, GraspSimulator, SimOptions, make_options
 
 DEG = np.pi / 180

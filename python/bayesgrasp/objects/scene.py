@@ -181,7 +181,7 @@ class Scene:
 
     def table_mesh(self, thickness: float = 0.02) -> Tuple[np.ndarray, np.ndarray]:
         """(V, F) of the table as a box whose top face is at z = 0."""
-        from .library import box
+        from .primitives import box
 
         sx, sy = self.table_size
         V, F = box([0.0, 0.0, -thickness / 2], [sx / 2, sy / 2, thickness / 2])
