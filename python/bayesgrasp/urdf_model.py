@@ -1,0 +1,187 @@
+"""A URDF as the hand conversion (:mod:`bayesgrasp.hand_urdf`) reads it: poses from URDF origins,
+the tree of links and joints, and the links' collision shapes (boxes, capsules, convex hulls) in
+the hand file's form."""
+from __future__ import annotations
+
+import math
+from pathlib import Path
+
+import numpy as np
+
+_TOL = 1e-6           # geometric checks (m, or cosine of an angle)
+_PRISM_SIDES = 32     # a lone cylinder's convex prism
+
+
+class HandFileError(ValueError):
+    """A URDF or sidecar the conversion cannot take (the message names the file and what)."""
+
+
+# ---------------------------------------------------------------- small geometry ----
+
+def _rpy(rpy) -> np.ndarray:
+    r, p, y = (float(v) for v in rpy)
+    cr, sr, cp, sp, cy, sy = math.cos(r), math.sin(r), math.cos(p), math.sin(p), math.cos(y), math.sin(y)
+    return np.array([[cy * cp, cy * sp * sr - sy * cr, cy * sp * cr + sy * sr],
+                     [sy * cp, sy * sp * sr + cy * cr, sy * sp * cr - cy * sr],
+                     [-sp, cp * sr, cp * cr]])
+
+
+def _pose(R: np.ndarray, t) -> np.ndarray:
+    T = np.eye(4)
+    T[:3, :3], T[:3, 3] = R, np.asarray(t, dtype=float)
+    return T
+
+
+def _origin(x) -> np.ndarray:
+    return np.eye(4) if x is None else np.asarray(x, dtype=float)
+
+
+def _unit(v) -> np.ndarray:
+    v = np.asarray(v, dtype=float)
+    return v / np.linalg.norm(v)
+
+
+# ---------------------------------------------------------------- the URDF's tree ----
+
+class _Tree:
+    """The URDF's links and joints at the zero configuration, in the hand (palm) frame."""
+
+    def __init__(self, robot, where: str):
+        self.where = where
+        self.links = {l.name: l for l in robot.links}
+        self.joints = {j.name: j for j in robot.joints}
+        self.parent_joint: dict[str, object] = {}
+        for j in robot.joints:
+            for end in (j.parent, j.child):
+                if end not in self.links:
+                    raise HandFileError(f"{where}: joint '{j.name}' names a link '{end}' that the URDF does not have")
+            if j.child in self.parent_joint:
+                raise HandFileError(f"{where}: kinematic loop: link '{j.child}' is the child of two joints "
+                                    f"('{self.parent_joint[j.child].name}' and '{j.name}')")
+            self.parent_joint[j.child] = j
+        for name in self.links:  # a cycle without a double parent (every link on it has one parent)
+            seen, n = {name}, name
+            while n in self.parent_joint:
+                n = self.parent_joint[n].parent
+                if n in seen:
+                    raise HandFileError(f"{where}: kinematic loop through link '{n}'")
+                seen.add(n)
+
+    def joint(self, name: str, what: str):
+        if name not in self.joints:
+            raise HandFileError(f"{self.where}: {what} names joint '{name}', which the URDF does not have")
+        return self.joints[name]
+
+    def chain(self, link: str) -> list:
+        """Joints from the root down to `link` (root first)."""
+        out = []
+        while link in self.parent_joint:
+            j = self.parent_joint[link]
+            out.append(j)
+            link = j.parent
+        return out[::-1]
+
+    def zero_pose(self, link: str) -> np.ndarray:
+        """The link's frame in the root's frame at every joint 0 (a joint at 0 is its origin)."""
+        T = np.eye(4)
+        for j in self.chain(link):
+            T = T @ _origin(j.origin)
+        return T
+
+
+# ---------------------------------------------------------------- collision shapes ----
+
+def _mesh_points(geom_mesh, urdf_dir: Path, where: str, link: str) -> np.ndarray:
+    import trimesh
+
+    name = geom_mesh.filename
+    rel = name.split("://", 1)[1] if "://" in name else name
+    if name.startswith("package://"):   # package://PKG/path: resolved beside the URDF without PKG, or with it
+        cands = [urdf_dir / rel.split("/", 1)[-1], urdf_dir / rel]
+    else:
+        cands = [Path(rel) if Path(rel).is_absolute() else urdf_dir / rel]
+    path = next((c for c in cands if c.is_file()), None)
+    if path is None:
+        raise HandFileError(f"{where}: link '{link}': mesh file '{name}' not found (looked for {cands[0]})")
+    try:
+        m = trimesh.load(str(path), force="mesh")
+    except Exception as e:  # noqa: BLE001 - trimesh's loaders raise many kinds
+        raise HandFileError(f"{where}: link '{link}': cannot read mesh '{path}' ({e})") from None
+    V = np.asarray(m.vertices, dtype=float)
+    if len(V) < 4:
+        raise HandFileError(f"{where}: link '{link}': mesh '{path}' has fewer than 4 vertices")
+    scale = geom_mesh.scale
+    return V * (1.0 if scale is None else np.asarray(scale, dtype=float))
+
+
+def _transform(T: np.ndarray, P: np.ndarray) -> np.ndarray:
+    return P @ T[:3, :3].T + T[:3, 3]
+
+
+def _convex(points: np.ndarray, where: str = "convex shape") -> dict:
+    """The convex hull of the points (Qhull, through scipy) as a hand file's convex shape: its
+    vertices and its triangles wound counter-clockwise seen from outside."""
+    from scipy.spatial import ConvexHull, QhullError
+
+    P = np.asarray(points, dtype=float)
+    try:
+        hull = ConvexHull(P)
+    except QhullError:
+        raise HandFileError(f"{where}: its points span no volume (flat or degenerate)") from None
+    keep = hull.vertices
+    index = {int(v): i for i, v in enumerate(keep)}
+    V = P[keep]
+    faces = []
+    for tri, eq in zip(hull.simplices, hull.equations):   # equations: outward normal n and offset, n.x + c <= 0
+        a, b, c = (index[int(v)] for v in tri)
+        if np.cross(V[b] - V[a], V[c] - V[a]) @ eq[:3] < 0:
+            b, c = c, b
+        faces.append([a, b, c])
+    return {"type": "convex", "vertices": [[float(x) for x in p] for p in V], "faces": faces}
+
+
+def _box(T: np.ndarray, size) -> dict:
+    """A URDF box at pose T in our link frame: a box if its axes are the link's (up to order and
+    sign), else its 8 corners as a convex shape."""
+    h = 0.5 * np.asarray(size, dtype=float)
+    R = T[:3, :3]
+    A = np.abs(R)
+    if np.all((A < _TOL) | (np.abs(A - 1.0) < _TOL)):
+        return {"type": "box", "center": [float(x) for x in T[:3, 3]], "half_extents": [float(x) for x in A @ h]}
+    corners = np.array([[sx, sy, sz] for sx in (-1, 1) for sy in (-1, 1) for sz in (-1, 1)]) * h
+    return _convex(_transform(T, corners), "a box")
+
+
+def _shapes_of(items: list, where: str) -> list:
+    """Our shapes from (kind, pose in our link frame, geometry) items; a cylinder with a sphere of
+    its radius at each end cap becomes one capsule."""
+    spheres = [(i, T[:3, 3], g.radius) for i, (kind, T, g) in enumerate(items) if kind == "sphere"]
+    used, out = set(), []
+    for i, (kind, T, g) in enumerate(items):
+        if kind != "cylinder":
+            continue
+        axis = T[:3, 2]
+        p0, p1 = T[:3, 3] - 0.5 * g.length * axis, T[:3, 3] + 0.5 * g.length * axis
+        caps = [next((k for k, c, r in spheres if k not in used and abs(r - g.radius) < _TOL
+                      and np.linalg.norm(c - p) < _TOL), None) for p in (p0, p1)]
+        if None not in caps and caps[0] != caps[1]:
+            used.update(caps)
+            used.add(i)
+            out.append({"type": "capsule", "p0": [float(x) for x in p0], "p1": [float(x) for x in p1],
+                        "radius": float(g.radius)})
+    for i, (kind, T, g) in enumerate(items):
+        if i in used:
+            continue
+        if kind == "sphere":
+            c = [float(x) for x in T[:3, 3]]
+            out.append({"type": "capsule", "p0": c, "p1": c, "radius": float(g.radius)})
+        elif kind == "box":
+            out.append(_box(T, g.size))
+        elif kind == "cylinder":
+            a = np.linspace(0.0, 2.0 * np.pi, _PRISM_SIDES, endpoint=False)
+            ring = np.c_[g.radius * np.cos(a), g.radius * np.sin(a)]
+            P = np.vstack([np.c_[ring, np.full(len(a), z)] for z in (-0.5 * g.length, 0.5 * g.length)])
+            out.append(_convex(_transform(T, P), f"{where}: a cylinder"))
+        else:  # mesh points, already in our link frame
+            out.append(_convex(g, f"{where}: a mesh"))
+    return out
