@@ -39,6 +39,22 @@ def test_generation_reports_each_batch_before_it_runs():
     assert "candidates obey the rule" in lines[2] and len(lines) == 3
 
 
+def test_generation_reports_its_lift_tests_and_keeps_their_verdicts(monkeypatch):
+    """The lift tests of the candidates run in batches that report progress (the 31.6 s silence
+    from an empty cache); the grasps kept are those of one whole batch."""
+    from bayesgrasp.models import training
+
+    s = TaskGraspSettings(candidates=120, spreads=(float(np.radians(60)),), lift_tests=6, keep=6)
+    whole = generate_task_grasps("mug/1", task_rule("mug", "top"), settings=s)
+    lines = []
+    monkeypatch.setattr(training, "PROGRESS_EVERY", 0.0)
+    monkeypatch.setattr(training, "lift_chunk", lambda: 2)
+    chunked = generate_task_grasps("mug/1", task_rule("mug", "top"), settings=s, say=lines.append)
+    assert whole and [np.asarray(g.pose).tolist() for g in chunked] == [np.asarray(g.pose).tolist() for g in whole]
+    progress = [x for x in lines if "lift tests:" in x]
+    assert progress and all("done, about" in x for x in progress)
+
+
 def test_generated_grasps_obey_their_rule_and_the_lift_test(grasp_file):
     _, grasps = grasp_file
     assert grasps, "a mug has stable top grasps"

@@ -27,6 +27,7 @@ from ..cache import atomic_write_text, load_checked
 from ..objects import ObjectModel, load_object
 from ..world import World
 from .settings import CACHE_VERSION
+from .training import lift_tests_in_chunks
 from .tasks import TaskGrasp, TaskRule
 
 Say = Callable[[str], None]
@@ -167,7 +168,8 @@ def generate_task_grasps(obj: Union[str, ObjectModel], rule: TaskRule, hand: str
     out = []
     for spread in sorted({f[1] for f in tested}):
         group = [f for f in tested if f[1] == spread]
-        lifted = np.asarray(world.grasp_poses(np.array([f[2] for f in group]), spread=spread, lift=True).lifted, bool)
+        lifted = lift_tests_in_chunks(lambda P: world.grasp_poses(P, spread=spread, lift=True).lifted,  # noqa: B023
+                                      np.array([f[2] for f in group]), say)
         out += [TaskGrasp(o.name, rule.name, f[2], f[1], f[0], True) for f, held in zip(group, lifted) if held]
     out.sort(key=lambda g: -g.epsilon)
     return out[:s.keep]

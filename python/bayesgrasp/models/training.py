@@ -58,24 +58,31 @@ def lift_chunk() -> int:
     return 4 * (os.cpu_count() or 1)
 
 
-def lifted_in_chunks(variant: Variant, world: World, rel: np.ndarray,
-                     say: Optional[Callable[[str], None]] = None) -> np.ndarray:
-    """(n,) bool: the lift test of each relative grasp of ``variant``. With ``say``, run in batches
-    of :func:`lift_chunk` and report "lift tests: k/n done, about s left" at most every PROGRESS_EVERY
-    seconds (each grasp's test is independent of the batch, so the verdicts are the same)."""
+def lift_tests_in_chunks(lift: Callable[[np.ndarray], np.ndarray], rows: np.ndarray,
+                         say: Optional[Callable[[str], None]] = None) -> np.ndarray:
+    """(n,) bool: ``lift(rows[s:e])`` (the lift test of each row: a grasp's verdict) over all rows.
+    With ``say``, run in batches of :func:`lift_chunk` and report "lift tests: k/n done, about s
+    left" at most every PROGRESS_EVERY seconds (each grasp's test is independent of the batch, so
+    the verdicts are the same)."""
     chunk = lift_chunk()
-    if say is None or len(rel) <= chunk:
-        return np.asarray(variant.simulate(world, rel, lift=True, quality=False).lifted, bool)
-    out = np.empty(len(rel), dtype=bool)
+    if say is None or len(rows) <= chunk:
+        return np.asarray(lift(rows), bool)
+    out = np.empty(len(rows), dtype=bool)
     start = last = time.monotonic()
-    for s in range(0, len(rel), chunk):
-        e = min(s + chunk, len(rel))
-        out[s:e] = np.asarray(variant.simulate(world, rel[s:e], lift=True, quality=False).lifted, bool)
+    for s in range(0, len(rows), chunk):
+        e = min(s + chunk, len(rows))
+        out[s:e] = np.asarray(lift(rows[s:e]), bool)
         now = time.monotonic()
-        if now - last >= PROGRESS_EVERY and e < len(rel):
-            say(f"  lift tests: {e}/{len(rel)} done, about {(now - start) / e * (len(rel) - e):.0f} s left")
+        if now - last >= PROGRESS_EVERY and e < len(rows):
+            say(f"  lift tests: {e}/{len(rows)} done, about {(now - start) / e * (len(rows) - e):.0f} s left")
             last = now
     return out
+
+
+def lifted_in_chunks(variant: Variant, world: World, rel: np.ndarray,
+                     say: Optional[Callable[[str], None]] = None) -> np.ndarray:
+    """(n,) bool: the lift test of each relative grasp of ``variant`` (:func:`lift_tests_in_chunks`)."""
+    return lift_tests_in_chunks(lambda r: variant.simulate(world, r, lift=True, quality=False).lifted, rel, say)
 
 
 def lift_outcomes(world: World, rel: np.ndarray, spread, say: Optional[Callable[[str], None]] = None) -> np.ndarray:
