@@ -228,7 +228,7 @@ def test_rotated_box_and_lone_cylinder_become_convex(tmp_path):
 def test_bad_convex_shape_refused(edit, message):
     spec = json.loads((HANDS_DIR / "barrett_bh8.json").read_text())
     corners = [[x, y, z] for x in (-0.045, 0.045) for y in (-0.045, 0.045) for z in (-0.06, 0.0)]
-    from bayesgrasp.urdf_model import _convex
+    from bayesgrasp.hand_urdf.urdf import _convex
 
     shape = _convex(np.array(corners))
     spec["palm"]["shapes"] = [shape]

@@ -8,20 +8,18 @@ joint particle belief over (model, pose). The updates run in C++ (``_core.belief
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import TYPE_CHECKING, Optional, Sequence
+from typing import Optional, Sequence
 
 import numpy as np
 
 from .. import _core
 from . import relative_planar_pose
 
-if TYPE_CHECKING:
-    from ..models import GraspModels
-    from ..planners.fusion import FusionSettings
-
 _b = _core.belief
 
-__all__ = ["ModelMixtureBelief", "UpdateResult", "LOG_MIN_LIKELIHOOD", "wrap"]
+__all__ = ["ModelMixtureBelief", "MixtureSettings", "UpdateResult", "LOG_MIN_LIKELIHOOD", "BELIEFS", "wrap"]
+
+BELIEFS = ("map", "particles")
 
 #: log of the smallest normal double (the core's): every likelihood below it means the measurement
 #: is impossible under every model (the belief is then kept, and the update says so).
@@ -31,6 +29,36 @@ LOG_MIN_LIKELIHOOD = float(_b.LOG_MIN_LIKELIHOOD)
 def wrap(a):
     """Angles wrapped into [-pi, pi)."""
     return np.mod(np.asarray(a, dtype=float) + np.pi, 2 * np.pi) - np.pi
+
+
+@dataclass(frozen=True)
+class MixtureSettings:
+    """The belief's settings (the fusion planner's settings extend them): belief "map" (the
+    thesis's per-model MAP poses) or "particles"; recursive: Eq. 4.5's recursive form; iterations:
+    Eq. 4.4 repeated with the prior re-centred at the last iterate; prior_std (m, m, rad) of Eq.
+    4.4's prior; measurement_noise (rad) added to the GP variance; particles per model (belief
+    "particles"); threads of the C++ updates."""
+
+    belief: str = "map"
+    recursive: bool = False
+    iterations: int = 1
+    prior_std: Sequence[float] = (0.015, 0.015, float(np.radians(15.0)))
+    measurement_noise: float = 0.0
+    particles_per_model: int = 200
+    threads: int = 1
+
+    def __post_init__(self):
+        if self.belief not in BELIEFS:
+            raise ValueError(f"belief: one of {', '.join(BELIEFS)}; got {self.belief!r}")
+        if self.iterations < 1:
+            raise ValueError(f"iterations: must be at least 1, got {self.iterations}")
+        ps = np.asarray(self.prior_std, dtype=float)
+        if ps.shape != (3,) or not np.all(np.isfinite(ps)) or np.any(ps <= 0):
+            raise ValueError(f"prior_std: three positive numbers (m, m, rad), got {self.prior_std}")
+        if not (np.isfinite(self.measurement_noise) and self.measurement_noise >= 0):
+            raise ValueError(f"measurement_noise: must be >= 0, got {self.measurement_noise}")
+        if self.particles_per_model < 2:
+            raise ValueError(f"particles_per_model: at least 2, got {self.particles_per_model}")
 
 
 @dataclass
@@ -48,14 +76,10 @@ class ModelMixtureBelief:
     """Per training model: weight w_i and planar pose p_i (Eqs. 4.4-4.5), or particles per model."""
 
     def __init__(self, names: Sequence[str], models: Sequence["GraspModels"], weights, poses,
-                 settings: Optional["FusionSettings"] = None, seed: int = 0):
-        if settings is None:
-            from ..planners.fusion import FusionSettings
-
-            settings = FusionSettings()
+                 settings: Optional[MixtureSettings] = None, seed: int = 0):
         self.names = list(names)
         self.models = list(models)
-        self.settings = settings
+        self.settings = settings or MixtureSettings()
         w = np.asarray(weights, dtype=float).ravel()
         p = np.atleast_2d(np.asarray(poses, dtype=float))
         if not (len(self.names) == len(self.models) == len(w) == len(p)) or len(w) == 0:

@@ -35,34 +35,25 @@ import numpy as np
 
 from .. import optim
 from ..belief import absolute_planar_pose_paired
-from ..belief.model_mixture import ModelMixtureBelief, wrap
+from ..belief.model_mixture import MixtureSettings, ModelMixtureBelief, wrap
 from .part_check import choose_lazily
 
-BELIEFS = ("map", "particles")
 TASK_TERMS = ("laplace", "part-aware")
 
 
 @dataclass(frozen=True)
-class FusionSettings:
-    """belief: "map" (the thesis's per-model MAP poses) or "particles"; recursive: Eq. 4.5's
-    recursive form; iterations: Eq. 4.4 repeated with the prior re-centred at the last iterate;
-    prior_std (m, m, rad) of Eq. 4.4's prior; measurement_noise (rad) added to the GP variance;
-    laplace_translation / laplace_rotation: Eq. 4.6's task-term scales b_t (m), b_yaw (rad);
-    search_margin: the grasp search box is the weighted model poses' x, y extent plus this (m);
-    PSO size; particles per model (belief "particles")."""
+class FusionSettings(MixtureSettings):
+    """The belief's settings (:class:`~bayesgrasp.belief.model_mixture.MixtureSettings`: belief,
+    recursive, iterations, prior_std, measurement_noise, particles_per_model, threads) and the
+    planner's: laplace_translation / laplace_rotation: Eq. 4.6's task-term scales b_t (m), b_yaw
+    (rad); search_margin: the grasp search box is the weighted model poses' x, y extent plus this
+    (m); PSO size; the task term and its part check."""
 
-    belief: str = "map"
-    recursive: bool = False
-    iterations: int = 1
-    prior_std: Sequence[float] = (0.015, 0.015, float(np.radians(15.0)))
-    measurement_noise: float = 0.0
     laplace_translation: float = 0.01
     laplace_rotation: float = float(np.radians(10.0))
     search_margin: float = 0.03
     pso_particles: int = 32
     pso_iter: int = 30
-    particles_per_model: int = 200
-    threads: int = 1
     # task_term "part-aware" (beyond the thesis): Eq. 4.6's optimum, the mapped task grasps and
     # perturbations of them (half-widths m, rad) up to part_candidates, closed on every model at its
     # pose; the chosen one maximises P(S | G) P(T | G) x P(rule, held | G) (stability counts from
@@ -73,8 +64,7 @@ class FusionSettings:
     part_rotation: float = float(np.radians(20.0))
 
     def __post_init__(self):
-        if self.belief not in BELIEFS:
-            raise ValueError(f"belief: one of {', '.join(BELIEFS)}; got {self.belief!r}")
+        super().__post_init__()
         if self.task_term not in TASK_TERMS:
             raise ValueError(f"task_term: one of {', '.join(TASK_TERMS)}; got {self.task_term!r}")
         if self.part_candidates < 1:
@@ -82,18 +72,9 @@ class FusionSettings:
         for name in ("part_translation", "part_rotation"):
             if not (np.isfinite(getattr(self, name)) and getattr(self, name) >= 0):
                 raise ValueError(f"{name}: must be >= 0, got {getattr(self, name)}")
-        if self.iterations < 1:
-            raise ValueError(f"iterations: must be at least 1, got {self.iterations}")
-        ps = np.asarray(self.prior_std, dtype=float)
-        if ps.shape != (3,) or not np.all(np.isfinite(ps)) or np.any(ps <= 0):
-            raise ValueError(f"prior_std: three positive numbers (m, m, rad), got {self.prior_std}")
         for name in ("laplace_translation", "laplace_rotation", "search_margin"):
             if not getattr(self, name) > 0:
                 raise ValueError(f"{name}: must be positive, got {getattr(self, name)}")
-        if not (np.isfinite(self.measurement_noise) and self.measurement_noise >= 0):
-            raise ValueError(f"measurement_noise: must be >= 0, got {self.measurement_noise}")
-        if self.particles_per_model < 2:
-            raise ValueError(f"particles_per_model: at least 2, got {self.particles_per_model}")
 
 
 @dataclass
@@ -116,8 +97,10 @@ class FusionPlanner:
     def __init__(self, belief: ModelMixtureBelief, task_grasps: Sequence[np.ndarray], seed: int = 0,
                  part_check: Optional[Callable[[np.ndarray, "ModelMixtureBelief"], object]] = None):
         """``part_check(grasps (K, 3), belief)`` -> a :class:`~.part_check.PartCheck` of the grasps
-        (held may be left to compute lazily): needed by task_term part-aware."""
-        if belief.settings.task_term == "part-aware" and part_check is None:
+        (held may be left to compute lazily): needed by task_term part-aware. The planner's settings
+        are the belief's when it was made with FusionSettings, else the defaults."""
+        self.settings = belief.settings if isinstance(belief.settings, FusionSettings) else FusionSettings()
+        if self.settings.task_term == "part-aware" and part_check is None:
             raise ValueError("task_term part-aware: needs a part check (see planners.part_check.check_top_grasps)")
         self.part_check = part_check
         if len(task_grasps) != len(belief.names):
@@ -137,7 +120,7 @@ class FusionPlanner:
 
     def task(self, grasps) -> np.ndarray:
         """P(T | G, w, p) = sum_i w_i sum_k Laplace(G; p_i o theta_ik) for top grasps (N, 3)."""
-        s = self.belief.settings
+        s = self.settings
         G = np.atleast_2d(np.asarray(grasps, dtype=float))
         out = np.zeros(len(G))
         for mapped, w in zip(self.mapped_task_grasps(), self.belief.weights):
@@ -154,7 +137,7 @@ class FusionPlanner:
 
     def plan(self) -> FusionPlan:
         """Round 1: the task term alone; later rounds: stability x task (Fig. 4.4)."""
-        s = self.belief.settings
+        s = self.settings
         self.round += 1
         with_s = self.round > 1
         seeds = np.vstack(self.mapped_task_grasps())
@@ -185,7 +168,7 @@ class FusionPlanner:
     def _candidates(self, optimum: np.ndarray, seeds: np.ndarray, low, high) -> np.ndarray:
         """Eq. 4.6's optimum, the seeds (the previous grasp, the mapped task grasps) and perturbations
         of the seeds up to part_candidates (x, y clipped to the search box, yaw wrapped)."""
-        s = self.belief.settings
+        s = self.settings
         C = np.vstack([optimum[None, :], seeds])[:max(1, s.part_candidates)]
         more = s.part_candidates - len(C)
         if more > 0:

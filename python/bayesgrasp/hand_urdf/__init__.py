@@ -32,7 +32,7 @@ from typing import Optional
 
 import numpy as np
 
-from .urdf_model import _TOL, HandFileError, _mesh_points, _origin, _pose, _rpy, _shapes_of, _transform, _Tree, _unit
+from .urdf import _TOL, HandFileError, _mesh_points, _origin, _pose, _rpy, _shapes_of, _transform, _Tree, _unit
 
 __all__ = ["HandFileError", "hand_json_from_urdf", "sidecar_path"]
 
@@ -55,7 +55,7 @@ def _load_sidecar(path: Path) -> dict:
         raise HandFileError(f"{path}: cannot read the sidecar ({e.strerror or e})") from None
     except json.JSONDecodeError as e:
         raise HandFileError(f"{path}: not valid JSON ({e})") from None
-    schema = json.loads((Path(__file__).parent / "data" / "schema" / "hand_sidecar.schema.json").read_text())
+    schema = json.loads((Path(__file__).parent.parent / "data" / "schema" / "hand_sidecar.schema.json").read_text())
     errors = sorted(jsonschema.Draft202012Validator(schema).iter_errors(data), key=lambda e: list(e.absolute_path))
     if errors:
         e = errors[0]

@@ -1,4 +1,4 @@
-"""A URDF as the hand conversion (:mod:`bayesgrasp.hand_urdf`) reads it: poses from URDF origins,
+"""A URDF as the hand conversion (the package :mod:`bayesgrasp.hand_urdf`) reads it: poses from URDF origins,
 the tree of links and joints, and the links' collision shapes (boxes, capsules, convex hulls) in
 the hand file's form."""
 from __future__ import annotations
