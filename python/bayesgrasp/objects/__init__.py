@@ -9,8 +9,8 @@
 from .library import (CATEGORY_SIZES, builtin, categories, category, generate, list_objects, load_object,
                       object_params, sample_params)
 from .primitives import boolean_available
-from .mesh_io import (DEFAULT_DENSITY, MESH_EXTENSIONS, MeshWarning, ObjectModel, load_mesh, mesh_from_object,
-                      mesh_is_watertight)
+from .mesh_io import DEFAULT_DENSITY, MESH_EXTENSIONS, MeshWarning, ObjectModel, load_mesh, mesh_from_object
+from .topology import mesh_is_watertight
 from .scene import Scene, TableScene
 
 __all__ = [

@@ -5,7 +5,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .mesh_io import orient_outward
+from .topology import orient_outward
 
 def revolve(profile, n: int):
     """Closed surface of revolution about the z axis.
