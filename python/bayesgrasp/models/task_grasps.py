@@ -142,6 +142,16 @@ def every_finger_touches(batch, hand) -> np.ndarray:
     return out
 
 
+def _lifted(world: World, grasps: Sequence[tuple]) -> np.ndarray:
+    """(n,) bool: the lift test of each (epsilon, spread, pose) grasp, one batch per spread."""
+    out = np.zeros(len(grasps), dtype=bool)
+    for spread in sorted({g[1] for g in grasps}):
+        rows = [k for k, g in enumerate(grasps) if g[1] == spread]
+        poses = np.array([grasps[k][2] for k in rows])
+        out[rows] = np.asarray(world.grasp_poses(poses, spread=spread, lift=True).lifted, bool)
+    return out
+
+
 def generate_task_grasps(obj: Union[str, ObjectModel], rule: TaskRule, hand: str = "barrett_bh8",
                          settings: Optional[TaskGraspSettings] = None, say: Optional[Say] = None) -> List[TaskGrasp]:
     """The demonstrated grasps of one model for one task (see the module docstring)."""
@@ -165,12 +175,10 @@ def generate_task_grasps(obj: Union[str, ObjectModel], rule: TaskRule, hand: str
     found.sort(key=lambda x: -x[0])
     tested = found[:s.lift_tests]
     say(f"task grasps {o.name}/{rule.name}: {len(found)} candidates obey the rule; lift-testing {len(tested)}")
-    out = []
-    for spread in sorted({f[1] for f in tested}):
-        group = [f for f in tested if f[1] == spread]
-        lifted = lift_tests_in_chunks(lambda P: world.grasp_poses(P, spread=spread, lift=True).lifted,  # noqa: B023
-                                      np.array([f[2] for f in group]), say)
-        out += [TaskGrasp(o.name, rule.name, f[2], f[1], f[0], True) for f, held in zip(group, lifted) if held]
+    held = lift_tests_in_chunks(lambda rows: _lifted(world, [tested[i] for i in rows]), np.arange(len(tested)), say)
+    out = [TaskGrasp(o.name, rule.name, tested[i][2], tested[i][1], tested[i][0], True)
+           for spread in sorted({f[1] for f in tested}) for i in range(len(tested))
+           if tested[i][1] == spread and held[i]]
     out.sort(key=lambda g: -g.epsilon)
     return out[:s.keep]
 
