@@ -5,6 +5,7 @@ calibration of P(S)."""
 from __future__ import annotations
 
 import os
+import threading
 import time
 from typing import Callable, Optional
 
@@ -62,20 +63,45 @@ def lift_tests_in_chunks(lift: Callable[[np.ndarray], np.ndarray], rows: np.ndar
                          say: Optional[Callable[[str], None]] = None) -> np.ndarray:
     """(n,) bool: ``lift(rows[s:e])`` (the lift test of each row: a grasp's verdict) over all rows.
     With ``say``, run in batches of :func:`lift_chunk` and report "lift tests: k/n done, about s
-    left" at most every PROGRESS_EVERY seconds (each grasp's test is independent of the batch, so
-    the verdicts are the same)."""
+    left" at most every PROGRESS_EVERY seconds, also while one batch runs long (the tests release
+    the GIL; a grasp that keeps the simulation busy made a batch of 8 silent for 28 s). Each
+    grasp's test is independent of its batch, so the verdicts are the same."""
     chunk = lift_chunk()
     if say is None or len(rows) <= chunk:
         return np.asarray(lift(rows), bool)
     out = np.empty(len(rows), dtype=bool)
-    start = last = time.monotonic()
-    for s in range(0, len(rows), chunk):
-        e = min(s + chunk, len(rows))
-        out[s:e] = np.asarray(lift(rows[s:e]), bool)
-        now = time.monotonic()
-        if now - last >= PROGRESS_EVERY and e < len(rows):
-            say(f"  lift tests: {e}/{len(rows)} done, about {(now - start) / e * (len(rows) - e):.0f} s left")
-            last = now
+    start = time.monotonic()
+    state = {"done": 0, "last": start}
+    lock = threading.Lock()
+    stop = threading.Event()
+
+    def report(final: bool = False) -> None:
+        with lock:
+            now, done = time.monotonic(), state["done"]
+            if now - state["last"] < PROGRESS_EVERY or (final and done >= len(rows)):
+                return
+            left = f"about {(now - start) / done * (len(rows) - done):.0f} s left" if done else \
+                f"{now - start:.0f} s so far"
+            say(f"  lift tests: {done}/{len(rows)} done, {left}")
+            state["last"] = now
+
+    def heartbeat() -> None:
+        while not stop.wait(min(1.0, PROGRESS_EVERY) if PROGRESS_EVERY > 0 else 0.05):
+            report()
+
+    watcher = threading.Thread(target=heartbeat, daemon=True)
+    watcher.start()
+    try:
+        for s in range(0, len(rows), chunk):
+            e = min(s + chunk, len(rows))
+            out[s:e] = np.asarray(lift(rows[s:e]), bool)
+            with lock:
+                state["done"] = e
+            if e < len(rows):
+                report(final=True)
+    finally:
+        stop.set()
+        watcher.join()
     return out
 
 
