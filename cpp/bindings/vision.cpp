@@ -183,14 +183,8 @@ void bind_segmentation(py::module_& m) {
       "segment_table",
       [](const DArray& cloud, const SegmentationOptions& options) {
         const Points P = points_arg(cloud, "cloud", true);
-        validate(options);
         py::gil_scoped_release release;
-        try {
-          return segment_table(P, options);
-        } catch (const std::invalid_argument& e) {
-          py::gil_scoped_acquire acquire;
-          throw py::value_error(std::string("cloud: ") + e.what());
-        }
+        return segment_table(P, options);  // validates the options; errors name the field or the cloud
       },
       py::arg("cloud"), py::arg("options") = SegmentationOptions(),
       "Table-top segmentation of an (N, 3) cloud (NaN rows ignored): the dominant plane by RANSAC "

@@ -34,11 +34,12 @@ def c_seed(value, name: str = "seed") -> int:
     return c_int(value, name, 0, SEED_MAX)
 
 
-def with_fields(cls, options=None, fields=None):
+def with_fields(cls, options=None, fields=None, validate: bool = True):
     """A copy of ``options`` (an instance of the bound option class ``cls``; None: its defaults)
     with ``fields`` set (a None value keeps the field as it is), each converted to the type of the
-    field's current value (ints range-checked, ``seed`` as an unsigned 64-bit seed), then validated.
-    ValueError naming an unknown field or a bad value; the ``options`` given is never changed."""
+    field's current value (ints range-checked, ``seed`` as an unsigned 64-bit seed), then validated
+    (``validate=False``: the caller validates once it has set everything). ValueError naming an
+    unknown field or a bad value; the ``options`` given is never changed."""
     if options is None:
         out = cls()
     elif isinstance(options, cls):
@@ -58,6 +59,6 @@ def with_fields(cls, options=None, fields=None):
         elif isinstance(current, float):
             value = float(value)
         setattr(out, name, value)
-    if hasattr(out, "validate"):
+    if validate and hasattr(out, "validate"):
         out.validate()
     return out

@@ -445,3 +445,15 @@ def test_shape_weights():
         shape_weights([-0.1, 0.2], [True, True])
     with pytest.raises(ValueError, match="phi"):
         shape_weights([np.inf, 0.2], [True, True])
+
+
+def test_registration_keywords_are_validated_together():
+    """The options are checked once all keywords are set, so their order does not matter: a zero
+    `up` is fine once the up prior is off, whichever keyword comes first."""
+    for kw in (dict(up=(0.0, 0.0, 0.0), up_prior=False), dict(up_prior=False, up=(0.0, 0.0, 0.0))):
+        o = registration_options(**kw)
+        assert not o.up_prior.enabled and not np.any(o.up_prior.up)
+    with pytest.raises(ValueError, match="up_prior.up"):
+        registration_options(up=(0.0, 0.0, 0.0))
+    with pytest.raises(ValueError, match="ransac.restarts"):
+        registration_options(restarts=2**40)   # does not fit a C++ int: named with its step

@@ -1,8 +1,8 @@
 #include "bayesgrasp/belief/model_mixture.hpp"
 
 #include <cmath>
-#include <random>
 #include <limits>
+#include <random>
 #include <stdexcept>
 #include <string>
 

@@ -211,19 +211,6 @@ std::vector<int> parse_measured_joints(const json& names, const HandModel& h) {
 
 }  // namespace
 
-double Shape::plane_distance(const Vec3& p) const {
-  double d = -std::numeric_limits<double>::infinity();
-  for (const Eigen::Vector4d& pl : planes) d = std::max(d, pl.head<3>().dot(p) - pl[3]);
-  return d;
-}
-
-double Finger::t_max() const {
-  double t = 0.0;
-  for (const Phalanx& p : phalanges)
-    if (p.ratio > 0) t = std::max(t, (p.upper - p.offset) / p.ratio);
-  return t;
-}
-
 HandModel HandModel::from_json(const std::string& json_text) {
   json root;
   try {

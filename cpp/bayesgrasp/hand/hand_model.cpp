@@ -1,6 +1,8 @@
 // HandModel's kinematics: the coupled closing of the fingers, joint checks, link and fingertip
 // poses, and hand poses from grasp parameters. Reading a hand file is in hand_file.cpp.
+#include <algorithm>
 #include <cmath>
+#include <limits>
 #include <stdexcept>
 #include <string>
 
@@ -24,6 +26,19 @@ Eigen::Matrix3d link_rotation(const Vec3& d, double theta) {
 }
 
 }  // namespace
+
+double Shape::plane_distance(const Vec3& p) const {
+  double d = -std::numeric_limits<double>::infinity();
+  for (const Eigen::Vector4d& pl : planes) d = std::max(d, pl.head<3>().dot(p) - pl[3]);
+  return d;
+}
+
+double Finger::t_max() const {
+  double t = 0.0;
+  for (const Phalanx& p : phalanges)
+    if (p.ratio > 0) t = std::max(t, (p.upper - p.offset) / p.ratio);
+  return t;
+}
 
 double HandModel::coupled_angle(int f, int p, double t) const {
   const Phalanx& ph = fingers_.at(f).phalanges.at(p);

@@ -45,7 +45,7 @@ SegmentationResult segment_table(const Points& cloud, const SegmentationOptions&
   }
   c->width = static_cast<std::uint32_t>(c->size());
   c->height = 1;
-  if (c->size() < 3) throw std::invalid_argument("cloud has fewer than 3 finite points");
+  if (c->size() < 3) throw std::invalid_argument("cloud: has fewer than 3 finite points");
 
   pcl::SACSegmentation<pcl::PointXYZ> seg;
   seg.setOptimizeCoefficients(true);
@@ -57,7 +57,7 @@ SegmentationResult segment_table(const Points& cloud, const SegmentationOptions&
   pcl::PointIndices inl;
   pcl::ModelCoefficients coef;
   seg.segment(inl, coef);
-  if (inl.indices.empty() || coef.values.size() != 4) throw std::invalid_argument("no plane found in the cloud");
+  if (inl.indices.empty() || coef.values.size() != 4) throw std::invalid_argument("cloud: no plane found");
 
   SegmentationResult out;
   Eigen::Vector4d pl(coef.values[0], coef.values[1], coef.values[2], coef.values[3]);

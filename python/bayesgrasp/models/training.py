@@ -75,10 +75,10 @@ def lift_tests_in_chunks(lift: Callable[[np.ndarray], np.ndarray], rows: np.ndar
     lock = threading.Lock()
     stop = threading.Event()
 
-    def report(final: bool = False) -> None:
+    def report() -> None:
         with lock:
             now, done = time.monotonic(), state["done"]
-            if now - state["last"] < PROGRESS_EVERY or (final and done >= len(rows)):
+            if now - state["last"] < PROGRESS_EVERY:
                 return
             left = f"about {(now - start) / done * (len(rows) - done):.0f} s left" if done else \
                 f"{now - start:.0f} s so far"
@@ -98,7 +98,7 @@ def lift_tests_in_chunks(lift: Callable[[np.ndarray], np.ndarray], rows: np.ndar
             with lock:
                 state["done"] = e
             if e < len(rows):
-                report(final=True)
+                report()
     finally:
         stop.set()
         watcher.join()

@@ -7,7 +7,7 @@ from typing import Optional, Sequence, Tuple, Union
 import numpy as np
 
 from bayesgrasp import _core
-from bayesgrasp._args import c_int, c_seed, with_fields
+from bayesgrasp._args import c_int, with_fields
 
 from .inputs import as_cloud, as_mesh
 
@@ -71,12 +71,8 @@ class Camera:
         ``noise``: on/off or a :class:`NoiseModel`; ``noise_fields`` set its fields (sigma_a, sigma_b,
         baseline, disparity_step, max_incidence (rad), edge_jump, edge_drop_prob, min_depth, max_depth)."""
         ms = [as_mesh(m, f"meshes[{i}]") for i, m in enumerate(meshes)]
-        nm = noise.__copy__() if isinstance(noise, NoiseModel) else NoiseModel(enabled=bool(noise))
-        nm.seed = c_seed(seed, "seed")
-        for key, value in noise_fields.items():
-            if key not in NoiseModel.fields:
-                raise ValueError(f"{key}: not a field of NoiseModel")
-            setattr(nm, key, value)
+        nm = with_fields(NoiseModel, noise if isinstance(noise, NoiseModel) else NoiseModel(enabled=bool(noise)),
+                         {**noise_fields, "seed": seed})
         depth, label = _v.render(ms, self.pose, self.intrinsics, _table(table), nm)
         return np.asarray(depth), np.asarray(label)
 

@@ -50,14 +50,14 @@ def registration_options(options: Optional[RegistrationOptions] = None, **keywor
                 raise ValueError(f"{key}: {why}")
             key = f"{owners[0]}.{key}"
         step, _, name = key.rpartition(".")
-        if step:
+        if step:   # a step's field; the whole is validated once, below (keyword order does not matter)
             sub = getattr(out, step)
             try:
-                setattr(out, step, with_fields(type(sub), sub, {name: value}))
-            except ValueError as e:
-                raise ValueError(f"{step}.{e}") from None
+                setattr(out, step, with_fields(type(sub), sub, {name: value}, validate=False))
+            except (ValueError, TypeError) as e:   # a value that does not convert, named with its step
+                raise type(e)(f"{step}.{e}") from None
         else:
-            out = with_fields(RegistrationOptions, out, {name: value})
+            out = with_fields(RegistrationOptions, out, {name: value}, validate=False)
     out.validate()
     return out
 
