@@ -59,11 +59,11 @@ def main():
             plan_t[m].append(time.perf_counter() - t1)
         for term in TASK_TERMS:
             trial = FusionTrial(obj, pose, ctx, eye_offset=eye, seed=k, settings=FusionSettings(task_term=term))
-            _, belief, planner = trial.start()
+            _, _, planner = trial.start()
             g0 = planner.plan().action
             m = trial._execute(g0)["measurement"]
             t3 = time.perf_counter()
-            belief.update(g0, m)
+            planner.observe(g0, m)
             t4 = time.perf_counter()
             planner.plan()
             t5 = time.perf_counter()

@@ -22,7 +22,7 @@ import time
 import numpy as np
 
 from bayesgrasp.models import ModelSettings
-from bayesgrasp.planners import ExplorationPlanner, PlannerSettings, StabilityPlanner, get_models
+from bayesgrasp.planners import ExplorationPlanner, PlannerSettings, Reading, StabilityPlanner, get_models
 from bayesgrasp.experiments import EpisodeSettings, RunContext, run_episode
 
 OBJECTS = ("cube", "cylinder", "mug", "mug2", "pitcher")
@@ -52,13 +52,13 @@ class GPStability(StabilityPlanner):
 
 def problem(obj, models, rng, seed):
     """A seeded decision problem: the planner's estimate (the truth off by up to 4 cm / 45 deg) and
-    the observation of a failed first grasp from the real loop (action, joint angles, stable)."""
+    the observation of a failed first grasp from the real loop (action, joint angles and whether it held)."""
     pose = np.array([rng.uniform(-0.08, 0.08), rng.uniform(-0.08, 0.08), rng.uniform(-np.pi, np.pi)])
     est = pose + rng.uniform(-1, 1, 3) * np.array([0.04, 0.04, np.radians(45)])
     ep = run_episode(obj, pose, EpisodeSettings(method="stability", attempts=1, stop_when_stable=False),
                      RunContext(success="epsilon", lift=False), seed=seed, estimate=est, models=models)
     a0 = ep["attempts"][0]
-    return est, (np.array(a0["action"]), np.array(a0["joint_angles"]), a0["stable"])
+    return est, (np.array(a0["action"]), Reading(a0["joint_angles"], held=a0["stable"]))
 
 
 def timed(planner_cls, models, est, seed, observe=None):

@@ -9,6 +9,7 @@ import sys
 import textwrap
 import time
 import warnings
+from dataclasses import replace
 
 import numpy as np
 import pytest
@@ -16,6 +17,7 @@ import pytest
 from bayesgrasp import _core, belief, optim, quality, vision
 from bayesgrasp.gp import ExactGP, SparseGP
 from bayesgrasp.models import ModelSettings, build_models
+from bayesgrasp.planners import Reading
 
 X = np.random.default_rng(0).uniform(size=(20, 2))
 Y = np.sin(3 * X[:, 0]) + 0.5 * X[:, 1]
@@ -149,21 +151,25 @@ def test_a_measurement_far_outside_any_joint_range_warns(planner):
 
     m = np.full(planner.models.n_joints, 1e6)
     with pytest.warns(MeasurementWarning, match="degrees instead of radians"):
-        planner.observe([0.0, 0.0, 0.0], m, False)
+        planner.observe([0.0, 0.0, 0.0], Reading(m, held=False))
 
 
-@pytest.mark.parametrize("stable", ["no", "yes", 2, None, 0.5])
-def test_an_outcome_that_is_not_a_bool_is_refused(planner, stable):
+@pytest.mark.parametrize("held", ["no", "yes", 2, 0.5])
+def test_an_outcome_that_is_not_a_bool_is_refused(held):
+    with pytest.raises(TypeError, match="held: expected a bool"):
+        Reading([0.5, 0.5], held=held)
+
+
+def test_numpy_bools_0_1_and_unknown_are_outcomes(planner):
     m = np.full(planner.models.n_joints, 0.5)
-    with pytest.raises(TypeError, match="stable: expected a bool"):
-        planner.observe([0.0, 0.0, 0.0], m, stable)
-
-
-def test_numpy_bools_and_0_1_are_outcomes(planner):
-    m = np.full(planner.models.n_joints, 0.5)
-    planner.observe([0.0, 0.0, 0.0], m, np.bool_(False))
-    planner.observe([0.0, 0.0, 0.0], m, 1)
-    assert planner.observations[-1].stable is True and planner.observations[-2].stable is False
+    planner.observe([0.0, 0.0, 0.0], Reading(m, held=np.bool_(False)))
+    planner.observe([0.0, 0.0, 0.0], Reading(m, held=1))
+    planner.observe([0.0, 0.0, 0.0], m)    # joint angles alone: whether it held is not known
+    assert [o.stable for o in planner.observations[-3:]] == [False, True, None]
+    # an unknown outcome adds no P(S) factor: the likelihood is the joint angles' alone
+    P = planner.belief.particles[:5]
+    unknown, known = planner.observations[-1], replace(planner.observations[-1], stable=False)
+    assert not np.allclose(planner.log_likelihood(P, unknown), planner.log_likelihood(P, known))
 
 
 def test_rotation_error_refuses_a_matrix_that_is_no_rotation():

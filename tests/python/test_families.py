@@ -2,6 +2,7 @@
 planners searching both families and updating with the executed family's models, and the
 episode / CLI records."""
 import json
+from dataclasses import replace
 
 import numpy as np
 import pytest
@@ -9,8 +10,8 @@ import pytest
 from bayesgrasp.cli import main
 from bayesgrasp.experiments import EpisodeSettings, RunContext, run_episode
 from bayesgrasp.models import FAMILIES, ModelSettings, Variant, parse_families
-from bayesgrasp.planners import ExplorationPlanner, StabilityPlanner, get_models
-from bayesgrasp.planners.base import Observation
+from bayesgrasp.planners import ExplorationPlanner, Reading, StabilityPlanner, get_models
+from bayesgrasp.planners.pose_results import Observation
 from bayesgrasp.world import World
 
 SMALL = dict(n_samples=400, n_inducing=60, max_iter=40, seed=3, n_lift_samples=300, n_calibration=200,
@@ -90,9 +91,9 @@ def test_planner_picks_the_better_family_and_updates_with_its_models(cylinder):
         assert plan.family == max(alone, key=alone.get)
     assert both.expected_stability(plan.action, plan.family) == pytest.approx(plan.predicted_stability, abs=1e-9)
     with pytest.raises(ValueError, match="family"):
-        both.observe(plan.action, np.full(cylinder["side"].n_joints, 0.5), stable=False)   # which family?
+        both.observe(plan.action, Reading(np.full(cylinder["side"].n_joints, 0.5), held=False))   # which family?
     with pytest.raises(ValueError, match="family"):
-        both.observe(plan.action, np.full(cylinder["side"].n_joints, 0.5), stable=False, family="front")
+        both.observe(replace(plan, family="front"), Reading(np.full(cylinder["side"].n_joints, 0.5), held=False))
     # observing a side grasp weights the particles by the side models' likelihood, not the top's
     m = np.full(cylinder["side"].n_joints, 0.6)
     side_only = StabilityPlanner(cylinder["side"], estimate=est, seed=1)
@@ -101,8 +102,8 @@ def test_planner_picks_the_better_family_and_updates_with_its_models(cylinder):
     P = both2.belief.particles
     np.testing.assert_allclose(both2.log_likelihood(P, side_obs), side_only.log_likelihood(P, side_obs))
     assert not np.allclose(both2.log_likelihood(P, side_obs), both2.log_likelihood(P, top_obs))
-    both2.observe(plan.action, m, stable=False, family="side")
-    assert both2.history[-1]["family"] == "side"
+    both2.observe(replace(plan, family="side"), Reading(m, held=False))
+    assert both2.history[-1].observation.family == "side"
     # exploration searches both families too
     ex = ExplorationPlanner(cylinder, estimate=est, seed=2)
     assert ex.plan().family in FAMILIES

@@ -9,7 +9,8 @@ from bayesgrasp import _core
 from bayesgrasp.belief import relative_planar_pose
 from bayesgrasp.experiments import EpisodeSettings, RunContext, run_episode
 from bayesgrasp.models import ModelSettings
-from bayesgrasp.planners import ExplorationPlanner, PlannerSettings, StabilityPlanner, get_models, make_planner
+from bayesgrasp.planners import (ExplorationPlanner, GraspPlanner, PlannerSettings, Reading, StabilityPlanner,
+                                 get_models, make_planner)
 
 EPSILON = ModelSettings(success="epsilon")
 NO_LIFT = RunContext(success="epsilon", lift=False)
@@ -77,10 +78,18 @@ def test_planner_interface_and_bad_input(cube):
     assert plan.kind == "stability" and plan.action.shape == (3,) and 0.0 <= plan.predicted_stability <= 1.0
     assert plan.evaluations > 0
     q = np.full(cube.n_joints, 0.8)
-    p.observe(plan.action, q, stable=False)
-    assert len(p.history) == 1 and p.belief.particles.shape == (500, 3)
+    before = p.belief.particles.copy()
+    up = p.observe(plan, Reading(q, held=False))
+    assert len(p.history) == 1 and p.belief.particles.shape == (500, 3) and p.history[0] is up
+    assert isinstance(p, GraspPlanner) and not np.array_equal(p.belief.particles, before)
+    d = up.to_dict()
+    assert d["stable"] is False and d["measurement"] == q.tolist() and np.allclose(d["mean"], p.belief.mean())
+    assert plan.to_dict()["action"] == plan.action.tolist() and plan.to_dict()["kind"] == "stability"
     with pytest.raises(ValueError, match="measurement"):
-        p.observe(plan.action, q[:-1], stable=False)
+        p.observe(plan, Reading(q[:-1], held=False))
+    with pytest.raises(ValueError, match="joints"):
+        p.observe(plan, np.append(q[:-1], np.nan))
+    assert len(p.history) == 1 and len(p.observations) == 1    # nothing changed by the failed calls
     with pytest.raises(ValueError, match="estimate"):
         StabilityPlanner(cube, estimate=(0.0, np.nan, 0.0))
     with pytest.raises(ValueError, match="method"):

@@ -77,8 +77,8 @@ def test_on_the_cube_most_3dof_estimates_are_closer_than_the_guess(cube):
     for k in range(8):
         truth, guess = S.problem("pose", rng)
         planner = T.TouchPlanner(cube, guess, T.TouchSettings(budget=2000, seed=k))
-        grasp = planner.touch_grasp()
-        r = planner.update(grasp, T.read(T.touch_world("cube", truth[:3]), grasp))
+        grasp = planner.plan().touch
+        r = planner.observe(grasp, T.read(T.touch_world("cube", truth[:3]), grasp))
         assert r.fitness <= r.initial_fitness
         closer += np.hypot(*(planner.estimate - truth)[:2]) < np.hypot(*(guess - truth)[:2])
     assert closer >= 6
@@ -127,7 +127,7 @@ def test_the_stop_level_ends_the_search_early_and_changes_nothing_at_zero(cube):
             cube.estimate(grasp, readings, guess, stop_fitness=bad)
     # the loop's settings carry it to the search
     planner = T.TouchPlanner(cube, guess, T.TouchSettings(seed=3, stop_fitness=s))
-    assert planner.update(grasp, readings).evaluations == part.evaluations
+    assert planner.observe(grasp, readings).evaluations == part.evaluations
 
 
 def test_bad_input(cube):

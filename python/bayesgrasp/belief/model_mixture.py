@@ -71,6 +71,10 @@ class UpdateResult:
     log_likelihoods: np.ndarray
     underflow: bool
 
+    def to_dict(self) -> dict:
+        return {"weights": self.weights.tolist(), "poses": self.poses.tolist(),
+                "log_likelihoods": self.log_likelihoods.tolist(), "underflow": bool(self.underflow)}
+
 
 class ModelMixtureBelief:
     """Per training model: weight w_i and planar pose p_i (Eqs. 4.4-4.5), or particles per model."""

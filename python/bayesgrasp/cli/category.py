@@ -66,7 +66,7 @@ def run(args) -> int:
                       for m, r in zip(ep.models, ep.registrations)],
            "cloud": cloud_json(ep.observation.cloud),
            "epsilon": out["epsilon"], "lifted": out["lifted"], "task_ok": out["task_ok"], "success": out["success"],
-           "failure": out["failure"], "reason": out["reason"] or None, "contact_parts": out.get("contact_parts", [])}
+           "failure": out["failure"], "reason": out["reason"] or None, "contact_parts": out["contact_parts"]}
     if "part_check" in out:      # part-aware: P(rule | A), P(rule, held | A) and each model's contact parts
         doc["part_check"] = out["part_check"]
     fmt = output_format(args)

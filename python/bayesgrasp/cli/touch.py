@@ -61,9 +61,9 @@ def run(args) -> int:
                                contact_term=args.contact_term, spread=args.spread, threads=0)
     planner = T.TouchPlanner(args.object, guess, settings, hand=ctx.hand)
     world = T.touch_world(args.object, truth[:3], truth[3], planner.model.hand)
-    grasp = planner.touch_grasp()
+    grasp = planner.plan().touch
     readings = T.read(world, grasp)
-    r = planner.update(grasp, readings)
+    r = planner.observe(grasp, readings)
     out = _result(args, planner, grasp, readings, r, truth, guess, case)
     if png:
         out["png"] = str(_landscape(planner, grasp, readings, truth, guess, png, args))

@@ -10,7 +10,7 @@ surface in the "complete model" mode the thesis warns is biased), :func:`registe
 """
 from __future__ import annotations
 
-from dataclasses import dataclass, field, replace
+from dataclasses import dataclass, field, fields, replace
 from functools import lru_cache
 from pathlib import Path
 from typing import Dict, List, Optional, Sequence, Tuple
@@ -91,13 +91,39 @@ def demonstrated(models: Sequence[str], rule: TaskRule, ctx: RunContext,
     return task_grasps(models, rule, ctx.hand, settings, cache_dir=cache, say=ctx.progress)
 
 
-def execute(obj, pose, plan: CategoryPlan, rule: TaskRule, ctx: RunContext) -> dict:
+@dataclass
+class TaskGraspOutcome:
+    """A category plan's grasp on the stand-in object: executed (approach, close, lift test) or
+    not (no stand-in: a camera's view; or no plan, ``reason``). One key set either way: what was
+    not measured is None. success = lifted and task_ok (the contacts obey the task's rule)."""
+
+    executed: bool
+    reason: str = ""
+    hand_pose: Optional[list] = None
+    spread: Optional[float] = None
+    epsilon: Optional[float] = None
+    force_closure: Optional[bool] = None
+    lifted: Optional[bool] = None
+    task_ok: Optional[bool] = None
+    success: Optional[bool] = None
+    failure: Optional[str] = None
+    contact_parts: List[str] = field(default_factory=list)
+    collision_at_start: Optional[bool] = None
+    stopped_by_table: Optional[bool] = None
+    joint_angles: Optional[list] = None
+    joint_names: Optional[list] = None
+
+    def to_dict(self) -> dict:
+        return {f.name: getattr(self, f.name) for f in fields(self)}
+
+
+def execute(obj, pose, plan: CategoryPlan, rule: TaskRule, ctx: RunContext) -> TaskGraspOutcome:
     """The planned grasp executed on the object at its true pose: the open hand approaches along
     the planned pose's direction through its position with its roll, closes, is lift-tested;
     task_ok: the object contacts obey the task's rule; success = lifted and task_ok."""
     if not plan.ok:
-        return {"executed": False, "reason": plan.reason, "lifted": False, "task_ok": False, "success": False,
-                "epsilon": 0.0, "force_closure": False, "failure": "no contact"}
+        return TaskGraspOutcome(False, plan.reason, lifted=False, task_ok=False, success=False, epsilon=0.0,
+                                force_closure=False, failure="no contact")
     world = World.single(obj, pose=pose, hand=ctx.hand, table=rule.table)
     A = plan.pose
     g = world.approach(A[:3, 2], A[:3, 3], Hand.approach_roll(A), spread=plan.spread, frame="world", lift=True)
@@ -113,18 +139,16 @@ def execute(obj, pose, plan: CategoryPlan, rule: TaskRule, ctx: RunContext) -> d
         failure = "wrong part"
     elif not lifted:
         failure = "slipped in the lift"
-    return {"executed": True, "reason": "", "hand_pose": np.asarray(g.hand_pose).tolist(), "spread": plan.spread,
-            "epsilon": float(g.epsilon), "force_closure": float(g.epsilon) > 0.0, "lifted": lifted,
-            "task_ok": task_ok, "success": lifted and task_ok, "failure": failure, "contact_parts": parts,
-            "collision_at_start": bool(g.collision_at_start), "stopped_by_table": bool(g.stopped_by_table),
-            "joint_angles": np.asarray(g.joint_angles).tolist(), "joint_names": list(g.joint_names)}
+    return TaskGraspOutcome(True, "", np.asarray(g.hand_pose).tolist(), plan.spread, float(g.epsilon),
+                            float(g.epsilon) > 0.0, lifted, task_ok, lifted and task_ok, failure, parts,
+                            bool(g.collision_at_start), bool(g.stopped_by_table), np.asarray(g.joint_angles).tolist(),
+                            list(g.joint_names))
 
 
-def not_executed(plan: CategoryPlan) -> dict:
-    """The outcome fields of a plan made on camera data with no stand-in to execute it on."""
-    return {"executed": False, "reason": plan.reason if not plan.ok else "", "lifted": None, "task_ok": None,
-            "success": None, "epsilon": None, "force_closure": None, "failure": None if plan.ok else "no contact",
-            "spread": plan.spread if plan.ok else None}
+def not_executed(plan: CategoryPlan) -> TaskGraspOutcome:
+    """The outcome of a plan made on camera data with no stand-in to execute it on."""
+    return TaskGraspOutcome(False, plan.reason if not plan.ok else "", spread=plan.spread if plan.ok else None,
+                            failure=None if plan.ok else "no contact")
 
 
 @dataclass
@@ -165,10 +189,5 @@ def plan_and_execute(ep: CategoryEpisode, category_name: str, task: str, method:
     planner = CategoryPlanner(ctx.hand, grasps, ep.registrations, cloud=ep.observation.cloud, settings=s, seed=seed,
                               rule=rule)
     plan = planner.plan()
-    out = execute(ep.obj, ep.pose, plan, rule, ctx) if ep.obj is not None else not_executed(plan)
-    out.update({"method": method, "task": task, "plan_ok": plan.ok, "objective": plan.objective,
-                "mixture": plan.mixture, "pose": None if not plan.ok else plan.pose.tolist(),
-                "weights": plan.weights, "contributions": plan.contributions, "dominant_model": plan.dominant_model,
-                "start_model": plan.start_model, "evaluations": plan.evaluations, "intrusion": plan.intrusion,
-                "task_grasps": len(grasps), **({"part_check": plan.extra} if plan.extra else {})})
-    return out
+    outcome = execute(ep.obj, ep.pose, plan, rule, ctx) if ep.obj is not None else not_executed(plan)
+    return {**outcome.to_dict(), **plan.to_dict(), "method": method, "task": task, "task_grasps": len(grasps)}

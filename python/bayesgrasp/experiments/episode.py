@@ -16,7 +16,7 @@ import numpy as np
 
 from ..models import GraspModels, ModelSettings, relative_top_grasps
 from ..objects import ObjectModel, load_object
-from ..planners import Planner, PlannerSettings, make_planner
+from ..planners import Planner, PlannerSettings, Reading, make_planner
 from ..world import World
 from .context import RunContext
 
@@ -150,7 +150,7 @@ def run_episode(obj: Union[str, ObjectModel], true_pose: Sequence[float], episod
         rec = _attempt_record(k, plan, ex, q, before, executed)
         stop = ex.success and episode.stop_when_stable
         if not stop:
-            planner.observe(plan.action, q, stable=ex.success, family=plan.family)
+            planner.observe(plan, Reading(q, held=ex.success))
             rec["belief_after"] = planner.summary(true_pose)
         attempts.append(rec)
         if on_attempt is not None:

@@ -30,7 +30,7 @@ from ..hand import Hand
 from ..io.grasp_schema import hand_grasp_record
 from ..models import GraspModels, ModelSettings, relative_top_grasps
 from ..objects import ObjectModel, load_object
-from ..planners import PlannerSettings, make_planner
+from ..planners import PlannerSettings, Reading, make_planner
 from ..world import World
 from .context import RunContext
 
@@ -295,13 +295,13 @@ class PoseEpisode(DiskEpisode):
                 break
             plan = planner.plan()
             self._check_replayed(f"attempt {step['attempt']}", plan.action.tolist(), step["top_grasp"])
-            planner.observe(plan.action, np.asarray(step["joints"])[self.models.joint_index], stable=False)
+            planner.observe(plan, Reading(np.asarray(step["joints"])[self.models.joint_index], held=False))
         if self.state["next"] is not None:
             self._check_replayed("the pending grasp", planner.plan().action.tolist(), self.state["next"]["top_grasp"])
         return planner
 
     def _absorb(self, step: dict, q: np.ndarray) -> None:
-        self.planner.observe(np.asarray(step["top_grasp"], dtype=float), q[self.models.joint_index], stable=False)
+        self.planner.observe(np.asarray(step["top_grasp"], dtype=float), Reading(q[self.models.joint_index], held=False))
         step["belief_after"] = self.planner.summary()
 
     def _plan_next(self) -> None:

@@ -211,7 +211,7 @@ class FusionEpisode(_CategoryBase):
                                  step["top_grasp"])
             if step["lifted"]:
                 return
-            self.mixture.update(np.asarray(step["top_grasp"], float), self._measurement(step["joints"]))
+            self.planner.observe(np.asarray(step["top_grasp"], float), self._measurement(step["joints"]))
         if self.state["next"] is not None:
             self._check_replayed("the pending grasp", self.planner.plan().action.tolist(),
                                  self.state["next"]["top_grasp"])
@@ -220,7 +220,7 @@ class FusionEpisode(_CategoryBase):
         return np.asarray(joints, float)[self.trial.models[0].joint_index]
 
     def _absorb(self, step: dict, q: np.ndarray) -> None:
-        up = self.mixture.update(np.asarray(step["top_grasp"], float), self._measurement(q))
+        up = self.planner.observe(np.asarray(step["top_grasp"], float), self._measurement(q))
         step["underflow"] = bool(up.underflow)
         step["belief_after"] = self.belief()
 

@@ -2,7 +2,7 @@
 
 Each run draws, for each of Pub. I's three cases, a hidden true state and an initial guess, executes
 the touch (a top grasp at the guessed object centre along the guessed yaw, at the hand's default
-spread: :meth:`~bayesgrasp.planners.touch.TouchPlanner.touch_grasp`) on the true object and lets
+spread: :meth:`~bayesgrasp.planners.touch.TouchPlanner.plan` without models) on the true object and lets
 one optimiser fit the touch model to the readings:
 
 * ``pose`` (3 DoF): x, y, yaw unknown; scale 1.
@@ -85,9 +85,9 @@ def _one_case(obj: str, case: str, optimizer: str, rng: np.random.Generator, see
     settings = TouchSettings(optimizer=optimizer, unknowns=case, budget=BUDGET, seed=seed,
                              box=(ERROR_XY, ERROR_YAW, SCALES[0], SCALES[1]), contact_term=contact_term)
     planner = TouchPlanner(model, initial, settings)
-    grasp = planner.touch_grasp()
+    grasp = planner.plan().touch
     readings = read(touch_world(obj, truth[:3], truth[3], model.hand), grasp)
-    r = planner.update(grasp, readings)
+    r = planner.observe(grasp, readings)
     rec = {"truth": truth.tolist(), "initial": initial.tolist(), "estimate": planner.estimate.tolist(),
            "status": r.status.name, "contacts": int(readings.contact_count), "fitness": r.fitness,
            "initial_fitness": r.initial_fitness, "evaluations": int(r.evaluations), "seconds": r.seconds,
@@ -104,7 +104,7 @@ def _second_grasp(obj: str, planner: TouchPlanner, truth, ctx: RunContext) -> di
     world = World.single(obj, pose=truth[:3], hand=ctx.hand)
     out = {}
     for name, estimate in (("initial", planner.initial), ("updated", planner.estimate)):
-        action = TouchPlanner(planner.model, estimate, planner.settings).plan(models)
+        action = TouchPlanner(planner.model, estimate, planner.settings, models=models).plan().action
         ex = execute(world, models, action, truth[:3], ctx)
         out[name] = {"action": action.tolist(), "success": ex.success, "epsilon": ex.epsilon, "lifted": ex.lifted}
     return out
@@ -347,7 +347,7 @@ def planned_on_truth(exp: Experiment, objects: List[str], ctx: RunContext, out) 
         wins = []
         for truth in truths:
             world = World.single(o, pose=truth[:3], hand=ctx.hand)
-            action = TouchPlanner(touch_model(o, ctx.hand), truth).plan(models)
+            action = TouchPlanner(touch_model(o, ctx.hand), truth, models=models).plan().action
             wins.append(execute(world, models, action, truth[:3], ctx).success)
         rows.append({"object": o, "runs": len(truths), "success_on_truth": float(np.mean(wins))})
     report._write_csv(rows, Path(out) / "second_grasp_on_truth.csv")

@@ -128,9 +128,7 @@ class FusionTrial:
             last = records[-1]
             if t > 1 and any(r["lifted"] for r in records):
                 break
-            up = belief.update(last["action"], last["measurement"])
-            if mode == "random" and planner.round == 0:
-                planner.round = 1          # round 1 uses stability x task after the first touch
+            up = planner.observe(last["action"], last["measurement"])
             plan = planner.plan()
             rec = self._record(t, self._execute(plan.action), belief, plan, up.underflow)
             records.append(rec)

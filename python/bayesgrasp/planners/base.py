@@ -8,14 +8,15 @@ stable. Every planner has the same interface::
 
     planner = StabilityPlanner(models, estimate=(0.01, -0.02, 0.3), seed=0)
     plan = planner.plan()                      # Plan: family, action, kind, predicted stability, ...
-    planner.observe(plan.action, joint_angles, stable=False, family=plan.family)
-    planner.belief, planner.history
+    update = planner.observe(plan, Reading(joint_angles, held=False))
+    planner.belief, planner.history            # history: every PoseUpdate
 
 ``models`` is one family's :class:`~bayesgrasp.models.GraspModels`, or a mapping from family
 name to models: the planners then search every family and keep the best, and the belief update
 takes the executed family's models.
 
-``observe`` is the Bayes update of the thesis: reweight the particles by the GP measurement
+(:mod:`.protocol`: every planner of the package has this interface.) ``observe`` is the Bayes
+update of the thesis: reweight the particles by the GP measurement
 likelihood P(M | A, O) (and, as an option, by P(S = observed | A, O)), resample, then move every
 particle with Metropolis steps whose target is the posterior of all observations so far, so
 that resampled copies spread out again.
@@ -32,6 +33,8 @@ import numpy as np
 from .. import optim
 from ..belief import ParticleBelief, absolute_planar_pose_paired, relative_planar_pose, resample_indices
 from ..models import FAMILIES, GraspModels
+from .pose_results import Observation, Plan, PoseUpdate
+from .protocol import as_reading
 
 
 @dataclass(frozen=True)
@@ -101,32 +104,6 @@ class PlannerSettings:
         return replace(self, **kw)
 
 
-@dataclass
-class Plan:
-    """A planned grasp. ``kind`` is "stability" or "explore"; ``predicted_stability`` the
-    belief-weighted P(S) of the action (Eq. 3.1's integral), ``objective`` what the planner's
-    own search maximised (equal for the stability planner), ``expected_entropy`` Eq. 3.2's value
-    for exploration plans (else None), ``seconds`` the wall time of the decision, ``family``
-    the grasp family of the action."""
-
-    action: np.ndarray
-    kind: str
-    predicted_stability: float
-    objective: float
-    expected_entropy: Optional[float] = None
-    seconds: float = 0.0
-    evaluations: int = 0
-    family: str = "top"
-
-
-@dataclass
-class Observation:
-    action: np.ndarray
-    measurement: np.ndarray
-    stable: bool
-    family: str = "top"
-
-
 def family_models(models: Union[GraspModels, Mapping[str, GraspModels]]) -> dict:
     """One family's models or a mapping family -> models, as a dict in FAMILIES order; the
     families must measure the same joints."""
@@ -151,16 +128,6 @@ class MeasurementWarning(UserWarning):
 
 # No revolute joint of a hand file turns more than half a turn from zero.
 MAX_JOINT_ANGLE = np.pi
-
-
-def _outcome(stable) -> bool:
-    """The grasp outcome as a bool: True/False, numpy bools or the ints 0/1; anything else (a
-    string such as "no" would be truthy) is a TypeError naming the argument."""
-    if isinstance(stable, (bool, np.bool_)):
-        return bool(stable)
-    if isinstance(stable, (int, np.integer)) and stable in (0, 1):
-        return bool(stable)
-    raise TypeError(f"stable: expected a bool (or 0/1), got {stable!r}")
 
 
 def wrap_angle(a):
@@ -198,7 +165,7 @@ class Planner:
         self.tables = {f: m.table() for f, m in self.family_models.items()}
         self.table = self.tables[self.families[0]]
         self.observations: List[Observation] = []
-        self.history: List[dict] = []
+        self.history: List[PoseUpdate] = []
         self._plans = 0
 
     # ---- the prior box --------------------------------------------------------------------------
@@ -220,10 +187,10 @@ class Planner:
         observation's family."""
         rel = relative_planar_pose(obs.action[None, :], poses)
         ll = self.family_models[obs.family].log_likelihood(rel, obs.measurement)
-        if self.settings.use_outcome:
+        if self.settings.use_outcome and obs.stable is not None:
             f = self.settings.outcome_floor
             ps = np.clip(self.tables[obs.family].stability(rel), f, 1.0 - f)
-            ll = ll + np.log(ps if obs.stable else 1.0 - ps)
+            ll = ll + np.log(ps if obs.stable else 1.0 - ps)   # no factor when not known
         return ll
 
     def log_posterior(self, poses: np.ndarray) -> np.ndarray:
@@ -263,29 +230,37 @@ class Planner:
     def _plan(self) -> Plan:
         raise NotImplementedError
 
-    def observe(self, action, measurement, stable: bool, family: Optional[str] = None) -> None:
-        """Bayes update after executing ``action`` (a world grasp (x, y, yaw) of ``family``; None:
-        the planner's only family) and reading ``measurement`` (the phalanx joint angles the
-        models predict) and whether the grasp was stable."""
-        if family is None and len(self.families) > 1:
-            raise ValueError(f"family: which family was executed ({', '.join(self.families)})?")
-        family = self._family(family)
+    def observe(self, grasp, measurement) -> PoseUpdate:
+        """Bayes update after executing ``grasp`` (the :class:`Plan` executed, or its world grasp
+        (x, y, yaw) when the planner has one family) and reading ``measurement`` (a
+        :class:`~.protocol.Reading`: the phalanx joint angles the models predict and whether the
+        grasp held; or the joint angles alone). Nothing changes when an argument is rejected."""
+        obs = self._observation(grasp, as_reading(measurement))
+        self.observations.append(obs)
+        self._update(obs)
+        update = PoseUpdate(obs, self.belief.mean(), float(self.belief.ess()))
+        self.history.append(update)
+        return update
+
+    def _observation(self, grasp, reading) -> Observation:
+        """The executed grasp and the reading checked against the planner's families and joints."""
+        if isinstance(grasp, Plan):
+            family, action = self._family(grasp.family), grasp.action
+        elif len(self.families) > 1:
+            raise ValueError(f"grasp: pass the executed Plan (which family was executed: {', '.join(self.families)}?)")
+        else:
+            family, action = self.families[0], grasp
         a = np.asarray(action, dtype=float).ravel()
-        m = np.asarray(measurement, dtype=float).ravel()
+        m = reading.joints
         if a.shape != (3,) or not np.all(np.isfinite(a)):
-            raise ValueError(f"action: expected (x, y, yaw), got {action}")
-        if m.shape != (self.models.n_joints,) or not np.all(np.isfinite(m)):
+            raise ValueError(f"grasp: expected a world top grasp (x, y, yaw), got {action}")
+        if m.shape != (self.models.n_joints,):
             raise ValueError(f"measurement: expected {self.models.n_joints} finite joint angles, got {m.shape}")
-        stable = _outcome(stable)
         if np.any(np.abs(m) > MAX_JOINT_ANGLE):
             warnings.warn(f"measurement: joint angles {m.tolist()} lie beyond +-{MAX_JOINT_ANGLE:.2f} rad, outside "
                           "any joint's range (degrees instead of radians?); the belief will collapse onto the "
-                          "few poses least unlikely under it", MeasurementWarning, stacklevel=2)
-        obs = Observation(a, m, stable, family)
-        self.observations.append(obs)
-        self._update(obs)
-        self.history.append({"family": family, "action": a.tolist(), "measurement": m.tolist(), "stable": stable,
-                             "mean": self.belief.mean().tolist(), "ess": float(self.belief.ess())})
+                          "few poses least unlikely under it", MeasurementWarning, stacklevel=3)
+        return Observation(a.copy(), np.array(m), reading.held, family)
 
     def _update(self, obs: Observation) -> None:
         s = self.settings

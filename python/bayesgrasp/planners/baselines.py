@@ -10,7 +10,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from .base import Observation, Plan, Planner
+from .base import Planner
+from .pose_results import Observation, Plan
 from .stability import StabilityPlanner
 
 

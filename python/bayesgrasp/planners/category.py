@@ -26,10 +26,16 @@ Choices the thesis leaves open (documented here and in the README):
 
 The baseline ("best single grasp"): the best-fitting model's task grasp of highest psi, mapped by
 its registration, no optimisation.
+
+The planner has the package's interface (:mod:`.protocol`). Pub. V plans once; beyond it, a grasp
+that did not hold (``observe(plan, Reading(joints, held=False))``) scales every component's weight
+by 1 - exp(-(|t - t_f| / b_t + angle(R, R_f) / b_r)), (t_f, R_f) the failed hand pose and b the
+density's scales, so the next plan moves away from it; ``belief`` is the models' normalised
+weights phi.
 """
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from typing import List, Optional, Sequence
 
 import numpy as np
@@ -38,7 +44,9 @@ from .. import _core, optim
 from ..hand import Hand
 from ..models.tasks import TaskGrasp, TaskRule
 from ..vision import RegistrationResult
+from .category_results import CategoryPlan, CategoryUpdate
 from .part_check import check_candidates, choose_lazily
+from .protocol import as_reading
 
 _task = _core.task
 
@@ -112,32 +120,6 @@ class CategorySettings:
         return d
 
 
-@dataclass
-class CategoryPlan:
-    """The chosen grasp: hand pose (4x4, scene frame) and spread; J there (with the clearance
-    factor: ``objective``; without: ``mixture``); the per-model weights phi (normalised) and
-    contributions to J; the component that dominates J and its model; the search start."""
-
-    pose: np.ndarray
-    spread: float
-    method: str
-    objective: float
-    mixture: float
-    weights: dict
-    contributions: dict
-    dominant_model: Optional[str]
-    dominant_grasp: int
-    start_model: Optional[str]
-    evaluations: int = 0
-    intrusion: float = 0.0
-    reason: str = ""
-    extra: dict = field(default_factory=dict)
-
-    @property
-    def ok(self) -> bool:
-        return not self.reason
-
-
 def psi(epsilon, scale: float, floor: float) -> np.ndarray:
     """Stability weight of task grasps from their epsilon: 1 - exp(-q / scale) for q > 0, else floor."""
     q = np.asarray(epsilon, dtype=float)
@@ -182,7 +164,37 @@ class CategoryPlanner:
         self.cloud = voxel_points(cloud, self.settings.clearance_voxel)
         self.seed = int(seed)
         self.weights = normalised_weights(self.registrations)
+        self.failed: List[np.ndarray] = []
         self._build_mixture()
+
+    @property
+    def belief(self) -> dict:
+        """The models' normalised registration weights phi (the shape belief Eq. 4.1 sums over)."""
+        return {r.model: float(w) for r, w in zip(self.registrations, self.weights)}
+
+    def observe(self, grasp, measurement) -> CategoryUpdate:
+        """After executing ``grasp`` (the :class:`CategoryPlan` or its 4x4 hand pose): a grasp that
+        did not hold (``measurement``: a :class:`~.protocol.Reading`) lowers the weight of the task
+        grasps near it (module docstring); one that held, or an unknown outcome, changes nothing."""
+        pose = np.asarray(grasp.pose if isinstance(grasp, CategoryPlan) else grasp, dtype=float)
+        if pose.shape != (4, 4) or not np.all(np.isfinite(pose)):
+            raise ValueError(f"grasp: expected the executed CategoryPlan or a finite 4x4 hand pose, got {pose.shape}")
+        held = as_reading(measurement).held
+        before = float(self.component_weight.sum())
+        if held is False:
+            self.failed.append(pose.copy())
+            self._build_mixture()
+        return CategoryUpdate(held, before, float(self.component_weight.sum()))
+
+    def _failure_factor(self) -> np.ndarray:
+        """Per task grasp, prod over failed poses of 1 - Laplace(mapped grasp; failed pose)."""
+        s = self.settings
+        f = np.ones(len(self.mapped))
+        for F in self.failed:
+            dt = np.linalg.norm(self.mapped[:, :3, 3] - F[:3, 3], axis=1)
+            cos = (np.einsum("nij,ij->n", self.mapped[:, :3, :3], F[:3, :3]) - 1.0) / 2.0
+            f *= 1.0 - np.exp(-(dt / s.translation_scale + np.arccos(np.clip(cos, -1.0, 1.0)) / s.rotation_scale))
+        return f
 
     # ---- the mixture ----------------------------------------------------------------------------
     def _build_mixture(self) -> None:
@@ -193,8 +205,10 @@ class CategoryPlanner:
         scale = s.psi_scale if s.psi_scale is not None else (float(np.median(pos)) if len(pos) else 0.1)
         self.psi = psi(eps, scale, s.psi_min)
         self.model_of = np.array([index[g.model] for g in self.grasps], dtype=int)
-        self.component_weight = self.psi * self.weights[self.model_of] if len(self.grasps) else np.zeros(0)
         self.mapped = np.array([self.registrations[i].transform @ g.pose for i, g in zip(self.model_of, self.grasps)])
+        self.component_weight = self.psi * self.weights[self.model_of] if len(self.grasps) else np.zeros(0)
+        if self.failed and len(self.grasps):
+            self.component_weight = self.component_weight * self._failure_factor()
         self.mixture = None
         if len(self.grasps) and self.component_weight.sum() > 0:
             self.mixture = _task.GraspMixture(self.mapped, self.component_weight, self.model_of.tolist(),

@@ -20,7 +20,8 @@ from typing import Optional, Tuple
 import numpy as np
 
 from .. import optim
-from .base import Plan, Planner, wrap_angle
+from .base import Planner, wrap_angle
+from .pose_results import Plan
 
 
 def kernel_matrix(particles: np.ndarray, weights: np.ndarray) -> np.ndarray:

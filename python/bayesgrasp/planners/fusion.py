@@ -19,7 +19,10 @@ The next grasp maximises (Eq. 4.6) P(S and T | G, w, p) = P(S | G, w, p) P(T | G
   theta_ik of model i (planar: x, y, yaw in the model's frame) placed by p_i, with
   Laplace(d) = exp(-(|d_xy| / b_t + |d_yaw| / b_yaw)).
 
-Round 1 uses the task term alone (Fig. 4.4); later rounds the product. The search is PSO over
+Round 1 uses the task term alone (Fig. 4.4); once the fingers have been read, the product. The
+planner has the package's interface (:mod:`.protocol`): ``plan()`` -> :class:`FusionPlan`,
+``observe(grasp, reading)`` -> the belief's
+:class:`~bayesgrasp.belief.model_mixture.UpdateResult`, ``belief``. The search is PSO over
 (x, y, yaw), its swarm seeded with the previous round's grasp and the mapped task grasps.
 
 Beyond the thesis (``belief="particles"``): a joint particle belief over (model, pose) in place
@@ -37,6 +40,7 @@ from .. import optim
 from ..belief import absolute_planar_pose_paired
 from ..belief.model_mixture import MixtureSettings, ModelMixtureBelief, wrap
 from .part_check import choose_lazily
+from .protocol import as_reading
 
 TASK_TERMS = ("laplace", "part-aware")
 
@@ -90,6 +94,11 @@ class FusionPlan:
     seeds: int = 0
     part: Optional[float] = None          # part-aware: P(rule, held | G) over the models
 
+    def to_dict(self) -> dict:
+        return {"action": np.asarray(self.action).tolist(), "objective": self.objective, "stability": self.stability,
+                "task": self.task, "round": self.round, "evaluations": self.evaluations, "seeds": self.seeds,
+                **({} if self.part is None else {"part": self.part})}
+
 
 class FusionPlanner:
     """Eq. 4.6 over a :class:`ModelMixtureBelief` with the models' top task grasps (planar)."""
@@ -111,7 +120,18 @@ class FusionPlanner:
             raise ValueError("task_grasps: no model has a demonstrated top grasp for the task")
         self._rng = np.random.default_rng(seed)
         self.round = 0
+        self.observations = 0
         self.previous: Optional[np.ndarray] = None
+
+    def observe(self, grasp, measurement):
+        """Eqs. 4.4-4.5 after executing ``grasp`` (the :class:`FusionPlan` executed or its top grasp
+        (x, y, yaw, world)) and reading ``measurement`` (a :class:`~.protocol.Reading` or the joint
+        angles the models predict); the next plan weighs stability in. Returns the belief's
+        UpdateResult; nothing changes when an argument is rejected."""
+        action = grasp.action if isinstance(grasp, FusionPlan) else grasp
+        update = self.belief.update(action, as_reading(measurement).joints)
+        self.observations += 1
+        return update
 
     def mapped_task_grasps(self) -> List[np.ndarray]:
         """Every model's top task grasps placed by its current pose: per model a (K_i, 3) array."""
@@ -136,9 +156,10 @@ class FusionPlanner:
         return t * self.belief.stability(grasps) if with_stability else t
 
     def plan(self) -> FusionPlan:
-        """Round 1: the task term alone; later rounds: stability x task (Fig. 4.4)."""
+        """Round 1: the task term alone; once the fingers have been read (a grasp observed before
+        the first plan counts as round 1), stability x task (Fig. 4.4)."""
         s = self.settings
-        self.round += 1
+        self.round = max(self.round, self.observations) + 1
         with_s = self.round > 1
         seeds = np.vstack(self.mapped_task_grasps())
         if self.previous is not None:

@@ -3,7 +3,8 @@ expected stability sum_j w_j P(S | A, O_j) over the particle belief, found by PS
 family the planner has models for)."""
 from __future__ import annotations
 
-from .base import Plan, Planner
+from .base import Planner
+from .pose_results import Plan
 
 
 class StabilityPlanner(Planner):

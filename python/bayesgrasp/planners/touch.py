@@ -18,23 +18,24 @@ continuous variant (``contact_term="surface"``) replaces the flag count by how f
 touched are from the candidate's surface (1 per centimetre, capped at 1) plus 1 per link that did
 not touch but would penetrate the candidate.
 
-Fig. 2.1's loop (:class:`TouchPlanner`): initial guess -> plan -> trial -> update the model ->
-re-plan. The state is a point estimate of the object (x, y, yaw, scale), not a belief. The touch is a
-palm-down top grasp at the estimated object centre (the origin of the object's frame: the centre of
-its xy bounding box), the hand's x axis along the object's estimated x axis, at the hand's default
-spread: the grasp a robot would try first on its guess, so the exploration is a by-product of a
-grasp attempt, as in the thesis. After it, :meth:`TouchPlanner.update` replaces the estimate by the
-state whose re-simulated touch best reproduces the readings, and
-:meth:`TouchPlanner.plan` places the grasp models' most stable relative grasp at the estimate::
+Fig. 2.1's loop (:class:`TouchPlanner`, the package's planner interface, :mod:`.protocol`):
+initial guess -> plan -> trial -> update the model -> re-plan. The belief is a point estimate of
+the object (x, y, yaw, scale). Without grasp models the plan is the touch: a palm-down top grasp at
+the estimated object centre (the origin of the object's frame: the centre of its xy bounding box),
+the hand's x axis along the object's estimated x axis, at the hand's default spread. With grasp
+models it is the models' most stable relative grasp placed at the estimate, the grasp a robot
+would try on its guess, so the exploration is a by-product of a grasp attempt, as in the thesis.
+Either way ``observe`` replaces the estimate by the state whose re-simulated grasp best reproduces
+the readings::
 
-    planner = TouchPlanner("mug", estimate=(0.0, 0.0, 0.3))
-    grasp = planner.touch_grasp()
-    result = planner.update(grasp, readings)     # readings of the executed grasp
-    action = planner.plan(models)                 # world top grasp (x, y, yaw) on the updated model
+    planner = TouchPlanner("mug", estimate=(0.0, 0.0, 0.3))       # models=...: plan stable grasps
+    plan = planner.plan()                         # TouchPlan: .touch (TouchGrasp), .action (x, y, yaw)
+    result = planner.observe(plan, readings)      # readings of the executed grasp: an EstimateResult
+    planner.belief                                # the estimate (x, y, yaw, scale)
 """
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import Optional, Sequence, Union
 
 import numpy as np
@@ -55,7 +56,7 @@ TouchModelOptions, minimum_budget = _t.TouchModelOptions, _t.minimum_budget
 __all__ = ["OPTIMIZERS", "UNKNOWNS", "CONTACT_TERMS", "TouchModel", "TouchGrasp", "TouchReadings", "EstimateOptions",
            "EstimateResult", "EstimateStatus", "FitnessOptions", "SearchBox", "canonical_object", "estimate_options",
            "minimum_budget", "orientation_error", "read", "scaled_object", "symmetry_order", "top_grasp",
-           "touch_world", "TouchPlanner", "TouchSettings"]
+           "touch_world", "TouchPlan", "TouchPlanner", "TouchSettings"]
 
 #: Optimisers by name (the CLI's and the experiment's): the four of the thesis and a trust region.
 OPTIMIZERS = {"descent": _t.Optimizer.descent, "sa": _t.Optimizer.annealing, "pso": _t.Optimizer.pso,
@@ -199,16 +200,33 @@ class TouchSettings:
     threads: int = 1
     stop_fitness: float = 0.0
 
-    def options(self):
+    def options(self) -> EstimateOptions:
         return estimate_options(self.optimizer, self.unknowns, self.budget, self.seed, self.contact_term, self.box,
                                 threads=self.threads, stop_fitness=self.stop_fitness)
+
+
+@dataclass
+class TouchPlan:
+    """The next grasp: ``touch``, the top grasp the hand executes (a TouchGrasp: descend, close);
+    ``action`` its (x, y, yaw) in the world; ``kind`` "touch" (the estimated centre, along the
+    estimated yaw) or "stability" (the grasp models' most stable grasp at the estimate)."""
+
+    touch: TouchGrasp
+    action: np.ndarray
+    kind: str
+    estimate: np.ndarray = field(default_factory=lambda: np.zeros(4))
+
+    def to_dict(self) -> dict:
+        return {"kind": self.kind, "action": self.action.tolist(), "spread": float(self.touch.spread),
+                "estimate": self.estimate.tolist()}
 
 
 class TouchPlanner:
     """Fig. 2.1's loop on a point estimate of one object (see the module docstring)."""
 
     def __init__(self, obj: Union[str, ObjectModel, TouchModel], estimate: Sequence[float],
-                 settings: Optional[TouchSettings] = None, hand: Union[Hand, str] = "barrett_bh8"):
+                 settings: Optional[TouchSettings] = None, hand: Union[Hand, str] = "barrett_bh8",
+                 models: Optional[GraspModels] = None):
         self.model = obj if isinstance(obj, TouchModel) else TouchModel(obj, hand)
         self.settings = settings or TouchSettings()
         self.settings.options()  # names checked now
@@ -217,30 +235,43 @@ class TouchPlanner:
             est = np.append(est, 1.0)
         if est.shape != (4,) or not np.all(np.isfinite(est)):
             raise ValueError(f"estimate: expected finite (x, y, yaw) or (x, y, yaw, scale), got {estimate}")
+        if models is not None and models.family != "top":
+            raise ValueError(f"models: the touch planner plans top grasps; got the {models.family} family's models")
+        self.models = models
         self.initial = est.copy()
         self.estimate = est.copy()
         self.results: list = []
+
+    @property
+    def belief(self) -> np.ndarray:
+        """The point estimate (x, y, yaw, scale)."""
+        return self.estimate
 
     @property
     def spread(self) -> float:
         s = self.settings.spread
         return float(self.model.hand.core.spread_default if s is None else s)
 
-    def touch_grasp(self) -> TouchGrasp:
-        """The exploratory grasp: a top grasp at the estimated centre, along the estimated yaw."""
+    def plan(self) -> TouchPlan:
+        """The touch at the estimate (no grasp models), or the models' most stable relative grasp
+        (the highest P(S) node of their table) placed at the estimated pose, at the models' spread."""
         x, y, yaw, _ = self.estimate
-        return top_grasp(x, y, yaw, self.spread)
+        if self.models is None:
+            return TouchPlan(top_grasp(x, y, yaw, self.spread), np.array([x, y, yaw]), "touch", self.estimate.copy())
+        best = self.models.table().best_relative_grasps(1)[0]
+        a = absolute_planar_pose(best[None, :], self.estimate[None, :3])[0]
+        return TouchPlan(top_grasp(*a, self.models.spread), a, "stability", self.estimate.copy())
 
-    def update(self, grasp: TouchGrasp, readings: TouchReadings) -> EstimateResult:
-        """Fits the model to the readings (the estimate is kept when the touch missed the object)."""
-        r = self.model.estimate(grasp, readings, self.estimate, self.settings.options())
+    def observe(self, grasp: Union[TouchPlan, TouchGrasp], readings: TouchReadings) -> EstimateResult:
+        """Fits the model to the readings of the executed grasp (a TouchPlan or a TouchGrasp); the
+        estimate is kept when the grasp missed the object."""
+        touch = grasp.touch if isinstance(grasp, TouchPlan) else grasp
+        if not isinstance(touch, TouchGrasp):
+            raise TypeError(f"grasp: expected the executed TouchPlan or TouchGrasp, got {type(grasp).__name__}")
+        if not isinstance(readings, TouchReadings):
+            raise TypeError(f"readings: expected the hand's TouchReadings, got {type(readings).__name__}")
+        r = self.model.estimate(touch, readings, self.estimate, self.settings.options())
         if r.status == EstimateStatus.estimated:
             self.estimate = np.asarray(r.state, dtype=float).copy()
         self.results.append(r)
         return r
-
-    def plan(self, models: GraspModels) -> np.ndarray:
-        """The world top grasp (x, y, yaw) on the current model: the grasp models' most stable
-        relative grasp (the highest P(S) node of their table) placed at the estimated pose."""
-        best = models.table().best_relative_grasps(1)[0]
-        return absolute_planar_pose(best[None, :], self.estimate[None, :3])[0]
