@@ -84,7 +84,7 @@ def _loop(args, pose, attempts: int = 4, estimate=None, noise: float = 0.0, quie
 
 
 def _belief_png(r: dict, path) -> Path:
-    from ..experiments.report import plot_belief_evolution
+    from ..experiments.pose_uncertainty_plots import plot_belief_evolution
 
     return plot_belief_evolution(r["snapshots"], r["true_pose"], Path(path),
                                  f"{r['object']}, {r['method']}: true pose "

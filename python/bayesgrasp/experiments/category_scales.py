@@ -12,7 +12,7 @@ from __future__ import annotations
 
 from functools import partial
 from pathlib import Path
-from typing import Dict, List
+from typing import Dict
 
 import numpy as np
 
@@ -20,6 +20,7 @@ from ..planners.category import CategorySettings
 from . import report
 from .category import plan_and_execute, see
 from .category_grasping import TASKS, prepare_task_grasps, view
+from .category_stats import grid_rows, nested_rows
 from .context import RunContext
 from .registry import Experiment, register
 from .runner import run_seed
@@ -55,60 +56,16 @@ def _make(exp: Experiment, method: str, ctx: RunContext):
     return method, partial(scales_run, ctx=ctx, scales=GRID[method])
 
 
-def _success(results: list, method: str, exclude: str = "", only: str = "") -> tuple:
-    """(successes, trials) of ``method`` over runs and tasks, without object ``exclude`` / only ``only``."""
-    k = n = 0
-    for _, r in results:
-        if (exclude and r["object"] == exclude) or (only and r["object"] != only):
-            continue
-        for outs in r["tasks"].values():
-            k += bool(outs[method]["success"])
-            n += 1
-    return k, n
-
-
-def grid_rows(results: Dict[str, list]) -> List[dict]:
-    """Per grid point: each method's success over all runs and tasks, and the thesis's two orderings."""
-    rows = []
-    for name, (t, r) in GRID.items():
-        res = results.get(name, [])
-        rates = {}
-        for m in DENSITIES:
-            k, n = _success(res, m)
-            rates[m] = k / n if n else float("nan")
-        rows.append({"scales": name, "s_t (cm)": 100 * t, "s_R (deg)": round(float(np.degrees(r))),
-                     **{m: round(rates[m], 3) for m in DENSITIES},
-                     "laplace above baseline": rates["laplace"] > rates["baseline"],
-                     "gaussian the worst density": rates["gaussian"] <= min(rates["laplace"], rates["regularised"])})
-    return rows
-
-
-def nested_rows(results: Dict[str, list]) -> List[dict]:
-    """Per held-out mug h: the scales chosen on the other mugs' runs (Laplace's success), h's Laplace
-    success there and at ours."""
-    rows = []
-    for h in MUGS:
-        def inner(name):
-            k, n = _success(results.get(name, []), "laplace", exclude=h)
-            return k / n if n else -1.0
-        best = max(GRID, key=inner)
-        kb, nb = _success(results.get(best, []), "laplace", only=h)
-        ko, no = _success(results.get(OURS, []), "laplace", only=h)
-        rows.append({"held out": h, "chosen on the others": best, "their success": round(inner(best), 3),
-                     "held-out success, chosen": f"{kb}/{nb}", "held-out success, ours (1 cm, 10 deg)": f"{ko}/{no}"})
-    return rows
-
-
 def write_report(exp: Experiment, results: Dict[str, list], out: Path) -> dict:
-    out, md, summary = report._start(exp.name, out)
-    grid, nested = grid_rows(results), nested_rows(results)
-    report._write_csv(grid, out / "grid.csv")
-    report._write_csv(nested, out / "nested.csv")
+    out, md, summary = report.start(exp.name, out)
+    grid, nested = grid_rows(results, GRID, DENSITIES), nested_rows(results, MUGS, GRID, OURS)
+    report.write_csv(grid, out / "grid.csv")
+    report.write_csv(nested, out / "nested.csv")
     md += ["Success = lifted and the contacts on the task's parts, pooled over the three mug tasks. The same "
-           "views at every grid point.", "", report._markdown(grid, tuple(grid[0])), "",
-           "## The scales chosen without the held-out mug", "", report._markdown(nested, tuple(nested[0])), ""]
+           "views at every grid point.", "", report.markdown(grid, tuple(grid[0])), "",
+           "## The scales chosen without the held-out mug", "", report.markdown(nested, tuple(nested[0])), ""]
     summary.update({"grid": grid, "nested": nested})
-    return report._finish(out, md, summary)
+    return report.finish(out, md, summary)
 
 
 register(Experiment("pub5_scales", MUGS, 2, "Eq. 4.1's density scales s_t x s_R on a 3 x 3 grid (mugs, the same views)",

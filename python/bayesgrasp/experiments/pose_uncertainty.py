@@ -33,9 +33,10 @@ from ..belief import relative_planar_pose, weight_entropy
 from ..models import relative_top_grasps
 from ..planners import PlannerSettings, make_planner
 from ..world import World
-from . import report
 from .context import RunContext
 from .episode import EpisodeSettings, run_episode
+from .pose_uncertainty_plots import plot_belief_evolution
+from .pose_uncertainty_report import write_entropy_order, write_episodes, write_landscapes
 from .registry import Experiment, register
 from .runner import run_seed
 
@@ -199,22 +200,22 @@ def belief_figures(exp: Experiment, objects: List[str], ctx: RunContext, out: Pa
                                   measurement_noise=ctx.measurement_noise, planner=ctx.planner_settings())
         r = run_episode(o, pose, episode, ctx,
                         seed=run_seed(ctx.seed, exp.name, o, 0), keep_planner=True)
-        p = report.plot_belief_evolution(r["snapshots"], pose, out / f"belief_{o}.png",
+        p = plot_belief_evolution(r["snapshots"], pose, out / f"belief_{o}.png",
                                          f"{o}, {method}, run 0: true pose {np.round(pose, 3).tolist()}", r["attempts"])
         lines.append(f"![{o}]({p.name})")
     with open(out / "summary.md", "a") as f:
         f.write("\n## Belief evolution (run 0)\n\n" + "\n\n".join(lines) + "\n")
 
 
-register(Experiment("pub2", FIVE, 100, "stability maximisation (Pub. II)", _episodes, report.write_episodes,
+register(Experiment("pub2", FIVE, 100, "stability maximisation (Pub. II)", _episodes, write_episodes,
                     ("stability",), belief_figures, prepare_object=prepare_models))
-register(Experiment("baselines", FIVE, 30, "all planners and the two baselines", _episodes, report.write_episodes,
+register(Experiment("baselines", FIVE, 30, "all planners and the two baselines", _episodes, write_episodes,
                     METHODS, prepare_object=prepare_models))
 register(Experiment("pub4", ("cube", "mug", "cylinder"), 30,
-                    "exploration vs stability only, 4 grasps per run (Pub. IV)", _episodes, report.write_episodes,
+                    "exploration vs stability only, 4 grasps per run (Pub. IV)", _episodes, write_episodes,
                     ("explore", "stability"), belief_figures, prepare_object=prepare_models))
 register(Experiment("entropy_order", ("cube", "mug"), 30,
                     "predicted vs realised entropy order of three grasps (Fig. 3.6)", _explore_runs(entropy_order_run),
-                    report.write_entropy_order, ("explore",), prepare_object=prepare_models))
+                    write_entropy_order, ("explore",), prepare_object=prepare_models))
 register(Experiment("landscapes", ("mug", "cube"), 3, "weight vs kernel entropy landscapes; 1,000 vs 10,000 samples",
-                    _explore_runs(landscapes_run), report.write_landscapes, ("explore",), prepare_object=prepare_models))
+                    _explore_runs(landscapes_run), write_landscapes, ("explore",), prepare_object=prepare_models))

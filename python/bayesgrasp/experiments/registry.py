@@ -1,6 +1,8 @@
 """The experiments by name. Each module of experiments registers its own (see
 :mod:`.pose_uncertainty`; the package imports every such module); the driver (:mod:`.driver`)
-runs any of them the same way."""
+runs any of them the same way, in three steps: prepare (what the runs share), run one (a
+(method, object, run index) -> a JSON-ready dict, stored), report (tables, prose and figures from
+the stored runs; each experiment's statistics, prose and figures are modules of their own)."""
 from __future__ import annotations
 
 from dataclasses import dataclass

@@ -30,13 +30,14 @@ from ..planners.fusion import FusionPlanner, FusionSettings
 from ..world import World
 from . import report
 from .category import demonstrated, see, training_models
-from .category_grasping import view, wilson
+from .category_grasping import view
 from .context import RunContext
 from .registry import Experiment, register
 from .runner import run_seed
+from .tactile_fusion_plots import plot_cumulative_success
+from .tactile_fusion_stats import ROUNDS, THESIS, round_rows, transitions
 
 MUGS = tuple(f"mug/{i}" for i in range(7))
-ROUNDS = 3
 
 
 def planar_top_grasps(grasps) -> np.ndarray:
@@ -177,44 +178,8 @@ def prepare(exp: Experiment, objects: List[str], ctx: RunContext) -> None:
     demonstrated(training_models("mug"), task_rule("mug", "top"), ctx)
 
 
-def transitions(results: list) -> dict:
-    """The thesis's accounting over trials (Pub. VI): after round 1, better / worse / same (both
-    unstable); unstable -> stable, stable -> unstable; of the still unstable, how many became
-    stable in rounds 2 and 3; cumulative success by round; the vision-only baseline."""
-    n = len(results)
-    better = worse = same = up = down = 0
-    for _, r in results:
-        r0, r1 = r["rounds"][0], r["rounds"][1] if len(r["rounds"]) > 1 else r["rounds"][0]
-        a, b = (r0["lifted"], r0["epsilon"]), (r1["lifted"], r1["epsilon"])
-        if not a[0] and not b[0] and abs(a[1] - b[1]) < 1e-3:
-            same += 1
-        elif b > a:
-            better += 1
-        else:
-            worse += 1
-        up += (not r0["lifted"]) and r1["lifted"]
-        down += r0["lifted"] and not r1["lifted"]
-    cumulative = []
-    for t in range(ROUNDS + 1):
-        cumulative.append(sum(any(x["lifted"] for x in r["rounds"][:t + 1]) for _, r in results))
-    still = [r for _, r in results if not any(x["lifted"] for x in r["rounds"][:2])]
-    later = [sum(any(x["lifted"] for x in r["rounds"][2:t + 1]) for r in still) for t in (2, 3)]
-    vision = sum(r["vision_only"]["lifted"] for _, r in results)
-    return {"trials": n, "better": better, "worse": worse, "same_both_unstable": same,
-            "unstable_to_stable": up, "stable_to_unstable": down, "still_unstable_after_round_1": len(still),
-            "became_stable_round_2": later[0], "became_stable_round_3": later[1] - later[0],
-            "cumulative_success_by_round": cumulative, "vision_only_success": vision,
-            "success_after_round_3": cumulative[-1], "ci_after_round_3": wilson(cumulative[-1], n),
-            "ci_vision_only": wilson(vision, n)}
-
-
-THESIS = {"better": 45, "worse": 34, "same_both_unstable": 21, "unstable_to_stable": 25, "stable_to_unstable": 21,
-          "still_unstable_after_round_1": 42, "became_stable_round_2": 15, "became_stable_round_3": 5,
-          "success_after_round_3": 78}
-
-
 def write_report(exp: Experiment, results: Dict[str, list], out: Path) -> dict:
-    out, md, summary = report._start(exp.name, out)
+    out, md, summary = report.start(exp.name, out)
     t = transitions(results["all"])
     rows = [{"measure": k, "ours": t[k], "thesis": THESIS.get(k, "")} for k in THESIS]
     rows += [{"measure": "cumulative success by round 0/1/2/3", "ours": " / ".join(map(str, t["cumulative_success_by_round"])),
@@ -228,52 +193,17 @@ def write_report(exp: Experiment, results: Dict[str, list], out: Path) -> dict:
          "holds": t["success_after_round_3"] >= 0.78 * t["trials"]},
         {"target": "issue 29: success after round 3 >= 88 of 105 (scaled to the trials)",
          "holds": t["success_after_round_3"] >= 88 / 105 * t["trials"]}]
-    report._write_csv(rows, out / "transitions.csv")
-    report._write_csv(targets, out / "targets.csv")
-    report._write_csv(round_rows(results["all"]), out / "rounds.csv")
+    report.write_csv(rows, out / "transitions.csv")
+    report.write_csv(targets, out / "targets.csv")
+    report.write_csv(round_rows(results["all"]), out / "rounds.csv")
     png = plot_cumulative_success(t, out / "cumulative_success.png", exp.name)
     md += [f"{t['trials']} trials. Success = lifted. After round 3: {t['success_after_round_3']} "
            f"(95% CI {t['ci_after_round_3'][0]:.2f}-{t['ci_after_round_3'][1]:.2f}); vision only: "
            f"{t['vision_only_success']} (CI {t['ci_vision_only'][0]:.2f}-{t['ci_vision_only'][1]:.2f}).", "",
-           report._markdown(rows, ("measure", "ours", "thesis")), "", report._markdown(targets, ("target", "holds")), "",
+           report.markdown(rows, ("measure", "ours", "thesis")), "", report.markdown(targets, ("target", "holds")), "",
            f"![cumulative success]({png.name})", ""]
     summary.update({"transitions": t, "targets": targets})
-    return report._finish(out, md, summary)
-
-
-def round_rows(results: list) -> List[dict]:
-    """One row per trial and round: the grasp's epsilon, whether it lifted, the heaviest model and
-    its weight after the round's update."""
-    rows = []
-    for key, r in results:
-        names = [g["model"] for g in r.get("registrations", [])]
-        for x in r["rounds"]:
-            w = dict(zip(names, x.get("weights", [])))
-            best = max(w, key=w.get) if w else ""
-            rows.append({"trial": str(key), "round": x.get("round"), "epsilon": x["epsilon"], "lifted": x["lifted"],
-                         "top_model": best, "top_weight": w.get(best, "")})
-    return rows
-
-
-def plot_cumulative_success(t: dict, path: Path, title: str) -> Path:
-    """Trials lifted by round (cumulative) with the vision-only baseline and the thesis's 78 of 100
-    after round 3 scaled to our trial count."""
-    plt = report._mpl()
-    n, c = t["trials"], t["cumulative_success_by_round"]
-    fig, ax = plt.subplots(figsize=(4.8, 3.6))
-    ax.plot(range(len(c)), c, "o-", label="ours: lifted by round (cumulative)")
-    ax.axhline(t["vision_only_success"], color="0.5", ls="--", label="ours: vision only")
-    ax.plot([len(c) - 1], [0.78 * n], "r*", ms=12, label="thesis: 78 of 100 after round 3 (scaled)")
-    ax.set_xticks(range(len(c)))
-    ax.set_xlabel("round (0 = the vision grasp)")
-    ax.set_ylabel(f"trials lifted (of {n})")
-    ax.set_ylim(0, n * 1.05)
-    ax.legend(fontsize=7, loc="lower right")
-    ax.set_title(title, fontsize=10)
-    fig.tight_layout()
-    fig.savefig(path, dpi=110)
-    plt.close(fig)
-    return path
+    return report.finish(out, md, summary)
 
 
 register(Experiment("pub6", MUGS, 15, "vision then touch: per-model poses and weights from the fingers (Pub. VI)",
