@@ -149,6 +149,26 @@ void bind_options(py::module_& m) {
         "The smallest budget the optimiser runs with in `dim` unknowns.");
 }
 
+/// EstimateResult as plain Python values (the status by name, arrays as lists): one key set.
+py::dict estimate_dict(const EstimateResult& r) {
+  py::dict d;
+  d["status"] = r.status == EstimateStatus::Estimated ? "estimated" : "no_contact";
+  d["message"] = r.message;
+  d["initial"] = std::vector<double>(r.initial.data(), r.initial.data() + r.initial.size());
+  d["state"] = std::vector<double>(r.state.data(), r.state.data() + r.state.size());
+  d["initial_fitness"] = r.initial_fitness;
+  d["fitness"] = r.fitness;
+  d["fitness_terms"] = py::dict(py::arg("joint") = r.joint_term, py::arg("contact") = r.contact_term,
+                                py::arg("height") = r.height_term);
+  d["evaluations"] = r.evaluations;
+  d["stopped"] = r.stopped;
+  d["restarts"] = r.restarts;
+  d["trace"] = py::dict(py::arg("evaluations") = r.trace_evaluations, py::arg("best_fitness") = r.trace_fitness);
+  d["seconds"] = r.seconds;
+  d["cpu_seconds"] = r.cpu_seconds;
+  return d;
+}
+
 void bind_results(py::module_& m) {
   py::class_<TouchPredictions>(m, "TouchPredictions", "Predicted readings of N candidates (row i = candidate i).")
       .def_readonly("num_candidates", &TouchPredictions::num_candidates, "num_candidates : int")
@@ -191,7 +211,11 @@ void bind_results(py::module_& m) {
       .def_readonly("trace_fitness", &EstimateResult::trace_fitness, "trace_fitness : list of float\n    best f so far")
       .def_readonly("seconds", &EstimateResult::seconds, "seconds : float\n    wall time of the search")
       .def_readonly("cpu_seconds", &EstimateResult::cpu_seconds,
-                    "cpu_seconds : float\n    processor time of the search (all threads)");
+                    "cpu_seconds : float\n    processor time of the search (all threads)")
+      .def("to_dict", &estimate_dict,
+           "{'status', 'message', 'initial', 'state', 'initial_fitness', 'fitness', 'fitness_terms': {'joint', "
+           "'contact', 'height'}, 'evaluations', 'stopped', 'restarts', 'trace': {'evaluations', 'best_fitness'}, "
+           "'seconds', 'cpu_seconds'} as plain Python values.");
 }
 
 /// States as the core takes them (an array that is not 2-D becomes 0 x 0: the core names the problem).

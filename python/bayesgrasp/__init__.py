@@ -12,3 +12,6 @@ if _dev_core:
     __path__.append(_dev_core)  # noqa: F821 (module __path__)
 
 __version__ = "0.1.0"
+
+#: The hand every command and function takes when none is named: the Barrett BH8 (the thesis's).
+DEFAULT_HAND = "barrett_bh8"

@@ -21,7 +21,7 @@ from typing import Optional
 
 import numpy as np
 
-from bayesgrasp import _core
+from bayesgrasp import DEFAULT_HAND, _core
 
 __all__ = ["Hand", "HANDS_DIR", "ShapeGeometry", "builtin_hands"]
 
@@ -80,6 +80,7 @@ class ShapeGeometry:
     faces: Optional[np.ndarray] = None
 
 
+
 class Hand:
     """A hand model (wraps :class:`bayesgrasp._core.hand.Hand`)."""
 
@@ -91,7 +92,7 @@ class Hand:
         self._text = text
 
     @classmethod
-    def load(cls, name_or_path: str | Path = "barrett_bh8") -> "Hand":
+    def load(cls, name_or_path: str | Path = DEFAULT_HAND) -> "Hand":
         """A built-in hand by name (see :func:`builtin_hands`), a hand file (JSON) by path, or a
         URDF (``NAME.urdf`` with its sidecar ``NAME.hand.json`` beside it; see
         :mod:`bayesgrasp.hand_urdf`)."""

@@ -62,6 +62,8 @@ def test_bad_engines_are_refused():
         make_engine("dask")
     with pytest.raises(ValueError, match="address"):
         make_engine("local", address="127.0.0.1:6379")
+    with pytest.raises(ValueError, match="workers 4 would be ignored"):
+        make_engine("ray", workers=4, address="127.0.0.1:6379")    # one channel: the cluster's CPUs
     with pytest.raises(ValueError, match="workers"):
         LocalEngine(0)
 

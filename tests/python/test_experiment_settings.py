@@ -173,9 +173,8 @@ def test_config_tables_reach_the_planner_the_episode_and_the_sweep(tmp_path):
     cfg.write_text('[planner]\nn_particles = 120\nhalf_width = [0.02, 0.02, 0.5]\n[episode]\nmeasurement_noise = 0.01\n'
                    '[sweep]\n"planner.pso_iter" = [5, 10]\n[sweep.models]\nn_samples = [300, 400]\n')
     args = build_parser().parse_args(["experiment", "pub2", "--config", str(cfg), "--sweep", "models.n_samples=350"])
-    apply_config(args, str(cfg), {"runs": None, "workers": 1, "out": None, "objects": None, "hand": "barrett_bh8",
-                                  "success": "lift", "no_lift": False, "seed": 0, "families": "top",
-                                  "engine": "local", "address": None, "cache": None})
+    assert args.config_defaults["hand"] == "barrett_bh8" and args.config_defaults["workers"] == 1
+    apply_config(args, str(cfg), args.config_defaults)
     ctx = context(args, progress=False)
     assert ctx.planner_settings().n_particles == 120 and tuple(ctx.planner_settings().half_width) == (0.02, 0.02, 0.5)
     assert ctx.measurement_noise == 0.01
@@ -193,3 +192,18 @@ def test_config_tables_reach_the_planner_the_episode_and_the_sweep(tmp_path):
     bad.write_text("[planner]\nn_particles = 1\n")
     code, _, err = run_cli("experiment", "pub2", "--config", str(bad), "--out", str(tmp_path / "e"))
     assert code != 0 and "n_particles" in err
+
+
+@pytest.mark.parametrize("key, option", [("models.success", "--success"), ("models.family", "--families")])
+def test_a_setting_with_an_option_of_its_own_is_refused_by_set(key, option):
+    from bayesgrasp.cli.args import CliError, parse_set
+
+    with pytest.raises(CliError, match=f"{key} is set by {option}"):
+        parse_set([f"{key}=epsilon"])
+    assert parse_set(["models.n_samples=300"]) == {"models": {"n_samples": 300}}
+
+
+def test_plan_refuses_two_different_noises():
+    code, _, err = run_cli("plan", "--object", "cube", "--true-pose", "0,0,0", "--noise", "0.01",
+                           "--set", "episode.measurement_noise=0.02")
+    assert code != 0 and "give one" in err

@@ -184,3 +184,18 @@ def test_lift_criterion_loop_stops_at_a_lifted_grasp_and_learns_from_dropped_one
         assert r["success"] == last["success"]
         assert ("belief_after" in last) == (not last["success"])
     assert any(r["success"] for r in runs)
+
+
+def test_an_episode_takes_the_planner_settings_and_the_noise_from_the_context_alone(cube):
+    from dataclasses import replace
+
+    small = replace(NO_LIFT, planner=PlannerSettings(n_particles=40, plan_particles=0))
+    r = run_episode("cube", (0.03, -0.02, 0.7), EpisodeSettings(method="stability", attempts=1), small, seed=5,
+                    models=cube, keep_planner=True)
+    assert r["planner"].belief.particles.shape == (40, 3)
+    exact = run_episode("cube", (0.03, -0.02, 0.7), EpisodeSettings(method="stability", attempts=1), small, seed=5,
+                        models=cube)
+    noisy = run_episode("cube", (0.03, -0.02, 0.7), EpisodeSettings(method="stability", attempts=1),
+                        replace(small, measurement_noise=0.05), seed=5, models=cube)
+    a, b = exact["attempts"][0], noisy["attempts"][0]
+    assert a["action"] == b["action"] and a["joint_angles"] != b["joint_angles"]   # same grasp, noisy reading

@@ -85,6 +85,9 @@ def test_the_touch_planner_touches_without_models_and_grasps_with_them():
     assert plan.kind == "touch" and np.allclose(plan.action, guess) and _round_trip(plan)["kind"] == "touch"
     r = planner.observe(plan, T.read(T.touch_world("cube", truth), plan.touch))
     assert r.fitness <= r.initial_fitness and np.array_equal(planner.belief, r.state)
+    d = _round_trip(r)
+    assert d["status"] == "estimated" and d["state"] == planner.belief.tolist() and d["fitness"] == r.fitness
+    assert d["trace"]["evaluations"] == list(r.trace_evaluations) and d["fitness_terms"]["joint"] == r.joint_term
     with pytest.raises(TypeError, match="readings"):
         planner.observe(plan, np.zeros(4))
     assert len(planner.results) == 1

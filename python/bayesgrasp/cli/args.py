@@ -8,6 +8,8 @@ import re
 from pathlib import Path
 from typing import List, Optional, Sequence
 
+from .. import DEFAULT_HAND
+
 
 class CliError(Exception):
     """A user error: printed as one line, exit status 2."""
@@ -91,7 +93,7 @@ def output_file(path: Optional[str], what: str) -> Optional[Path]:
 
 def add_hand_option(p: argparse.ArgumentParser) -> None:
     """--hand, as every command takes it (RunContext.hand)."""
-    p.add_argument("--hand", type=hand_name, default="barrett_bh8",
+    p.add_argument("--hand", type=hand_name, default=DEFAULT_HAND,
                    help="built-in hand name, hand file or URDF (with its NAME.hand.json sidecar)")
 
 
@@ -160,7 +162,7 @@ def context(args: argparse.Namespace, progress: bool = True):
         out_dir(args.cache, "--cache")  # before minutes of model building
     success, lift = getattr(args, "success", "lift"), not getattr(args, "no_lift", False)
     try:  # RunContext checks the settings (the success/lift rule among them); errors name the option
-        return RunContext(hand=getattr(args, "hand", "barrett_bh8"), cache_dir=getattr(args, "cache", None),
+        return RunContext(hand=getattr(args, "hand", DEFAULT_HAND), cache_dir=getattr(args, "cache", None),
                           success=success, lift=lift, seed=getattr(args, "seed", 0),
                           progress=stderr_progress if progress else None,
                           model_settings=model_settings(getattr(args, "set", []), success),
@@ -184,6 +186,8 @@ def families_arg(text):
 
 #: --set's groups: the dataclass each sets (planner and episode settings reach the experiments only).
 SET_GROUPS = ("models", "planner", "episode")
+#: Fields --set may not reach: an option of their own sets them (one channel per setting).
+SET_BY_OPTION = {"models.success": "--success", "models.family": "--families"}
 
 
 def _set_classes():
@@ -227,6 +231,8 @@ def parse_set(assignments) -> dict:
                               for g, c in classes.items())
             raise CliError(f"--set: expected models.FIELD=VALUE, planner.FIELD=VALUE or episode.FIELD=VALUE with "
                            f"FIELD one of ({known}); got {a!r}")
+        if key in SET_BY_OPTION:
+            raise CliError(f"--set: {key} is set by {SET_BY_OPTION[key]}; give it there")
         default = getattr(cls(), name)
         try:
             out.setdefault(group, {})[name] = _read_value(default, text, name)

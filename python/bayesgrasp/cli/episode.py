@@ -72,7 +72,6 @@ def add(sub) -> None:
 
 def new(args) -> int:
     from ..experiments.outside_loop import PoseEpisode
-    from ..planners import PlannerSettings
     from .plan import _vision_start
 
     fmt = output_format(args)
@@ -93,13 +92,13 @@ def new(args) -> int:
 
         obj = load_object(args.object, units=args.units)
     start, _ = _vision_start(args, obj, est, quiet=fmt != "text")
-    settings = PlannerSettings()
+    ctx = context(args)
+    settings = ctx.planner_settings()           # --set planner.FIELD=VALUE
     if start is not None:
         est = start.estimate.tolist()
         settings = settings.with_(half_width=tuple(start.half_width.tolist()))
     if est is None:
         raise CliError("--estimate: needed (or --cloud / --depth to register the object to)")
-    ctx = context(args)
     ep = PoseEpisode.new(args.dir, obj, est, ctx, method=method, attempts=args.attempts, seed=ctx.seed,
                          planner=settings)
     _print_next(ep, fmt)

@@ -35,9 +35,13 @@ def add(sub) -> None:
                         "--set; one results file, each point's report in OUT/GROUP.FIELD=V_.../")
     add_context_options(e, lift=True)
     add_families_option(e)
-    e.set_defaults(run=run)
+    # the command line's defaults, read once here: --config fills only the options left at them
+    e.set_defaults(run=run, config_defaults={k: e.get_default(k) for k in CONFIG_OPTIONS})
 
 
+#: The options --config may set (argparse destinations).
+CONFIG_OPTIONS = ("runs", "workers", "out", "objects", "hand", "success", "no_lift", "seed", "families", "engine",
+                  "address", "cache")
 #: The TOML keys --config takes at its top level, with the option each sets and how it is checked.
 CONFIG_KEYS = {"runs": int, "workers": int, "engine": str, "address": str, "out": str, "objects": list, "hand": str, "success": str,
                "lift": bool, "seed": int, "cache": str, "families": str}
@@ -144,10 +148,7 @@ def run(args) -> int:
     except ValueError as e:
         raise CliError(str(e)) from None
     if args.config:
-        apply_config(args, args.config, {"runs": None, "workers": 1, "out": None, "objects": None,
-                                         "hand": "barrett_bh8", "success": "lift", "no_lift": False, "seed": 0,
-                                         "families": "top", "engine": "local", "address": None,
-                                         "cache": None})
+        apply_config(args, args.config, args.config_defaults)
         if (args.runs is not None and args.runs < 1) or args.workers < 1 or not 0 <= args.seed <= SEED_MAX:
             raise CliError(f"--config: {args.config}: runs and workers must be at least 1, seed in [0, 2^63 - 1]")
         if args.engine not in ("local", "ray"):
@@ -160,8 +161,6 @@ def run(args) -> int:
             raise CliError(f"--config: {args.config}: {e}") from None
     for o in args.objects or ():
         load_object(o)  # a clear error for an unknown object
-    if args.address and args.engine != "ray":
-        raise CliError("--address: only with --engine ray")
     out = out_dir(args.out or f"out/experiments/{args.name}")
     ctx = context(args)
     points = None

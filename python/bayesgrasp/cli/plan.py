@@ -72,13 +72,15 @@ def _loop(args, pose, attempts: int = 4, estimate=None, noise: float = 0.0, quie
     if attempts < 1:
         raise CliError(f"--attempts: must be at least 1, got {attempts}")
     ctx = context(args)
+    if noise and ctx.measurement_noise and noise != ctx.measurement_noise:
+        raise CliError(f"--noise {noise} and --set episode.measurement_noise={ctx.measurement_noise}: give one")
     obj = args.object if obj is None else obj
     World.single(obj, pose=pose, hand=ctx.hand)  # a clear error for an unknown object or a pose off the table
     models = ctx.family_models(obj)
     planner = ctx.planner_settings()
     planner = planner if half_width is None else replace(planner, half_width=tuple(half_width))
-    episode = EpisodeSettings(method=args.method, attempts=attempts, measurement_noise=noise or ctx.measurement_noise,
-                              planner=planner)
+    ctx = replace(ctx, planner=planner, measurement_noise=noise or ctx.measurement_noise)
+    episode = EpisodeSettings(method=args.method, attempts=attempts)
     return run_episode(obj, pose, episode, ctx, seed=ctx.seed, estimate=estimate, models=models,
                        keep_planner=True, on_attempt=None if quiet else _print_attempt)
 

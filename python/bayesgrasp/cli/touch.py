@@ -105,12 +105,8 @@ def _result(args, planner, grasp, readings, r, truth, guess, case) -> dict:
                      "joint_names": list(planner.model.hand.core.joint_names),
                      "contact_links": [n for n, c in zip(names, readings.contact) if c],
                      "hand_pose": np.asarray(readings.hand_pose).tolist()},
-        "status": r.status.name, "message": r.message,
-        "initial_fitness": r.initial_fitness, "fitness": r.fitness,
-        "fitness_terms": {"joint": r.joint_term, "contact": r.contact_term, "height": r.height_term},
+        **{k: v for k, v in r.to_dict().items() if k not in ("initial", "state", "stopped", "cpu_seconds")},
         "errors_before": _errors(args.object, guess, truth), "errors_after": _errors(args.object, est, truth),
-        "evaluations": int(r.evaluations), "restarts": int(r.restarts), "seconds": r.seconds,
-        "trace": {"evaluations": list(map(int, r.trace_evaluations)), "best_fitness": list(r.trace_fitness)},
     }
 
 

@@ -9,6 +9,7 @@ from __future__ import annotations
 import sys
 import time
 
+from .. import DEFAULT_HAND
 from .args import bounded_int
 
 
@@ -25,7 +26,7 @@ def add(sub) -> None:
                    "(default: the only one)")
     v.add_argument("--object", default=None, help="results.sqlite: the run's object (default: the only one)")
     v.add_argument("--run", dest="run_index", type=bounded_int(0, 10**9), default=0, help="results.sqlite: the run's index")
-    v.add_argument("--hand", default="barrett_bh8", help="results.sqlite: the hand the experiment ran with")
+    v.add_argument("--hand", default=DEFAULT_HAND, help="results.sqlite: the hand the experiment ran with")
     v.add_argument("--seconds", type=float, default=None, help="stop after this long (default: until Ctrl-C)")
     v.set_defaults(run=run)
 

@@ -7,7 +7,7 @@ from typing import List
 import numpy as np
 
 from ..planners.category import METHODS
-from .report import mpl
+from .report import mpl, save_figure
 
 
 def plot_success(rows: List[dict], path: Path, title: str) -> Path:
@@ -29,7 +29,4 @@ def plot_success(rows: List[dict], path: Path, title: str) -> Path:
     ax.set_title(title, fontsize=10)
     ax.legend(fontsize=8, ncol=2)
     ax.grid(axis="y", alpha=0.3)
-    fig.tight_layout()
-    fig.savefig(path, dpi=110)
-    plt.close(fig)
-    return path
+    return save_figure(fig, path)

@@ -7,6 +7,7 @@ import sys
 from dataclasses import dataclass, field, replace
 from typing import Callable, Optional, Union
 
+from .. import DEFAULT_HAND
 from ..models import GraspModels, ModelSettings, get_models, parse_families
 from ..models.settings import SUCCESS_CRITERIA
 from ..objects import ObjectModel
@@ -44,7 +45,7 @@ class RunContext:
     planner: the planners' settings (None: the defaults); measurement_noise: std (rad) of the
     Gaussian noise on the measured joint angles in the closed-loop experiments."""
 
-    hand: str = "barrett_bh8"
+    hand: str = DEFAULT_HAND
     cache_dir: Optional[str] = None
     success: str = "lift"
     lift: bool = True

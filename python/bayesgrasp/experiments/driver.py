@@ -42,7 +42,7 @@ def prepare(exp, objects: Sequence[str], ctx: RunContext, engine) -> None:
 def run(name: str, out_dir, ctx: Optional[RunContext] = None, runs: Optional[int] = None, workers: int = 1,
         objects: Optional[Sequence[str]] = None, engine=None) -> dict:
     """Runs (or resumes) experiment ``name`` into ``out_dir`` and writes its tables and plots.
-    ``engine``: where the runs go (default: ``workers`` local processes). Returns the summary
+    ``engine``: where the runs go (default: ``workers`` local processes; not both). Returns the summary
     dict (also written as summary.json). Progress (model building, the progress bar) is shown
     when ``ctx.progress`` is set."""
     exp = get_experiment(name)
@@ -52,6 +52,8 @@ def run(name: str, out_dir, ctx: Optional[RunContext] = None, runs: Optional[int
         raise ValueError(f"runs: must be at least 1, got {runs}")
     if workers < 1:
         raise ValueError(f"workers: must be at least 1, got {workers}")
+    if engine is not None and workers != 1:
+        raise ValueError(f"workers: the engine has its own ({workers} would be ignored); give one of the two")
     engine = engine or LocalEngine(workers)
     objects = list(exp.objects if objects is None else objects)
     out = Path(out_dir)

@@ -137,6 +137,8 @@ def make_engine(name: str = "local", workers: int = 1, address: Optional[str] = 
         raise ValueError(f"engine: one of {', '.join(ENGINES)}; got {name!r}")
     if address and name != "ray":
         raise ValueError("address: only for engine 'ray'")
+    if address and workers != 1:
+        raise ValueError(f"workers: the cluster at {address} has its own CPUs; workers {workers} would be ignored")
     if name == "local":
         return LocalEngine(workers)
     return RayEngine(workers=None if address else workers, address=address)

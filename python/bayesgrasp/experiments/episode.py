@@ -9,12 +9,12 @@ steps: :func:`plan` is the planner's, then :func:`execute` (the grasp at the tru
 """
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from typing import Callable, Optional, Sequence, Union
 
 import numpy as np
 
-from ..models import GraspModels, ModelSettings, relative_top_grasps
+from ..models import GraspModels, relative_top_grasps
 from ..objects import ObjectModel, load_object
 from ..planners import Planner, PlannerSettings, Reading, make_planner
 from ..world import World
@@ -24,23 +24,20 @@ from .context import RunContext
 @dataclass(frozen=True)
 class EpisodeSettings:
     """method: a planner name (see :data:`bayesgrasp.planners.PLANNERS`); attempts: grasps at most;
-    measurement_noise: std (rad) of Gaussian noise on the measured joint angles; stop_when_stable:
-    stop at the first successful grasp (False: every attempt is made, the thesis's fixed number of
-    grasps, and the belief is updated after successful grasps too). What success is comes from
-    the run context (:attr:`RunContext.success`)."""
+    stop_when_stable: stop at the first successful grasp (False: every attempt is made, the
+    thesis's fixed number of grasps, and the belief is updated after successful grasps too). The
+    rest comes from the run context, each setting from there only: what success is
+    (:attr:`RunContext.success`), the planner's settings (:meth:`RunContext.planner_settings`),
+    the noise on the measured joint angles (:attr:`RunContext.measurement_noise`), the models'
+    settings."""
 
     method: str = "explore"
     attempts: int = 4
-    measurement_noise: float = 0.0
     stop_when_stable: bool = True
-    planner: PlannerSettings = field(default_factory=PlannerSettings)
-    models: Optional[ModelSettings] = None   # None: the run context's (its success criterion)
 
     def __post_init__(self):
         if self.attempts < 1:
             raise ValueError(f"attempts: must be at least 1, got {self.attempts}")
-        if not (np.isfinite(self.measurement_noise) and self.measurement_noise >= 0):
-            raise ValueError(f"measurement_noise: must be >= 0, got {self.measurement_noise}")
 
 
 @dataclass
@@ -132,11 +129,12 @@ def run_episode(obj: Union[str, ObjectModel], true_pose: Sequence[float], episod
     obj_model = load_object(obj) if isinstance(obj, str) else obj
     true_pose = _check_pose(true_pose)
     world = World.single(obj_model, pose=true_pose, hand=ctx.hand)  # raises if off the table
-    models = models or ctx.family_models(obj if isinstance(obj, str) else obj_model, episode.models)
+    models = models or ctx.family_models(obj if isinstance(obj, str) else obj_model)
     rng = np.random.default_rng(seed)
-    estimate = initial_estimate(true_pose, episode.planner, rng) if estimate is None else estimate
+    settings = ctx.planner_settings()
+    estimate = initial_estimate(true_pose, settings, rng) if estimate is None else estimate
     estimate = np.asarray(estimate, dtype=float)
-    planner = make_planner(episode.method, models, estimate, episode.planner, seed=int(rng.integers(2**31)))
+    planner = make_planner(episode.method, models, estimate, settings, seed=int(rng.integers(2**31)))
     initial = planner.summary(true_pose)
     snapshots, attempts = [], []
     for k in range(episode.attempts):
@@ -146,7 +144,7 @@ def run_episode(obj: Union[str, ObjectModel], true_pose: Sequence[float], episod
         plan = planner.plan()
         executed = planner.family_models[plan.family]
         ex = execute(world, executed, plan.action, true_pose, ctx)
-        q = read_fingers(ex, executed, episode.measurement_noise, rng)
+        q = read_fingers(ex, executed, ctx.measurement_noise, rng)
         rec = _attempt_record(k, plan, ex, q, before, executed)
         stop = ex.success and episode.stop_when_stable
         if not stop:

@@ -59,8 +59,7 @@ def episode_run(experiment: str, obj: str, run_index: int, seed: int, *, base: s
                 stop_when_stable: bool, ctx: RunContext) -> dict:
     """One closed-loop episode on the run's true pose (the same problem for every method)."""
     pose = true_pose(base, obj, run_index, ctx.seed)
-    episode = EpisodeSettings(method=method, stop_when_stable=stop_when_stable,
-                              measurement_noise=ctx.measurement_noise, planner=ctx.planner_settings())
+    episode = EpisodeSettings(method=method, stop_when_stable=stop_when_stable)
     return _strip(run_episode(obj, pose, episode, ctx, seed=run_seed(ctx.seed, base, obj, run_index)))
 
 
@@ -196,12 +195,10 @@ def belief_figures(exp: Experiment, objects: List[str], ctx: RunContext, out: Pa
     lines = []
     for o in objects:
         pose = true_pose(exp.name, o, 0, ctx.seed)
-        episode = EpisodeSettings(method=method, stop_when_stable=(exp.name != "pub4"),
-                                  measurement_noise=ctx.measurement_noise, planner=ctx.planner_settings())
-        r = run_episode(o, pose, episode, ctx,
-                        seed=run_seed(ctx.seed, exp.name, o, 0), keep_planner=True)
+        episode = EpisodeSettings(method=method, stop_when_stable=(exp.name != "pub4"))
+        r = run_episode(o, pose, episode, ctx, seed=run_seed(ctx.seed, exp.name, o, 0), keep_planner=True)
         p = plot_belief_evolution(r["snapshots"], pose, out / f"belief_{o}.png",
-                                         f"{o}, {method}, run 0: true pose {np.round(pose, 3).tolist()}", r["attempts"])
+                                  f"{o}, {method}, run 0: true pose {np.round(pose, 3).tolist()}", r["attempts"])
         lines.append(f"![{o}]({p.name})")
     with open(out / "summary.md", "a") as f:
         f.write("\n## Belief evolution (run 0)\n\n" + "\n\n".join(lines) + "\n")

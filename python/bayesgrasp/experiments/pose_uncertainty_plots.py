@@ -9,7 +9,7 @@ from typing import Dict, List, Optional
 import numpy as np
 
 from .pose_uncertainty_stats import ATTEMPTS
-from .report import mpl
+from .report import mpl, save_figure
 
 
 def plot_per_attempt(tables: Dict[str, List[dict]], path: Path, title: str) -> Path:
@@ -42,10 +42,7 @@ def plot_per_attempt(tables: Dict[str, List[dict]], path: Path, title: str) -> P
     axes[0].set_ylim(0, 1.02)
     axes[0].legend(fontsize=8)
     fig.suptitle(title)
-    fig.tight_layout()
-    fig.savefig(path, dpi=110)
-    plt.close(fig)
-    return path
+    return save_figure(fig, path)
 
 
 def plot_belief_evolution(snapshots, true_pose, path: Path, title: str = "", attempts: Optional[list] = None) -> Path:
@@ -92,9 +89,7 @@ def plot_belief_evolution(snapshots, true_pose, path: Path, title: str = "", att
                bbox_to_anchor=(0.45, -0.04))
     if title:
         fig.suptitle(title, fontsize=10)
-    fig.savefig(path, dpi=110, bbox_inches="tight")
-    plt.close(fig)
-    return path
+    return save_figure(fig, path, tight="bbox")
 
 
 def plot_landscape(r: dict, path: Path, title: str) -> Path:
@@ -120,10 +115,7 @@ def plot_landscape(r: dict, path: Path, title: str) -> Path:
     ax.set_ylabel("grasp y (cm)")
     ax.legend(fontsize=7, loc="lower left")
     ax.set_title(title, fontsize=10)
-    fig.tight_layout()
-    fig.savefig(path, dpi=110)
-    plt.close(fig)
-    return path
+    return save_figure(fig, path)
 
 
 def plot_weight_vs_kernel(r: dict, path: Path, title: str) -> Path:
@@ -139,10 +131,7 @@ def plot_weight_vs_kernel(r: dict, path: Path, title: str) -> Path:
         ax.set_xlabel("grasp x (cm)")
         ax.set_ylabel("grasp y (cm)")
     fig.suptitle(f"{title}: Pearson {r['pearson']:.2f}, Spearman {r['spearman']:.2f}", fontsize=10)
-    fig.tight_layout()
-    fig.savefig(path, dpi=110)
-    plt.close(fig)
-    return path
+    return save_figure(fig, path)
 
 
 def plot_one_dof(r: dict, path: Path) -> Path:
@@ -157,7 +146,4 @@ def plot_one_dof(r: dict, path: Path) -> Path:
     ax.set_ylabel("expected posterior entropy")
     ax.set_title("cube, uncertainty in x only", fontsize=10)
     ax.legend(fontsize=8)
-    fig.tight_layout()
-    fig.savefig(path, dpi=110)
-    plt.close(fig)
-    return path
+    return save_figure(fig, path)

@@ -21,6 +21,16 @@ def mpl():
     return plt
 
 
+def save_figure(fig, path, tight: str = "layout") -> Path:
+    """Writes ``fig`` to ``path`` at 110 dpi (laid out tightly first; tight="bbox": cropped to what
+    is drawn instead), closes it and returns the path."""
+    if tight == "layout":
+        fig.tight_layout()
+    fig.savefig(path, dpi=110, **({"bbox_inches": "tight"} if tight == "bbox" else {}))
+    mpl().close(fig)
+    return Path(path)
+
+
 def markdown(rows: List[dict], cols: Sequence[str]) -> str:
     """A Markdown table of ``rows`` with columns ``cols`` (floats to three decimals, NaN as a dash)."""
     def fmt(v):

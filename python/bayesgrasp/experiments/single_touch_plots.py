@@ -5,7 +5,7 @@ from typing import Dict, Sequence
 
 import numpy as np
 
-from .report import mpl
+from .report import mpl, save_figure
 
 
 def plot_errors(results: Dict[str, list], case: str, path, objects: Sequence[str]) -> None:
@@ -43,6 +43,4 @@ def plot_errors(results: Dict[str, list], case: str, path, objects: Sequence[str
     axes[0, 0].legend([plt.Rectangle((0, 0), 1, 1, color=f"C{j}") for j in range(len(series))], series,
                       ncol=len(series), fontsize=8)
     axes[0, 0].set_title(f"pub1, case {case}: errors after one touch (initial: before it)")
-    fig.tight_layout()
-    fig.savefig(path, dpi=110)
-    plt.close(fig)
+    save_figure(fig, path)

@@ -20,6 +20,7 @@ from .context import RunContext
 from .driver import prepare
 from .engines import LocalEngine
 from .registry import get_experiment
+from .report import mpl, save_figure
 from .runner import ResultStore, Series, run_all
 
 
@@ -135,11 +136,7 @@ def _write_summary(name: str, rows: List[dict], axes: List[str], out: Path) -> N
 
 def _plot(rows: List[dict], axes: List[str], metric: str, path: Path, name: str) -> None:
     """``metric`` against the first axis, one line per combination of the other axes."""
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
+    plt = mpl()
     x_axis, rest = axes[0], axes[1:]
     fig, ax = plt.subplots(figsize=(6, 4))
     groups: Dict[tuple, list] = {}
@@ -158,6 +155,4 @@ def _plot(rows: List[dict], axes: List[str], metric: str, path: Path, name: str)
     ax.set_title(f"{name}: {metric}")
     if rest:
         ax.legend(fontsize=8)
-    fig.tight_layout()
-    fig.savefig(path, dpi=110)
-    plt.close(fig)
+    save_figure(fig, path)

@@ -3,7 +3,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from .report import mpl
+from .report import mpl, save_figure
 
 
 def plot_cumulative_success(t: dict, path: Path, title: str) -> Path:
@@ -21,7 +21,4 @@ def plot_cumulative_success(t: dict, path: Path, title: str) -> Path:
     ax.set_ylim(0, n * 1.05)
     ax.legend(fontsize=7, loc="lower right")
     ax.set_title(title, fontsize=10)
-    fig.tight_layout()
-    fig.savefig(path, dpi=110)
-    plt.close(fig)
-    return path
+    return save_figure(fig, path)

@@ -14,6 +14,7 @@ from typing import Callable, Optional, Union
 
 import numpy as np
 
+from .. import DEFAULT_HAND
 from .. import gp as _gp
 from ..cache import atomic_write, atomic_write_text, cache_root, load_checked
 from ..objects import ObjectModel, load_object
@@ -150,7 +151,7 @@ def _train(world: World, settings: ModelSettings, key: str, say: Say) -> GraspMo
     return models
 
 
-def build_models(obj: Union[str, ObjectModel], hand="barrett_bh8", settings: Optional[ModelSettings] = None,
+def build_models(obj: Union[str, ObjectModel], hand=DEFAULT_HAND, settings: Optional[ModelSettings] = None,
                  cache_dir: Union[str, Path, None] = None, progress: Optional[Say] = None) -> GraspModels:
     """Fits (or loads from ``cache_dir``) the measurement and stability models of ``obj``.
 
@@ -191,7 +192,7 @@ def _as_reloaded(models: GraspModels, files: Optional[_CacheFiles], settings: Mo
 _MODELS: dict = {}
 
 
-def get_models(obj: Union[str, ObjectModel], hand: str = "barrett_bh8", settings: Optional[ModelSettings] = None,
+def get_models(obj: Union[str, ObjectModel], hand: str = DEFAULT_HAND, settings: Optional[ModelSettings] = None,
                cache_dir=None, progress: Optional[Say] = None) -> GraspModels:
     """build_models with a per-process memo (a worker builds or loads each object's models once);
     ``cache_dir`` None means :func:`default_cache_dir`."""

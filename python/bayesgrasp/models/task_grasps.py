@@ -23,6 +23,7 @@ from typing import Callable, List, Optional, Sequence, Union
 
 import numpy as np
 
+from .. import DEFAULT_HAND
 from ..cache import atomic_write_text, load_checked
 from ..objects import ObjectModel, load_object
 from ..world import World
@@ -152,7 +153,7 @@ def _lifted(world: World, grasps: Sequence[tuple]) -> np.ndarray:
     return out
 
 
-def generate_task_grasps(obj: Union[str, ObjectModel], rule: TaskRule, hand: str = "barrett_bh8",
+def generate_task_grasps(obj: Union[str, ObjectModel], rule: TaskRule, hand: str = DEFAULT_HAND,
                          settings: Optional[TaskGraspSettings] = None, say: Optional[Say] = None) -> List[TaskGrasp]:
     """The demonstrated grasps of one model for one task (see the module docstring)."""
     s = settings or TaskGraspSettings()
@@ -227,7 +228,7 @@ def _key(obj: ObjectModel, hand_text: str, rule: TaskRule, s: TaskGraspSettings)
     return h.hexdigest()[:20]
 
 
-def task_grasps(models: Sequence[Union[str, ObjectModel]], rule: TaskRule, hand: str = "barrett_bh8",
+def task_grasps(models: Sequence[Union[str, ObjectModel]], rule: TaskRule, hand: str = DEFAULT_HAND,
                 settings: Optional[TaskGraspSettings] = None, cache_dir=None, say: Optional[Say] = None) -> List[TaskGrasp]:
     """Every model's demonstrated grasps for the task, generated once and cached as JSON."""
     from ..hand import Hand

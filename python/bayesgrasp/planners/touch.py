@@ -42,6 +42,7 @@ import numpy as np
 
 from .. import _core
 from ..belief import absolute_planar_pose
+from .. import DEFAULT_HAND
 from ..hand import Hand
 from ..models import GraspModels
 from ..objects import ObjectModel, Scene, load_object
@@ -88,7 +89,7 @@ def scaled_object(obj: Union[str, ObjectModel], scale: float) -> ObjectModel:
 
 
 def touch_world(obj: Union[str, ObjectModel], pose: Sequence[float], scale: float = 1.0,
-                hand: Union[Hand, str] = "barrett_bh8") -> GraspSimulator:
+                hand: Union[Hand, str] = DEFAULT_HAND) -> GraspSimulator:
     """The "real" world of a touch: the object (scaled) at planar pose (x, y, yaw), world frame."""
     model = scaled_object(obj, scale) if scale != 1.0 else canonical_object(obj)
     V, F = Scene.single(model, *pose).object_mesh_world(0)
@@ -128,7 +129,7 @@ class TouchModel:
     """The robot's internal model of one object for touches: the core's TouchModel on the object's
     canonical mesh (see :func:`canonical_object`) and the hand."""
 
-    def __init__(self, obj: Union[str, ObjectModel], hand: Union[Hand, str] = "barrett_bh8",
+    def __init__(self, obj: Union[str, ObjectModel], hand: Union[Hand, str] = DEFAULT_HAND,
                  options: Optional[TouchModelOptions] = None):
         self.object = canonical_object(obj)
         self.hand = hand if isinstance(hand, Hand) else Hand.load(hand)
@@ -225,7 +226,7 @@ class TouchPlanner:
     """Fig. 2.1's loop on a point estimate of one object (see the module docstring)."""
 
     def __init__(self, obj: Union[str, ObjectModel, TouchModel], estimate: Sequence[float],
-                 settings: Optional[TouchSettings] = None, hand: Union[Hand, str] = "barrett_bh8",
+                 settings: Optional[TouchSettings] = None, hand: Union[Hand, str] = DEFAULT_HAND,
                  models: Optional[GraspModels] = None):
         self.model = obj if isinstance(obj, TouchModel) else TouchModel(obj, hand)
         self.settings = settings or TouchSettings()

@@ -24,9 +24,9 @@ from typing import List, Optional, Tuple
 
 import numpy as np
 
+from .. import DEFAULT_HAND
 from .scene import Contact, ResultError, ResultScene, Step, _object, _planar_models, _verdict
 
-DEFAULT_HAND = "barrett_bh8"
 
 
 def results_file(path) -> Path:

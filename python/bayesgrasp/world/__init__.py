@@ -38,6 +38,7 @@ import numpy as np
 
 from ..belief import absolute_planar_pose
 from .. import physics, quality
+from .. import DEFAULT_HAND
 from ..hand import Hand
 from ..objects import ObjectModel, Scene
 from ..objects.scene import planar_pose_matrix
@@ -67,7 +68,7 @@ class World:
             an object the hand does not hold falls.
     """
 
-    def __init__(self, scene: Scene, hand: Union[Hand, str] = "barrett_bh8", object_index: int = 0,
+    def __init__(self, scene: Scene, hand: Union[Hand, str] = DEFAULT_HAND, object_index: int = 0,
                  mu: float = DEFAULT_FRICTION, spread: Optional[float] = None, standoff: float = 0.0,
                  table: bool = True):
         if not (np.isfinite(mu) and mu >= 0):
