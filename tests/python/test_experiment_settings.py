@@ -207,3 +207,35 @@ def test_plan_refuses_two_different_noises():
     code, _, err = run_cli("plan", "--object", "cube", "--true-pose", "0,0,0", "--noise", "0.01",
                            "--set", "episode.measurement_noise=0.02")
     assert code != 0 and "give one" in err
+
+
+@pytest.mark.parametrize("argv, refused", [
+    (["pub5", "--families", "side"], "--families"),
+    (["pub1_variants", "--set", "planner.n_particles=100"], "--set planner.n_particles"),
+    (["pub6", "--no-lift", "--success", "epsilon"], "--no-lift"),
+    (["entropy_order", "--sweep", "episode.measurement_noise=0,0.01"], "--sweep episode.measurement_noise"),
+])
+def test_an_option_the_experiment_does_not_read_is_refused(argv, refused):
+    from bayesgrasp.cli import build_parser
+    from bayesgrasp.cli.args import CliError
+    from bayesgrasp.cli.experiment import _refuse_unread
+    from bayesgrasp.experiments import get_experiment
+
+    args = build_parser().parse_args(["experiment", *argv])
+    with pytest.raises(CliError, match=f"{refused}.*experiment {argv[0]} does not read"):
+        _refuse_unread(args, get_experiment(argv[0]))
+
+
+def test_the_closed_loop_experiments_read_every_run_setting():
+    from bayesgrasp.cli import build_parser
+    from bayesgrasp.cli.experiment import _refuse_unread, given_settings
+    from bayesgrasp.experiments import get_experiment
+
+    args = build_parser().parse_args(["experiment", "pub2", "--families", "top,side", "--success", "epsilon",
+                                      "--no-lift", "--set", "planner.n_particles=100",
+                                      "--sweep", "episode.measurement_noise=0,0.01", "--set", "models.n_samples=300"])
+    assert set(given_settings(args)) == {"families", "success", "lift", "planner", "measurement_noise", "models"}
+    _refuse_unread(args, get_experiment("pub2"))          # nothing refused
+    with pytest.raises(ValueError, match="not run-context settings"):
+        from bayesgrasp.experiments.registry import Experiment
+        Experiment("x", ("cube",), 1, "", None, None, reads=("threads",))

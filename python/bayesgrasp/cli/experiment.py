@@ -95,6 +95,38 @@ def _toml_value(v) -> str:
     return "none" if v is None else str(v).lower() if isinstance(v, bool) else str(v)
 
 
+#: --set / --sweep groups -> the run-context setting each reaches.
+GROUP_SETTING = {"models": "models", "planner": "planner", "episode": "measurement_noise"}
+
+
+def given_settings(args) -> dict:
+    """The run-context settings this command line (and --config) gives other values than the
+    defaults: {setting: the option that gives it}."""
+    d = args.config_defaults
+    given = {}
+    if args.success != d["success"]:
+        given["success"] = "--success"
+    if args.no_lift:
+        given["lift"] = "--no-lift"
+    if args.families != d["families"]:
+        given["families"] = "--families"
+    for option, assignments in (("--set", args.set), ("--sweep", args.sweep)):
+        for a in assignments:
+            group = a.partition("=")[0].partition(".")[0]
+            if group in GROUP_SETTING:
+                given.setdefault(GROUP_SETTING[group], f"{option} {a.partition('=')[0]}")
+    return given
+
+
+def _refuse_unread(args, exp) -> None:
+    """A setting the experiment's runs do not read is refused, not silently dropped."""
+    unread = {s: o for s, o in given_settings(args).items() if s not in exp.reads}
+    if unread:
+        reads = ", ".join(exp.reads) or "none of them"
+        raise CliError(f"{', '.join(unread.values())}: experiment {exp.name} does not read "
+                       f"{', '.join(unread)} (of the run settings it reads: {reads})")
+
+
 def sweep_points(args) -> list:
     """--sweep's grid as [(params, args for that point)]: each value read as its field's type
     (parse_set), a field swept twice or a tuple-valued field refused."""
@@ -161,6 +193,7 @@ def run(args) -> int:
             raise CliError(f"--config: {args.config}: {e}") from None
     for o in args.objects or ():
         load_object(o)  # a clear error for an unknown object
+    _refuse_unread(args, get_experiment(args.name))
     out = out_dir(args.out or f"out/experiments/{args.name}")
     ctx = context(args)
     points = None

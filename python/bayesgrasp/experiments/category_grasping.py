@@ -88,6 +88,6 @@ def write_report(exp: Experiment, results: Dict[str, list], out: Path) -> dict:
 
 
 register(Experiment("pub5", HELD_OUT, 10, "category task grasping, leave-one-out, partial views (Pub. V)",
-                    _make(False), write_report, ("all",), prepare=prepare_task_grasps))
+                    _make(False), write_report, ("all",), prepare=prepare_task_grasps, reads=()))
 register(Experiment("pub5_complete", HELD_OUT, 10, "category task grasping with the complete model as the cloud",
-                    _make(True), write_report, ("all",), prepare=prepare_task_grasps))
+                    _make(True), write_report, ("all",), prepare=prepare_task_grasps, reads=()))

@@ -69,4 +69,4 @@ def write_report(exp: Experiment, results: Dict[str, list], out: Path) -> dict:
 
 
 register(Experiment("pub5_scales", MUGS, 2, "Eq. 4.1's density scales s_t x s_R on a 3 x 3 grid (mugs, the same views)",
-                    _make, write_report, tuple(GRID), prepare=prepare_task_grasps))
+                    _make, write_report, tuple(GRID), prepare=prepare_task_grasps, reads=()))

@@ -301,7 +301,8 @@ class PoseEpisode(DiskEpisode):
         return planner
 
     def _absorb(self, step: dict, q: np.ndarray) -> None:
-        self.planner.observe(np.asarray(step["top_grasp"], dtype=float), Reading(q[self.models.joint_index], held=False))
+        grasp = np.asarray(step["top_grasp"], dtype=float)
+        self.planner.observe(grasp, Reading(q[self.models.joint_index], held=False))
         step["belief_after"] = self.planner.summary()
 
     def _plan_next(self) -> None:

@@ -7,7 +7,8 @@ from typing import Dict
 
 import numpy as np
 
-from .pose_uncertainty_plots import plot_landscape, plot_one_dof, plot_per_attempt, plot_weight_vs_kernel
+from .pose_uncertainty_plots import (plot_landscape, plot_one_dof, plot_per_attempt,
+                                     plot_weight_vs_kernel)
 from .pose_uncertainty_stats import average_rows, by_object, episode_table
 from .report import finish, markdown, start, write_csv
 

@@ -12,6 +12,10 @@ from typing import TYPE_CHECKING, Callable, Dict, List, Optional, Sequence
 if TYPE_CHECKING:
     from .context import RunContext
 
+#: The run context's settings an experiment's runs may read, besides the hand, the cache and the
+#: seed that every one reads (``--set episode.FIELD`` is measurement_noise).
+CONTEXT_SETTINGS = ("success", "lift", "families", "models", "planner", "measurement_noise")
+
 #: (experiment, object, run index, seed) -> a JSON-ready dict; module level (sent to workers).
 RunFunction = Callable[[str, str, int, int], dict]
 
@@ -29,7 +33,10 @@ class Experiment:
       disk cache the runs then read;
     * ``prepare(experiment, objects, ctx)`` (optional): what the runs share, built once in the
       driver's process before them (task grasps: their disk cache is then shared by the workers);
-    * ``finish(experiment, objects, ctx, out)`` (optional): extra figures after the report.
+    * ``finish(experiment, objects, ctx, out)`` (optional): extra figures after the report;
+
+    and ``reads``: which of :data:`CONTEXT_SETTINGS` its runs read (the command line refuses the
+    others, so that no option is silently dropped).
     """
 
     name: str
@@ -42,6 +49,12 @@ class Experiment:
     finish: Optional[Callable[["Experiment", List[str], "RunContext", Path], None]] = None
     prepare: Optional[Callable[["Experiment", List[str], "RunContext"], None]] = None
     prepare_object: Optional[Callable[["Experiment", str, "RunContext"], None]] = None
+    reads: Sequence[str] = CONTEXT_SETTINGS
+
+    def __post_init__(self):
+        unknown = set(self.reads) - set(CONTEXT_SETTINGS)
+        if unknown:
+            raise ValueError(f"reads: {sorted(unknown)} are not run-context settings ({', '.join(CONTEXT_SETTINGS)})")
 
 
 EXPERIMENTS: Dict[str, Experiment] = {}

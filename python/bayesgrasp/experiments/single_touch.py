@@ -185,7 +185,8 @@ def prepare_models(exp: Experiment, obj: str, ctx: RunContext) -> None:
 
 
 register(Experiment("pub1", OBJECTS, 30, "what one touch tells about an object: four optimisers (Pub. I)",
-                    _make_run, write_report, OPTIMIZERS, planned_on_truth, prepare_object=prepare_models))
+                    _make_run, write_report, OPTIMIZERS, planned_on_truth, prepare_object=prepare_models,
+                    reads=("success", "lift", "models")))
 
 
 # ---- variants: the continuous contact term, another hand ---------------------------------------
@@ -219,4 +220,4 @@ def write_variants(exp: Experiment, results: Dict[str, list], out) -> dict:
 
 register(Experiment("pub1_variants", ("cube", "mug", "hammer/0"), 10,
                     "pub1 (3 DoF) with the continuous contact term and with another hand", _make_variant,
-                    write_variants, tuple(VARIANTS)))
+                    write_variants, tuple(VARIANTS), reads=()))

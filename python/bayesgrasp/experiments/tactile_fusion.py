@@ -206,11 +206,14 @@ def write_report(exp: Experiment, results: Dict[str, list], out: Path) -> dict:
     return report.finish(out, md, summary)
 
 
+#: pub6 reads the models of the training mugs (built for the success criterion); it lift-tests every grasp.
+FUSION_READS = ("success", "models")
 register(Experiment("pub6", MUGS, 15, "vision then touch: per-model poses and weights from the fingers (Pub. VI)",
-                    _make("random"), write_report, ("all",), prepare=prepare))
+                    _make("random"), write_report, ("all",), prepare=prepare, reads=FUSION_READS))
 register(Experiment("pub6_vision", MUGS, 15, "pub6 with G(0) planned from the camera's view (Eq. 4.6, task term)",
-                    _make("vision"), write_report, ("all",), prepare=prepare))
+                    _make("vision"), write_report, ("all",), prepare=prepare, reads=FUSION_READS))
 register(Experiment("pub6_part_aware", MUGS, 15, "pub6 with the part-aware task term (Eq. 4.6 x P(rule, held | G))",
-                    _make("random", task_term="part-aware"), write_report, ("all",), prepare=prepare))
+                    _make("random", task_term="part-aware"), write_report, ("all",), prepare=prepare,
+                    reads=FUSION_READS))
 register(Experiment("pub6_particles", MUGS, 15, "pub6 with a joint particle belief over (model, pose)",
-                    _make("random", "particles"), write_report, ("all",), prepare=prepare))
+                    _make("random", "particles"), write_report, ("all",), prepare=prepare, reads=FUSION_READS))
