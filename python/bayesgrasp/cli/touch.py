@@ -22,14 +22,15 @@ def add(sub) -> None:
     t.add_argument("--true-pose", required=True, metavar="X,Y,YAW", help="the object's hidden pose (m, m, rad)")
     t.add_argument("--true-scale", type=float, default=1.0, help="the object's hidden uniform scale")
     t.add_argument("--estimate", required=True, metavar="X,Y,YAW", help="the initial guess (m, m, rad)")
-    t.add_argument("--optimizer", default="pso", choices=["pso", "sa", "firefly", "descent", "trust_region"],
-                   help="the fit's optimiser: particle swarm, simulated annealing, firefly, gradient descent or "
-                        "trust region (Pub. I compares them)")
+    t.add_argument("--optimizer", default=None, choices=["pso", "sa", "firefly", "descent", "trust_region"],
+                   help="the fit's optimiser: particle swarm (default), simulated annealing, firefly, gradient "
+                        "descent or trust region (Pub. I compares them)")
     t.add_argument("--size", action="store_true", help="estimate the scale too (4 DoF; the guess is scale 1)")
     t.add_argument("--orientation-only", action="store_true", help="estimate the yaw alone, the position given")
-    t.add_argument("--budget", type=bounded_int(1, 10**7), default=2000, help="fitness evaluations (re-simulated closings)")
-    t.add_argument("--contact-term", default="flags", choices=["flags", "surface"],
-                   help="0/1 contact flags, or the continuous distance of the touching links to the surface")
+    t.add_argument("--budget", type=bounded_int(1, 10**7), default=None,
+                   help="fitness evaluations (re-simulated closings; default 2,000)")
+    t.add_argument("--contact-term", default=None, choices=["flags", "surface"],
+                   help="0/1 contact flags (default), or the continuous distance of the touching links to the surface")
     t.add_argument("--spread", type=float, default=None, help="finger spread of the touch (rad); default: the hand's")
     add_seed_option(t, "the optimiser's seed")
     add_hand_option(t)
@@ -57,8 +58,8 @@ def run(args) -> int:
         guess[:2] = truth[:2]
     png = output_file(args.png, "--png")
     ctx = context(args, progress=False)
-    settings = T.TouchSettings(optimizer=args.optimizer, unknowns=case, budget=args.budget, seed=ctx.seed,
-                               contact_term=args.contact_term, spread=args.spread, threads=0)
+    given = {k: getattr(args, k) for k in ("optimizer", "budget", "contact_term") if getattr(args, k) is not None}
+    settings = T.TouchSettings(unknowns=case, seed=ctx.seed, spread=args.spread, threads=0, **given)
     planner = T.TouchPlanner(args.object, guess, settings, hand=ctx.hand)
     world = T.touch_world(args.object, truth[:3], truth[3], planner.model.hand)
     grasp = planner.plan().touch
@@ -97,7 +98,8 @@ def _result(args, planner, grasp, readings, r, truth, guess, case) -> dict:
     names = list(planner.model.hand.core.link_names)
     est = np.asarray(planner.estimate, dtype=float)
     return {
-        "object": args.object, "case": case, "optimizer": args.optimizer, "contact_term": args.contact_term,
+        "object": args.object, "case": case, "optimizer": planner.settings.optimizer,
+        "contact_term": planner.settings.contact_term,
         "true_state": truth.tolist(), "initial": guess.tolist(), "estimate": est.tolist(),
         "top_grasp": {"x": grasp.x, "y": grasp.y, "yaw": grasp.yaw, "spread": grasp.spread},
         "grasp": hand_grasp_record(planner.model.hand, readings.hand_pose, readings.joints, grasp.spread),
@@ -118,7 +120,7 @@ def _landscape(planner, grasp, readings, truth, guess, png, args, n: int = 25):
     ys = np.linspace(guess[1] - box[0], guess[1] + box[0], n)
     X, Y = np.meshgrid(xs, ys, indexing="ij")
     states = np.column_stack([X.ravel(), Y.ravel(), np.full(X.size, truth[2]), np.full(X.size, truth[3])])
-    model, ct = planner.model, args.contact_term
+    model, ct = planner.model, planner.settings.contact_term
     f_xy = model.fitness(grasp, readings, states, contact_term=ct, threads=0).total.reshape(n, n)
     yaws = np.linspace(guess[2] - box[1], guess[2] + box[1], 121)
     at = [np.column_stack([np.full(yaws.size, p[0]), np.full(yaws.size, p[1]), yaws, np.full(yaws.size, p[3])])
@@ -126,7 +128,7 @@ def _landscape(planner, grasp, readings, truth, guess, png, args, n: int = 25):
     f_yaw = [model.fitness(grasp, readings, s, contact_term=ct, threads=0).total for s in at]
     L = {"xs": xs, "ys": ys, "f_xy": f_xy, "yaws": yaws, "f_yaw_truth": f_yaw[0], "f_yaw_estimate": f_yaw[1],
          "truth": truth, "initial": guess, "estimate": planner.estimate}
-    return viz.plot_touch_landscape(L, png, f"{args.object}: one touch, {args.optimizer}")
+    return viz.plot_touch_landscape(L, png, f"{args.object}: one touch, {planner.settings.optimizer}")
 
 
 def _deg(v):

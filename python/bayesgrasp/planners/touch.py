@@ -106,18 +106,33 @@ def read(world: GraspSimulator, grasp: TouchGrasp) -> TouchReadings:
     return TouchReadings.from_grasp(_t.execute(world.core, grasp))
 
 
-def estimate_options(optimizer: str = "pso", unknowns: str = "pose", budget: int = 2000, seed: int = 0,
-                     contact_term: str = "flags", box: Optional[Sequence[float]] = None, population: int = 0,
-                     threads: int = 1, stop_fitness: float = 0.0) -> EstimateOptions:
-    """EstimateOptions from names. ``box``: (xy m, yaw rad, scale_low, scale_high); default
-    (0.03, 30 deg, 0.8, 1.2). ``stop_fitness`` > 0 ends the search once a candidate's fitness is
-    below it (0: spend the whole budget)."""
+#: The core's defaults (EstimateOptions' own): the one home of every touch-search default.
+_CORE = EstimateOptions()
+
+
+def _name_of(table: dict, value) -> str:
+    return next(k for k, v in table.items() if v == value)
+
+
+def estimate_options(optimizer: Optional[str] = None, unknowns: Optional[str] = None, budget: Optional[int] = None,
+                     seed: Optional[int] = None, contact_term: Optional[str] = None,
+                     box: Optional[Sequence[float]] = None, population: Optional[int] = None,
+                     threads: Optional[int] = None, stop_fitness: Optional[float] = None) -> EstimateOptions:
+    """EstimateOptions from names; None keeps the core's default (pso, pose, 2,000 evaluations,
+    seed 0, flags, the box (0.03 m, 30 deg, 0.8, 1.2), the optimiser's population, one thread,
+    stop_fitness 0). ``box``: (xy m, yaw rad, scale_low, scale_high). ``stop_fitness`` > 0 ends the
+    search once a candidate's fitness is below it (0: spend the whole budget)."""
     o = EstimateOptions()
-    o.optimizer = _choice(OPTIMIZERS, optimizer, "optimizer")
-    o.unknowns = _choice(UNKNOWNS, unknowns, "unknowns")
-    o.fitness.contact_term = _choice(CONTACT_TERMS, contact_term, "contact_term")
-    o.budget, o.seed, o.population, o.threads = int(budget), int(seed), int(population), int(threads)
-    o.stop_fitness = float(stop_fitness)
+    if optimizer is not None:
+        o.optimizer = _choice(OPTIMIZERS, optimizer, "optimizer")
+    if unknowns is not None:
+        o.unknowns = _choice(UNKNOWNS, unknowns, "unknowns")
+    if contact_term is not None:
+        o.fitness.contact_term = _choice(CONTACT_TERMS, contact_term, "contact_term")
+    for name, value, kind in (("budget", budget, int), ("seed", seed, int), ("population", population, int),
+                              ("threads", threads, int), ("stop_fitness", stop_fitness, float)):
+        if value is not None:
+            setattr(o, name, kind(value))
     if box is not None:
         b = SearchBox()
         b.xy, b.yaw, b.scale_low, b.scale_high = (float(v) for v in box)
@@ -191,15 +206,15 @@ class TouchSettings:
     candidate reproduces the readings below this fitness (0: spend the budget; 0.003 makes a 3-DoF
     PSO estimate 2.5-4x faster with the same errors, BENCHMARKS.md)."""
 
-    optimizer: str = "pso"
-    unknowns: str = "pose"
-    budget: int = 2000
-    seed: int = 0
-    box: Sequence[float] = (0.03, float(np.radians(30.0)), 0.8, 1.2)
-    contact_term: str = "flags"
+    optimizer: str = _name_of(OPTIMIZERS, _CORE.optimizer)
+    unknowns: str = _name_of(UNKNOWNS, _CORE.unknowns)
+    budget: int = _CORE.budget
+    seed: int = _CORE.seed
+    box: Sequence[float] = (_CORE.box.xy, _CORE.box.yaw, _CORE.box.scale_low, _CORE.box.scale_high)
+    contact_term: str = _name_of(CONTACT_TERMS, _CORE.fitness.contact_term)
     spread: Optional[float] = None
-    threads: int = 1
-    stop_fitness: float = 0.0
+    threads: int = _CORE.threads
+    stop_fitness: float = _CORE.stop_fitness
 
     def options(self) -> EstimateOptions:
         return estimate_options(self.optimizer, self.unknowns, self.budget, self.seed, self.contact_term, self.box,
