@@ -228,7 +228,8 @@ def test_an_option_the_experiment_does_not_read_is_refused(argv, refused):
 
 def test_the_closed_loop_experiments_read_every_run_setting():
     from bayesgrasp.cli import build_parser
-    from bayesgrasp.cli.experiment import _refuse_unread, given_settings
+    from bayesgrasp.cli.args import given_settings
+    from bayesgrasp.cli.experiment import _refuse_unread
     from bayesgrasp.experiments import get_experiment
 
     args = build_parser().parse_args(["experiment", "pub2", "--families", "top,side", "--success", "epsilon",
@@ -239,3 +240,14 @@ def test_the_closed_loop_experiments_read_every_run_setting():
     with pytest.raises(ValueError, match="not run-context settings"):
         from bayesgrasp.experiments.registry import Experiment
         Experiment("x", ("cube",), 1, "", None, None, reads=("threads",))
+
+
+@pytest.mark.parametrize("argv, refused", [
+    (["category", "--category", "mug", "--task", "top", "--scene-object", "mug/3", "--set", "models.n_samples=300"],
+     "--set models.n_samples: `category` does not read models"),
+    (["fuse", "--category", "mug", "--task", "top", "--scene-object", "mug/3", "--set", "planner.n_particles=100"],
+     "--set planner.n_particles: `fuse` does not read planner"),
+])
+def test_a_command_refuses_a_run_setting_it_does_not_read(argv, refused):
+    code, _, err = run_cli(*argv)
+    assert code == 2 and refused in err

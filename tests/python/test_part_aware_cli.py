@@ -1,5 +1,6 @@
 """The part-aware plan and task term through the CLI (issue 29), with test_viewer_results' small
 models and two training mugs."""
+from test_outside_loop_category import without_set
 from test_viewer_results import cat_options, cli_json  # noqa: F401  (cat_options: the fixture)
 
 
@@ -7,7 +8,7 @@ def test_the_cli_plans_part_aware_and_fuses_with_the_part_aware_term(capsys, cat
     """`category --method part-aware` and `fuse --task-term part-aware` end to end (small models,
     two training mugs): the check's figures are in the output, and the executed grasp's verdict."""
     doc = cli_json(capsys, "category", "--category", "mug", "--task", "top", "--scene-object", "mug/3",
-                   "--object-pose", "0.01,0.02,0.7", "--method", "part-aware", *cat_options, "--json")
+                   "--object-pose", "0.01,0.02,0.7", "--method", "part-aware", *without_set(cat_options), "--json")
     pc = doc["part_check"]
     assert doc["method"] == "part-aware" and 0.0 <= pc["p_success"] <= pc["p_rule"] <= 1.0 + 1e-12
     assert pc["candidates"] == 64 and set(pc["contact_parts_on_models"]) <= {"mug/1", "mug/2"}
@@ -21,6 +22,6 @@ def test_the_text_output_says_what_the_part_check_found(capsys, cat_options):
     from bayesgrasp.cli import main
 
     assert main(["category", "--category", "mug", "--task", "top", "--scene-object", "mug/3", "--object-pose",
-                 "0.01,0.02,0.7", "--method", "part-aware", *cat_options]) == 0
+                 "0.01,0.02,0.7", "--method", "part-aware", *without_set(cat_options)]) == 0
     line = next(x for x in capsys.readouterr().out.splitlines() if "part check:" in x)
     assert "of 64 candidates obeyed the rule on some model" in line

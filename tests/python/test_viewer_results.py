@@ -16,6 +16,7 @@ from bayesgrasp.models.task_grasps import TaskGraspSettings, generate_task_grasp
 from bayesgrasp.models.tasks import task_rule  # noqa: E402
 from bayesgrasp.viewer import read_result, scene_from_result, serve  # noqa: E402
 from bayesgrasp.viewer.serve import stop  # noqa: E402
+from test_outside_loop_category import without_set  # noqa: E402
 
 SET = {"n_samples": 300, "n_inducing": 50, "max_iter": 30, "n_lift_samples": 150, "n_calibration": 100, "n_pilot": 40,
        "n_pilot_lifts": 10}
@@ -110,7 +111,7 @@ def test_register_places_each_model_by_its_transform_over_the_cloud(capsys):
 
 def test_category_and_fuse_show_cloud_models_and_rounds(capsys, cat_options):
     cat = cli_json(capsys, "category", "--category", "mug", "--task", "top", "--scene-object", "mug/3",
-                   "--object-pose", "0.01,0.02,0.7", *cat_options, "--json")
+                   "--object-pose", "0.01,0.02,0.7", *without_set(cat_options), "--json")
     assert cat["cloud"] and all(len(m["transform"]) == 4 for m in cat["models"])
     nodes, _ = served_nodes(scene_from_result(cat))
     assert {"/cloud", "/steps/0/models/mug_1", "/steps/0/models/mug_2"} <= set(nodes)

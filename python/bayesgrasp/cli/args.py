@@ -154,10 +154,45 @@ CONTEXT_OPTIONS = {"lift": "--no-lift", "success": "--success", "families": "--f
                    "measurement_noise": "--set episode.measurement_noise", "planner": "--set planner"}
 
 
-def context(args: argparse.Namespace, progress: bool = True):
-    """The :class:`~bayesgrasp.experiments.context.RunContext` of a command, built once from its options."""
+#: --set groups -> the run-context setting each reaches.
+GROUP_SETTING = {"models": "models", "planner": "planner", "episode": "measurement_noise"}
+
+
+def given_settings(args: argparse.Namespace) -> dict:
+    """The run-context settings the command line gives other values than the context's defaults:
+    {setting: the option that gives it} (--sweep groups included)."""
+    from ..experiments.context import RunContext
+
+    given = {}
+    if getattr(args, "success", RunContext.success) != RunContext.success:
+        given["success"] = "--success"
+    if getattr(args, "no_lift", False):
+        given["lift"] = "--no-lift"
+    if families_arg(getattr(args, "families", ",".join(RunContext.families))) != RunContext.families:
+        given["families"] = "--families"
+    for option, assignments in (("--set", getattr(args, "set", [])), ("--sweep", getattr(args, "sweep", []))):
+        for a in assignments:
+            group = a.partition("=")[0].partition(".")[0]
+            if group in GROUP_SETTING:
+                given.setdefault(GROUP_SETTING[group], f"{option} {a.partition('=')[0]}")
+    return given
+
+
+def refuse_unread(args: argparse.Namespace, reads, what: str) -> None:
+    """A run setting that ``what`` does not read (not in ``reads``) is refused, not silently dropped."""
+    unread = {s: o for s, o in given_settings(args).items() if s not in reads}
+    if unread:
+        raise CliError(f"{', '.join(unread.values())}: {what} does not read {', '.join(unread)} (of the run "
+                       f"settings it reads: {', '.join(reads) or 'none'})")
+
+
+def context(args: argparse.Namespace, progress: bool = True, reads: Optional[Sequence[str]] = None):
+    """The :class:`~bayesgrasp.experiments.context.RunContext` of a command, built once from its
+    options; ``reads``: the run settings the command reads (None: all), the others are refused."""
     from ..experiments.context import RunContext, stderr_progress
 
+    if reads is not None:
+        refuse_unread(args, reads, f"`{args.command}`" if getattr(args, "command", None) else "this command")
     if getattr(args, "cache", None):
         out_dir(args.cache, "--cache")  # before minutes of model building
     success, lift = getattr(args, "success", "lift"), not getattr(args, "no_lift", False)

@@ -50,7 +50,7 @@ def run(args) -> int:
     if view is not None and args.complete:
         raise CliError("--complete: not with camera data (it replaces the view by the object's whole surface)")
     exclude = args.exclude if args.exclude is not None else [m for m in [args.scene_object] if m]
-    ctx = context(args)
+    ctx = context(args, reads=())      # Eq. 4.1 on the registrations; every grasp is lift-tested
     ep = see(args.scene_object, pose, args.category, exclude=exclude, seed=ctx.seed, complete=args.complete,
              observation=None if view is None else camera_input.observation(view))
     if not any(r.success for r in ep.registrations):

@@ -92,7 +92,7 @@ def new(args) -> int:
 
         obj = load_object(args.object, units=args.units)
     start, _ = _vision_start(args, obj, est, quiet=fmt != "text")
-    ctx = context(args)
+    ctx = context(args, reads=("success", "models", "planner"))   # the robot reads the joints and the lift
     settings = ctx.planner_settings()           # --set planner.FIELD=VALUE
     if start is not None:
         est = start.estimate.tolist()
@@ -126,7 +126,7 @@ def _new_category(args, fmt: str) -> int:
     else:
         raise CliError("--cloud, --depth or --object: the view to plan from")
     exclude = args.exclude if args.exclude is not None else [m for m in [args.object] if m]
-    ctx = context(args)
+    ctx = context(args, reads=("success", "models") if method == "fusion" else ())
     common = dict(exclude=exclude, seed=ctx.seed, grasps=task_grasps_arg(args))
     if method == "fusion":
         ep = FusionEpisode.new(args.dir, obs, args.category, args.task, ctx, attempts=args.attempts, **common)

@@ -4,7 +4,8 @@ from __future__ import annotations
 import argparse
 import time
 
-from .args import SEED_MAX, CliError, add_context_options, add_families_option, bounded_int, context, hand_name, out_dir
+from .args import (SEED_MAX, CliError, add_context_options, add_families_option, bounded_int, context, hand_name,
+                   out_dir, refuse_unread)
 
 
 def add(sub) -> None:
@@ -95,36 +96,9 @@ def _toml_value(v) -> str:
     return "none" if v is None else str(v).lower() if isinstance(v, bool) else str(v)
 
 
-#: --set / --sweep groups -> the run-context setting each reaches.
-GROUP_SETTING = {"models": "models", "planner": "planner", "episode": "measurement_noise"}
-
-
-def given_settings(args) -> dict:
-    """The run-context settings this command line (and --config) gives other values than the
-    defaults: {setting: the option that gives it}."""
-    d = args.config_defaults
-    given = {}
-    if args.success != d["success"]:
-        given["success"] = "--success"
-    if args.no_lift:
-        given["lift"] = "--no-lift"
-    if args.families != d["families"]:
-        given["families"] = "--families"
-    for option, assignments in (("--set", args.set), ("--sweep", args.sweep)):
-        for a in assignments:
-            group = a.partition("=")[0].partition(".")[0]
-            if group in GROUP_SETTING:
-                given.setdefault(GROUP_SETTING[group], f"{option} {a.partition('=')[0]}")
-    return given
-
-
 def _refuse_unread(args, exp) -> None:
     """A setting the experiment's runs do not read is refused, not silently dropped."""
-    unread = {s: o for s, o in given_settings(args).items() if s not in exp.reads}
-    if unread:
-        reads = ", ".join(exp.reads) or "none of them"
-        raise CliError(f"{', '.join(unread.values())}: experiment {exp.name} does not read "
-                       f"{', '.join(unread)} (of the run settings it reads: {reads})")
+    refuse_unread(args, exp.reads, f"experiment {exp.name}")
 
 
 def sweep_points(args) -> list:
@@ -173,7 +147,8 @@ def run(args) -> int:
 
     if args.name == "list":
         for name in experiment_names():
-            print(f"{name:<14} {EXPERIMENTS[name].description}")
+            exp = EXPERIMENTS[name]
+            print(f"{name:<16} {exp.description} (reads: {', '.join(exp.reads) or 'no run settings'})")
         return 0
     try:
         get_experiment(args.name)

@@ -51,7 +51,7 @@ def run(args) -> int:
         raise CliError(f"--noise: must be >= 0, got {args.noise}")
     png = output_file(args.png, "--png")
     view = camera_input.observe(args)
-    ctx = context(args)
+    ctx = context(args, reads=("success", "models"))     # the training models' P(S) and GPs
     settings = FusionSettings(belief=args.belief, recursive=args.recursive, measurement_noise=args.noise,
                               task_term=args.task_term)
     grasps = task_grasps_arg(args)
