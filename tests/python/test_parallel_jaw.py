@@ -114,7 +114,7 @@ def test_plan_category_and_view_with_the_jaw(capsys, tmp_path):
     f.write_text(json.dumps({"grasps": [grasp_to_json(g) for g in grasps]}))
     excluded = [f"mug/{i}" for i in range(7) if i not in (1, 2)]
     cat = cli_json(capsys, "category", "--category", "mug", "--task", "top", "--scene-object", "mug/3", "--object-pose",
-                   "0.01,0.02,0.7", "--hand", JAW, *small(tmp_path / "m"), "--task-grasps", f, "--exclude", *excluded,
+                   "0.01,0.02,0.7", "--hand", JAW, "--task-grasps", f, "--exclude", *excluded,
                    "--seed", 3, "--json")
     assert cat["executed"] and cat["success"] == (cat["lifted"] and cat["task_ok"])
     for doc in (plan, cat):
