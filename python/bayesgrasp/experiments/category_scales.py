@@ -23,7 +23,6 @@ from .category_grasping import TASKS, prepare_task_grasps, view
 from .category_stats import grid_rows, nested_rows
 from .context import RunContext
 from .registry import Experiment, register
-from .runner import run_seed
 
 MUGS = tuple(f"mug/{i}" for i in range(7))
 TRANSLATION_CM = (0.5, 1.0, 2.0)
@@ -42,11 +41,10 @@ GRID = {series_name(t, r): (t / 100.0, float(np.radians(r))) for t in TRANSLATIO
 def scales_run(experiment: str, obj: str, run_index: int, seed: int, *, ctx: RunContext, scales: tuple) -> dict:
     """One view of ``obj`` (the same for every grid point) and the four methods at ``scales``."""
     cat = obj.split("/")[0]
-    view_seed = run_seed(ctx.seed, "pub5_scales", obj, run_index)
-    pose, eye = view(view_seed)
-    ep = see(obj, pose, cat, exclude=(obj,), eye_offset=eye, seed=view_seed % (2**31))
+    pose, eye = view(seed)
+    ep = see(obj, pose, cat, exclude=(obj,), eye_offset=eye, seed=seed % (2**31))
     t, r = scales
-    tasks = {task: {m: plan_and_execute(ep, cat, task, m, ctx, seed=view_seed % (2**31),
+    tasks = {task: {m: plan_and_execute(ep, cat, task, m, ctx, seed=seed % (2**31),
                                         settings=CategorySettings(method=m, translation_scale=t, rotation_scale=r))
                     for m in DENSITIES} for task in TASKS[cat]}
     return {"object": obj, "category": cat, "pose": list(pose), "scales": [t, r], "tasks": tasks}

@@ -13,6 +13,11 @@ from ..models.settings import SUCCESS_CRITERIA
 from ..objects import ObjectModel
 from ..planners import PlannerSettings
 
+#: How the run seeds are made, stored with the results: each run is given run_seed(--seed, the
+#: experiment's seed name, object, run index) and uses it (stores without it derived seeds from
+#: the series name and cannot be resumed: their stored seeds are not the ones the runs used).
+RUN_SEEDS = "run_seed(seed, seed_name, object, run_index)"
+
 
 def _plain(v):
     """A settings value as JSON would give it back (tuples as lists, numpy scalars as numbers)."""
@@ -96,7 +101,7 @@ class RunContext:
     def result_settings(self) -> dict:
         """Every setting of this context that changes a run's result, as plain JSON values: the
         package and cache versions, the hand (its name and a digest of its file), the success
-        criterion, the lift test on or off and the effective model settings. Stored beside an
+        criterion, the lift test on or off, the effective model settings and how run seeds are made. Stored beside an
         experiment's results; a resume with different values is refused (runner.ResultStore)."""
         import hashlib
         from dataclasses import asdict
@@ -114,7 +119,7 @@ class RunContext:
                 "lift": self.lift, "families": list(self.families),
                 "models": {k: _plain(v) for k, v in asdict(models).items()},
                 "planner": {k: _plain(v) for k, v in asdict(self.planner_settings()).items()},
-                "measurement_noise": float(self.measurement_noise)}
+                "measurement_noise": float(self.measurement_noise), "run_seeds": RUN_SEEDS}
 
     def for_workers(self) -> "RunContext":
         """The same context without the progress callable (worker processes get it pickled)."""

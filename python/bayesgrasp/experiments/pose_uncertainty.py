@@ -44,9 +44,10 @@ FIVE = ("cube", "cylinder", "mug", "mug2", "pitcher")
 METHODS = ("stability", "explore", "ml_pose", "open_loop")
 
 
-def true_pose(experiment: str, obj: str, run_index: int, base_seed: int = 0) -> np.ndarray:
-    """The hidden true pose of a run: the same for every method of the experiment."""
-    rng = np.random.default_rng(run_seed(base_seed, experiment, obj, run_index))
+def true_pose(seed: int) -> np.ndarray:
+    """The hidden true pose of a run from its seed (:func:`.runner.run_seed`): every method of the
+    experiment gets the same seed for the same (object, run), so the same problem."""
+    rng = np.random.default_rng(seed)
     return np.array([rng.uniform(-0.1, 0.1), rng.uniform(-0.1, 0.1), rng.uniform(-np.pi, np.pi)])
 
 
@@ -55,20 +56,18 @@ def _strip(result: dict) -> dict:
 
 
 # ---- run functions (module level: sent to worker processes) ----------------------------------------
-def episode_run(experiment: str, obj: str, run_index: int, seed: int, *, base: str, method: str,
-                stop_when_stable: bool, ctx: RunContext) -> dict:
+def episode_run(experiment: str, obj: str, run_index: int, seed: int, *, method: str, stop_when_stable: bool,
+                ctx: RunContext) -> dict:
     """One closed-loop episode on the run's true pose (the same problem for every method)."""
-    pose = true_pose(base, obj, run_index, ctx.seed)
     episode = EpisodeSettings(method=method, stop_when_stable=stop_when_stable)
-    return _strip(run_episode(obj, pose, episode, ctx, seed=run_seed(ctx.seed, base, obj, run_index)))
+    return _strip(run_episode(obj, true_pose(seed), episode, ctx, seed=seed))
 
 
-def _initial_planner(name: str, obj: str, run_index: int, ctx: RunContext, seed: int, models=None,
-                     settings: Optional[PlannerSettings] = None):
+def _initial_planner(obj: str, ctx: RunContext, seed: int, models=None, settings: Optional[PlannerSettings] = None):
     """A run's hidden true pose and an exploration planner on its initial belief (around a
     noisy estimate of that pose): (pose, models, planner, rng, settings); rng (seeded by
     ``seed``) has drawn the estimate and the planner's seed and serves the rest of the run."""
-    pose = true_pose(name, obj, run_index, ctx.seed)
+    pose = true_pose(seed)
     models = models or ctx.models(obj)
     rng = np.random.default_rng(seed)
     s = settings or ctx.planner_settings()
@@ -80,7 +79,7 @@ def entropy_order_run(experiment: str, obj: str, run_index: int, seed: int, *, c
                       grid: int = 15) -> dict:
     """Predict the expected entropy of a grid of grasps from the initial belief, execute the best,
     the median and the worst, and compare the realised weight entropies after reweighting."""
-    pose, models, planner, _, _ = _initial_planner("entropy_order", obj, run_index, ctx, seed)
+    pose, models, planner, _, _ = _initial_planner(obj, ctx, seed)
     cands = _grid_actions(planner, grid, yaw=planner.belief.mean()[2])
     h, se = planner.expected_entropy(cands, n_samples=200, seed=1)
     order = np.argsort(h)
@@ -118,7 +117,7 @@ def entropy_gain_run(obj: str, run_index: int, ctx: Optional[RunContext] = None,
     and posterior-mean position errors (before: the prior's)."""
     ctx = ctx or RunContext()
     pose, models, planner, rng, _ = _initial_planner(
-        "entropy_gain", obj, run_index, ctx, run_seed(ctx.seed, "entropy_gain", obj, run_index), models,
+        obj, ctx, run_seed(ctx.seed, "entropy_gain", obj, run_index), models,
         PlannerSettings(explore_stability_weight=0.0))  # Eq. 3.2 alone
     world = World.single(obj, pose=pose, hand=ctx.hand)
     informative, _, _ = planner.minimise_entropy()
@@ -145,7 +144,7 @@ def landscapes_run(experiment: str, obj: str, run_index: int, seed: int, *, ctx:
                    grid: int = 21) -> dict:
     """Weight vs kernel expected-entropy landscapes over (x, y) at the belief's mean yaw; for the
     cube also the 1-D (x only) uncertainty case with 1,000 and 10,000 measurement samples."""
-    pose, models, planner, rng, s = _initial_planner("landscapes", obj, run_index, ctx, seed)
+    pose, models, planner, rng, s = _initial_planner(obj, ctx, seed)
     cands = _grid_actions(planner, grid, yaw=planner.belief.mean()[2])
     hw, _ = planner.expected_entropy(cands, n_samples=200, seed=3, method="weight")
     hk, _ = planner.expected_entropy(cands, n_samples=200, seed=3, method="kernel")
@@ -179,7 +178,7 @@ def prepare_models(exp: Experiment, obj: str, ctx: RunContext) -> None:
 
 
 def _episodes(exp: Experiment, method: str, ctx: RunContext):
-    fn = partial(episode_run, base=exp.name, method=method, stop_when_stable=(exp.name != "pub4"), ctx=ctx)
+    fn = partial(episode_run, method=method, stop_when_stable=(exp.name != "pub4"), ctx=ctx)
     return f"{exp.name}/{method}", fn
 
 
@@ -194,9 +193,10 @@ def belief_figures(exp: Experiment, objects: List[str], ctx: RunContext, out: Pa
     method = exp.methods[0]
     lines = []
     for o in objects:
-        pose = true_pose(exp.name, o, 0, ctx.seed)
+        seed = run_seed(ctx.seed, exp.seeds, o, 0)
+        pose = true_pose(seed)
         episode = EpisodeSettings(method=method, stop_when_stable=(exp.name != "pub4"))
-        r = run_episode(o, pose, episode, ctx, seed=run_seed(ctx.seed, exp.name, o, 0), keep_planner=True)
+        r = run_episode(o, pose, episode, ctx, seed=seed, keep_planner=True)
         p = plot_belief_evolution(r["snapshots"], pose, out / f"belief_{o}.png",
                                   f"{o}, {method}, run 0: true pose {np.round(pose, 3).tolist()}", r["attempts"])
         lines.append(f"![{o}]({p.name})")

@@ -35,8 +35,11 @@ class Experiment:
       driver's process before them (task grasps: their disk cache is then shared by the workers);
     * ``finish(experiment, objects, ctx, out)`` (optional): extra figures after the report;
 
-    and ``reads``: which of :data:`CONTEXT_SETTINGS` its runs read (the command line refuses the
-    others, so that no option is silently dropped).
+    ``reads``: which of :data:`CONTEXT_SETTINGS` its runs read (the command line refuses the
+    others, so that no option is silently dropped); and ``seed_name``: the name its run seeds
+    derive from (:func:`.runner.run_seed`; default its own): experiments that share one see the
+    same problems (pub1_variants pub1's, the pub6 variants pub6's). A run is given its seed and
+    uses it, so the seed stored with a result is the one it was made with.
     """
 
     name: str
@@ -50,11 +53,17 @@ class Experiment:
     prepare: Optional[Callable[["Experiment", List[str], "RunContext"], None]] = None
     prepare_object: Optional[Callable[["Experiment", str, "RunContext"], None]] = None
     reads: Sequence[str] = CONTEXT_SETTINGS
+    seed_name: Optional[str] = None
 
     def __post_init__(self):
         unknown = set(self.reads) - set(CONTEXT_SETTINGS)
         if unknown:
             raise ValueError(f"reads: {sorted(unknown)} are not run-context settings ({', '.join(CONTEXT_SETTINGS)})")
+
+    @property
+    def seeds(self) -> str:
+        """The name the run seeds derive from."""
+        return self.seed_name or self.name
 
 
 EXPERIMENTS: Dict[str, Experiment] = {}

@@ -34,7 +34,7 @@ from . import report
 from .context import RunContext
 from .episode import execute
 from .registry import Experiment, register
-from .runner import ResultStore, run_seed
+from .runner import ResultStore
 from .single_touch_plots import plot_errors
 from .single_touch_prose import findings, markdown_case
 from .single_touch_stats import case_rows, second_grasp_rows
@@ -115,11 +115,10 @@ def _second_grasp(obj: str, planner: TouchPlanner, truth, ctx: RunContext) -> di
 
 def touch_run(experiment: str, obj: str, run_index: int, seed: int, *, optimizer: str, ctx: RunContext) -> dict:
     """One run: the three cases on problems (and optimiser seeds) shared by every optimiser."""
-    base = run_seed(ctx.seed, "pub1", obj, run_index)
-    rng = np.random.default_rng(base)
+    rng = np.random.default_rng(seed)
     out = {"object": obj, "optimizer": optimizer, "cases": {}}
     for case in CASES:
-        rec, planner, truth = _one_case(obj, case, optimizer, rng, base, ctx)
+        rec, planner, truth = _one_case(obj, case, optimizer, rng, seed, ctx)
         out["cases"][case] = rec
         if case == "pose":
             out["second_grasp"] = _second_grasp(obj, planner, truth, ctx)
@@ -199,8 +198,7 @@ VARIANTS = {"pso/flags": ("pso", "flags", None), "pso/surface": ("pso", "surface
 def variant_run(experiment: str, obj: str, run_index: int, seed: int, *, method: str, ctx: RunContext) -> dict:
     """pub1's 3-DoF problem of the same run index, with another contact term or hand."""
     optimizer, term, hand = VARIANTS[method]
-    base = run_seed(ctx.seed, "pub1", obj, run_index)
-    rec, _, _ = _one_case(obj, "pose", optimizer, np.random.default_rng(base), base, ctx, term, hand)
+    rec, _, _ = _one_case(obj, "pose", optimizer, np.random.default_rng(seed), seed, ctx, term, hand)
     return {"object": obj, "method": method, "cases": {"pose": rec}}
 
 
@@ -220,4 +218,4 @@ def write_variants(exp: Experiment, results: Dict[str, list], out) -> dict:
 
 register(Experiment("pub1_variants", ("cube", "mug", "hammer/0"), 10,
                     "pub1 (3 DoF) with the continuous contact term and with another hand", _make_variant,
-                    write_variants, tuple(VARIANTS), reads=()))
+                    write_variants, tuple(VARIANTS), reads=(), seed_name="pub1"))   # pub1's problems

@@ -89,7 +89,7 @@ def run_sweep(name: str, out_dir, points: Sequence[Point], runs=None, objects=No
                 base, fn = exp.make_run(exp, method, p.ctx.for_workers())
                 names[method] = f"{base}@{p.label}"
                 store.check_settings(names[method], settings)   # before anything is built
-                series.append(Series(names[method], tuple(objects), runs, fn, seed_name=base))
+                series.append(Series(names[method], tuple(objects), runs, fn, seed_name=exp.seeds))
             plans.append((p, names, series))
         for i, (p, _, _) in enumerate(plans):
             if progress is not None:

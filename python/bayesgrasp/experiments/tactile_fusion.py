@@ -33,7 +33,6 @@ from .category import demonstrated, see, training_models
 from .category_grasping import view
 from .context import RunContext
 from .registry import Experiment, register
-from .runner import run_seed
 from .tactile_fusion_plots import plot_cumulative_success
 from .tactile_fusion_stats import ROUNDS, THESIS, round_rows, transitions
 
@@ -155,7 +154,6 @@ class FusionTrial:
 # ---- the experiment ------------------------------------------------------------------------------------
 def fusion_run(experiment: str, obj: str, run_index: int, seed: int, *, ctx: RunContext, mode: str,
                belief: str, task_term: str = "laplace") -> dict:
-    seed = run_seed(ctx.seed, "pub6", obj, run_index)   # every pub6 variant sees pub6's trials
     pose, eye = view(seed)
     trial = FusionTrial(obj, pose, ctx, settings=FusionSettings(belief=belief, task_term=task_term), eye_offset=eye,
                         seed=seed % (2**31))
@@ -206,14 +204,14 @@ def write_report(exp: Experiment, results: Dict[str, list], out: Path) -> dict:
     return report.finish(out, md, summary)
 
 
-#: pub6 reads the models of the training mugs (built for the success criterion); it lift-tests every grasp.
-FUSION_READS = ("success", "models")
+#: pub6 reads the models of the training mugs (built for the success criterion); it lift-tests every
+#: grasp. Every variant sees pub6's trials (its seeds).
+PUB6 = dict(prepare=prepare, reads=("success", "models"), seed_name="pub6")
 register(Experiment("pub6", MUGS, 15, "vision then touch: per-model poses and weights from the fingers (Pub. VI)",
-                    _make("random"), write_report, ("all",), prepare=prepare, reads=FUSION_READS))
+                    _make("random"), write_report, ("all",), **PUB6))
 register(Experiment("pub6_vision", MUGS, 15, "pub6 with G(0) planned from the camera's view (Eq. 4.6, task term)",
-                    _make("vision"), write_report, ("all",), prepare=prepare, reads=FUSION_READS))
+                    _make("vision"), write_report, ("all",), **PUB6))
 register(Experiment("pub6_part_aware", MUGS, 15, "pub6 with the part-aware task term (Eq. 4.6 x P(rule, held | G))",
-                    _make("random", task_term="part-aware"), write_report, ("all",), prepare=prepare,
-                    reads=FUSION_READS))
+                    _make("random", task_term="part-aware"), write_report, ("all",), **PUB6))
 register(Experiment("pub6_particles", MUGS, 15, "pub6 with a joint particle belief over (model, pose)",
-                    _make("random", "particles"), write_report, ("all",), prepare=prepare, reads=FUSION_READS))
+                    _make("random", "particles"), write_report, ("all",), **PUB6))
