@@ -22,7 +22,7 @@ from bayesgrasp.experiments.context import RunContext
 from bayesgrasp.experiments.tactile_fusion import FusionTrial
 from bayesgrasp.models.tasks import task_rule
 from bayesgrasp.planners.category import CategoryPlanner, CategorySettings
-from bayesgrasp.planners.fusion import FusionPlanner, FusionSettings
+from bayesgrasp.planners.fusion import FusionSettings
 
 METHODS = ("laplace", "part-aware")
 TASK_TERMS = ("laplace", "part-aware")
@@ -59,7 +59,7 @@ def main():
             plan_t[m].append(time.perf_counter() - t1)
         for term in TASK_TERMS:
             trial = FusionTrial(obj, pose, ctx, eye_offset=eye, seed=k, settings=FusionSettings(task_term=term))
-            _, _, planner = trial.start()
+            _, planner = trial.start()
             g0 = planner.plan().action
             m = trial._execute(g0)["measurement"]
             t3 = time.perf_counter()

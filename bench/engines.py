@@ -33,7 +33,7 @@ def throughput(engine, ctx, objects, runs):
     with tempfile.TemporaryDirectory() as d:
         store = ResultStore(os.path.join(d, "results.sqlite"))
         t0 = time.perf_counter()
-        run_all([Series(series, tuple(objects), runs, fn)], store, ctx.seed, engine, progress=False)
+        run_all([Series(series, tuple(objects), runs, fn, seed_name=exp.seeds)], store, ctx.seed, engine, progress=False)
         seconds = time.perf_counter() - t0
         store.close()
     return len(objects) * runs / seconds, seconds

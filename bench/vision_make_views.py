@@ -9,7 +9,6 @@ Usage: python bench/vision_make_views.py [--views 240] [--seed 0]
 """
 import argparse
 import os
-import sys
 import time
 
 import numpy as np

@@ -12,7 +12,7 @@ wrenches do not span 6-D). Degenerate grasps are never an error::
 """
 from __future__ import annotations
 
-from bayesgrasp._args import c_int, c_seed
+from bayesgrasp._args import c_int
 import numpy as np
 
 from bayesgrasp import _core

@@ -8,7 +8,6 @@ import subprocess
 import sys
 import textwrap
 import time
-import warnings
 from dataclasses import replace
 
 import numpy as np
@@ -168,8 +167,12 @@ def test_numpy_bools_0_1_and_unknown_are_outcomes(planner):
     assert [o.stable for o in planner.observations[-3:]] == [False, True, None]
     # an unknown outcome adds no P(S) factor: the likelihood is the joint angles' alone
     P = planner.belief.particles[:5]
-    unknown, known = planner.observations[-1], replace(planner.observations[-1], stable=False)
-    assert not np.allclose(planner.log_likelihood(P, unknown), planner.log_likelihood(P, known))
+    unknown = planner.observations[-1]
+    ll = planner.log_likelihood(P, unknown)
+    for held in (False, True):      # neither outcome: None is not read as held or as dropped
+        assert not np.allclose(ll, planner.log_likelihood(P, replace(unknown, stable=held)))
+    planner.settings = replace(planner.settings, use_outcome=False)     # the joint angles' likelihood alone
+    np.testing.assert_allclose(ll, planner.log_likelihood(P, replace(unknown, stable=True)))
 
 
 def test_rotation_error_refuses_a_matrix_that_is_no_rotation():

@@ -1,7 +1,6 @@
 """Python-level tests of bayesgrasp.belief: callables called once per batch, the all-zero
 likelihood warning, KDE entropy against scipy's gaussian_kde, expected posterior entropy, the GP
 measurement model paths, the relative pose, bad input."""
-import warnings
 
 import numpy as np
 import pytest

@@ -2,7 +2,6 @@
 intrinsics, the table frame, the units guard and bad input; checked against analytic geometry and
 scans rendered from known poses."""
 import json
-import warnings
 
 import numpy as np
 import open3d as o3d
@@ -297,6 +296,19 @@ def test_bad_camera_options_exit_2_with_one_line_naming_the_option(mug_scan, ext
     assert main(argv) == 2
     err = capsys.readouterr().err
     assert needle in err and "Traceback" not in err and len(err.strip().splitlines()) == 1, err
+
+
+def test_plan_refuses_a_belief_spread_given_beside_camera_data(mug_scan, capsys):
+    """With --cloud the registration sets the belief's spread: a --set planner.half_width would be
+    dropped, so it is refused (before any model is built)."""
+    from bayesgrasp.cli import main
+
+    d, _ = mug_scan
+    for command in (["plan", "--true-pose", "0,0,0"], ["episode", "new", "--dir", str(d / "ep")]):
+        argv = [*command, "--object", "mug/3", "--cloud", str(d / "cloud.ply"), "--set", "planner.half_width=0.1,0.1,1"]
+        assert main(argv) == 2
+        assert "--set planner.half_width: not with --cloud or --depth" in capsys.readouterr().err
+    assert not (d / "ep").exists()
 
 
 def test_the_mm_cloud_registers_with_units_mm(mug_scan, capsys):

@@ -203,10 +203,19 @@ def test_a_setting_with_an_option_of_its_own_is_refused_by_set(key, option):
     assert parse_set(["models.n_samples=300"]) == {"models": {"n_samples": 300}}
 
 
-def test_plan_refuses_two_different_noises():
+@pytest.mark.parametrize("other", ["0.02", "0.01"])
+def test_plan_refuses_the_noise_by_two_names(other):
     code, _, err = run_cli("plan", "--object", "cube", "--true-pose", "0,0,0", "--noise", "0.01",
-                           "--set", "episode.measurement_noise=0.02")
-    assert code != 0 and "give one" in err
+                           "--set", f"episode.measurement_noise={other}")
+    assert code == 2 and "two names for one setting" in err
+
+
+@pytest.mark.parametrize("extra, option", [(["--engine", "local", "--address", "127.0.0.1:6379"], "--address"),
+                                           (["--engine", "ray", "--address", "127.0.0.1:6379", "--workers", "2"],
+                                            "--workers")])
+def test_engine_errors_name_the_option_at_fault(tmp_path, extra, option):
+    code, _, err = run_cli("experiment", "pub2", "--runs", "1", "--out", tmp_path / "o", *extra)
+    assert code == 2 and f"error: {option}: " in err, err
 
 
 @pytest.mark.parametrize("argv, refused", [
@@ -215,28 +224,32 @@ def test_plan_refuses_two_different_noises():
     (["pub6", "--no-lift", "--success", "epsilon"], "--no-lift"),
     (["entropy_order", "--sweep", "episode.measurement_noise=0,0.01"], "--sweep episode.measurement_noise"),
 ])
-def test_an_option_the_experiment_does_not_read_is_refused(argv, refused):
-    from bayesgrasp.cli import build_parser
-    from bayesgrasp.cli.args import CliError
-    from bayesgrasp.cli.experiment import _refuse_unread
-    from bayesgrasp.experiments import get_experiment
+def test_an_option_the_experiment_does_not_read_is_refused(tmp_path, argv, refused):
+    import re
 
-    args = build_parser().parse_args(["experiment", *argv])
-    with pytest.raises(CliError, match=f"{refused}.*experiment {argv[0]} does not read"):
-        _refuse_unread(args, get_experiment(argv[0]))
+    code, _, err = run_cli("experiment", *argv, "--out", tmp_path / "o")
+    assert code == 2 and re.search(f"{re.escape(refused)}.*experiment {argv[0]} does not read", err), err
+    assert not (tmp_path / "o").exists()       # refused before anything is written
 
 
 def test_the_closed_loop_experiments_read_every_run_setting():
     from bayesgrasp.cli import build_parser
     from bayesgrasp.cli.args import given_settings
-    from bayesgrasp.cli.experiment import _refuse_unread
     from bayesgrasp.experiments import get_experiment
 
     args = build_parser().parse_args(["experiment", "pub2", "--families", "top,side", "--success", "epsilon",
                                       "--no-lift", "--set", "planner.n_particles=100",
                                       "--sweep", "episode.measurement_noise=0,0.01", "--set", "models.n_samples=300"])
-    assert set(given_settings(args)) == {"families", "success", "lift", "planner", "measurement_noise", "models"}
-    _refuse_unread(args, get_experiment("pub2"))          # nothing refused
+    given = given_settings(args)
+    assert set(given) == {"families", "success", "lift", "planner", "measurement_noise", "models"}
+    assert given["lift"] == "--no-lift" and given["planner"] == "--set planner.n_particles"
+    for name in ("pub2", "baselines", "pub4"):
+        assert set(get_experiment(name).reads) == set(given)
+    # options at the context's defaults are not given; a --set is given even at its default value
+    at_defaults = build_parser().parse_args(["experiment", "pub5", "--families", "top", "--success", "lift"])
+    assert given_settings(at_defaults) == {}
+    assert given_settings(build_parser().parse_args(["experiment", "pub5", "--set", "planner.n_particles=500"])) \
+        == {"planner": "--set planner.n_particles"}
     with pytest.raises(ValueError, match="not run-context settings"):
         from bayesgrasp.experiments.registry import Experiment
         Experiment("x", ("cube",), 1, "", None, None, reads=("threads",))

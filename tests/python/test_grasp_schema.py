@@ -8,7 +8,7 @@ from scipy.spatial.transform import Rotation
 
 from bayesgrasp.cli import main
 from bayesgrasp.hand import Hand
-from bayesgrasp.io.grasp_schema import grasp_record, hand_grasp_record, schema, to_ros, validate
+from bayesgrasp.io.grasp_schema import grasp_record, hand_grasp_record, schema, validate
 
 
 def cli_json(capsys, *argv):

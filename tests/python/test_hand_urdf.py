@@ -3,7 +3,6 @@ files, and a URDF or sidecar the conversion cannot take is refused in one line n
 import json
 import re
 import shutil
-from pathlib import Path
 
 import numpy as np
 import pytest

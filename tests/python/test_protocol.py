@@ -9,7 +9,7 @@ import pytest
 from bayesgrasp.belief import absolute_planar_pose
 from bayesgrasp.belief.model_mixture import ModelMixtureBelief
 from bayesgrasp.models import build_models
-from bayesgrasp.planners import GraspPlanner, Reading
+from bayesgrasp.planners import PLANNERS, GraspPlanner, Reading
 from bayesgrasp.planners import touch as T
 from bayesgrasp.planners.category import CategoryPlanner, CategorySettings
 from bayesgrasp.planners.fusion import FusionPlanner
@@ -30,7 +30,11 @@ def test_the_pose_planner_has_the_interface():
     assert isinstance(p, GraspPlanner)
     plan = p.plan()
     assert _round_trip(plan)["action"] == plan.action.tolist()
+    w0, P0 = p.belief.weights.copy(), p.belief.particles.copy()
     up = p.observe(plan, Reading(np.full(p.models.n_joints, 0.5), held=False))
+    assert len(p.observations) == 1 and p.observations[0].stable is False and p.observations[0].family == plan.family
+    # the reading moved the belief (re-weighted, or resampled and jittered)
+    assert not np.allclose(p.belief.weights, w0) or not np.array_equal(p.belief.particles, P0)
     assert _round_trip(up)["ess"] == pytest.approx(p.belief.ess())
 
 
@@ -88,7 +92,7 @@ def test_the_touch_planner_touches_without_models_and_grasps_with_them():
     d = _round_trip(r)
     assert d["status"] == "estimated" and d["state"] == planner.belief.tolist() and d["fitness"] == r.fitness
     assert d["trace"]["evaluations"] == list(r.trace_evaluations) and d["fitness_terms"]["joint"] == r.joint_term
-    with pytest.raises(TypeError, match="readings"):
+    with pytest.raises(TypeError, match="measurement: expected the hand's TouchReadings"):
         planner.observe(plan, np.zeros(4))
     assert len(planner.results) == 1
     models = build_models("cube", settings=TINY, cache_dir=None)
@@ -96,3 +100,13 @@ def test_the_touch_planner_touches_without_models_and_grasps_with_them():
     best = models.table().best_relative_grasps(1)[0]
     assert grasping.kind == "stability" and grasping.touch.spread == pytest.approx(models.spread)
     np.testing.assert_allclose(grasping.action, absolute_planar_pose(best[None], planner.belief[None, :3])[0])
+
+
+@pytest.mark.parametrize("cls", [*PLANNERS.values(), FusionPlanner, CategoryPlanner, T.TouchPlanner])
+def test_every_planner_names_the_protocols_arguments(cls):
+    """observe(grasp, measurement), plan() without arguments, as GraspPlanner declares them (an
+    isinstance check sees only that the names exist)."""
+    import inspect
+
+    assert list(inspect.signature(cls.observe).parameters) == ["self", "grasp", "measurement"]
+    assert list(inspect.signature(cls.plan).parameters) == ["self"]

@@ -6,7 +6,7 @@ import pytest
 
 from bayesgrasp.experiments import single_touch as S
 from bayesgrasp.experiments.registry import get_experiment
-from bayesgrasp.experiments.runner import RunKey
+from bayesgrasp.experiments.runner import RunKey, run_seed
 from bayesgrasp.planners import touch as T
 
 
@@ -161,7 +161,8 @@ def test_pub1_runs_and_reports_without_the_loop(tmp_path, monkeypatch):
     results = {}
     for opt in exp.methods:
         series, fn = exp.make_run(exp, opt, ctx)
-        results[opt] = [(RunKey(series, "cube", i, 0), fn(series, "cube", i, 0)) for i in range(3)]
+        seeds = [run_seed(0, exp.seeds, "cube", i) for i in range(3)]
+        results[opt] = [(RunKey(series, "cube", i, s), fn(series, "cube", i, s)) for i, s in enumerate(seeds)]
     # every optimiser saw the same problems
     truths = {opt: [r["cases"]["pose"]["truth"] for _, r in res] for opt, res in results.items()}
     assert all(t == truths["pso"] for t in truths.values())

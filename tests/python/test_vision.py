@@ -1,7 +1,6 @@
 """Vision: camera vs analytic depth, segmentation of two objects, registration of known transforms
 (asymmetric and body of revolution), Open3D-like input, the option classes and keywords, typed
 failures, the shape weights, bad inputs, determinism, the CLI function."""
-import json
 import math
 
 import numpy as np

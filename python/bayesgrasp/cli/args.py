@@ -159,17 +159,14 @@ GROUP_SETTING = {"models": "models", "planner": "planner", "episode": "measureme
 
 
 def given_settings(args: argparse.Namespace) -> dict:
-    """The run-context settings the command line gives other values than the context's defaults:
-    {setting: the option that gives it} (--sweep groups included)."""
+    """The run-context settings the command line gives: {setting: the option that gives it} for an
+    option set to another value than the context's default, and for any --set or --sweep of a
+    setting's group (given is given, even at the default value)."""
     from ..experiments.context import RunContext
 
-    given = {}
-    if getattr(args, "success", RunContext.success) != RunContext.success:
-        given["success"] = "--success"
-    if getattr(args, "no_lift", False):
-        given["lift"] = "--no-lift"
-    if families_arg(getattr(args, "families", ",".join(RunContext.families))) != RunContext.families:
-        given["families"] = "--families"
+    values = {"success": getattr(args, "success", RunContext.success), "lift": not getattr(args, "no_lift", False),
+              "families": families_arg(getattr(args, "families", ",".join(RunContext.families)))}
+    given = {s: CONTEXT_OPTIONS[s] for s, v in values.items() if v != getattr(RunContext, s)}
     for option, assignments in (("--set", getattr(args, "set", [])), ("--sweep", getattr(args, "sweep", []))):
         for a in assignments:
             group = a.partition("=")[0].partition(".")[0]
@@ -219,8 +216,6 @@ def families_arg(text):
         raise CliError(f"--{e}") from None
 
 
-#: --set's groups: the dataclass each sets (planner and episode settings reach the experiments only).
-SET_GROUPS = ("models", "planner", "episode")
 #: Fields --set may not reach: an option of their own sets them (one channel per setting).
 SET_BY_OPTION = {"models.success": "--success", "models.family": "--families"}
 

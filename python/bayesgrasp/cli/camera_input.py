@@ -4,7 +4,6 @@ the cloud's frame and units; read once here into the object's cloud in the table
 from __future__ import annotations
 
 import argparse
-from typing import Optional
 
 from .args import CliError, floats
 

@@ -72,7 +72,7 @@ def add(sub) -> None:
 
 def new(args) -> int:
     from ..experiments.outside_loop import PoseEpisode
-    from .plan import _vision_start
+    from .plan import _vision_start, started
 
     fmt = output_format(args)
     if args.category or args.task:
@@ -93,10 +93,9 @@ def new(args) -> int:
         obj = load_object(args.object, units=args.units)
     start, _ = _vision_start(args, obj, est, quiet=fmt != "text")
     ctx = context(args, reads=("success", "models", "planner"))   # the robot reads the joints and the lift
-    settings = ctx.planner_settings()           # --set planner.FIELD=VALUE
+    settings = started(ctx.planner_settings(), start)     # --set planner.FIELD=VALUE
     if start is not None:
         est = start.estimate.tolist()
-        settings = settings.with_(half_width=tuple(start.half_width.tolist()))
     if est is None:
         raise CliError("--estimate: needed (or --cloud / --depth to register the object to)")
     ep = PoseEpisode.new(args.dir, obj, est, ctx, method=method, attempts=args.attempts, seed=ctx.seed,

@@ -40,12 +40,11 @@ def add(sub) -> None:
     e.set_defaults(run=run, config_defaults={k: e.get_default(k) for k in CONFIG_OPTIONS})
 
 
-#: The options --config may set (argparse destinations).
-CONFIG_OPTIONS = ("runs", "workers", "out", "objects", "hand", "success", "no_lift", "seed", "families", "engine",
-                  "address", "cache")
-#: The TOML keys --config takes at its top level, with the option each sets and how it is checked.
-CONFIG_KEYS = {"runs": int, "workers": int, "engine": str, "address": str, "out": str, "objects": list, "hand": str, "success": str,
-               "lift": bool, "seed": int, "cache": str, "families": str}
+#: The TOML keys --config takes at its top level, with how each is checked.
+CONFIG_KEYS = {"runs": int, "workers": int, "engine": str, "address": str, "out": str, "objects": list, "hand": str,
+               "success": str, "lift": bool, "seed": int, "cache": str, "families": str}
+#: The options --config may set (argparse destinations: lift is --no-lift's).
+CONFIG_OPTIONS = tuple("no_lift" if k == "lift" else k for k in CONFIG_KEYS)
 
 
 def apply_config(args, path: str, defaults: dict) -> None:
@@ -94,11 +93,6 @@ def _toml_value(v) -> str:
     if isinstance(v, (list, tuple)):
         return ",".join(_toml_value(x) for x in v)
     return "none" if v is None else str(v).lower() if isinstance(v, bool) else str(v)
-
-
-def _refuse_unread(args, exp) -> None:
-    """A setting the experiment's runs do not read is refused, not silently dropped."""
-    refuse_unread(args, exp.reads, f"experiment {exp.name}")
 
 
 def sweep_points(args) -> list:
@@ -168,7 +162,8 @@ def run(args) -> int:
             raise CliError(f"--config: {args.config}: {e}") from None
     for o in args.objects or ():
         load_object(o)  # a clear error for an unknown object
-    _refuse_unread(args, get_experiment(args.name))
+    exp = get_experiment(args.name)
+    refuse_unread(args, exp.reads, f"experiment {exp.name}")    # not silently dropped
     out = out_dir(args.out or f"out/experiments/{args.name}")
     ctx = context(args)
     points = None
@@ -179,8 +174,9 @@ def run(args) -> int:
     t0 = time.perf_counter()
     try:
         engine = make_engine(args.engine, args.workers, args.address)
-    except ValueError as e:
-        raise CliError(f"--engine: {e}") from None
+    except ValueError as e:      # its errors name the field: engine, workers or address
+        field, _, why = str(e).partition(": ")
+        raise CliError(f"--{field}: {why}" if field in ("engine", "workers", "address") else f"--engine: {e}") from None
     try:
         if points is not None:
             run_sweep(args.name, out, points, runs=args.runs, objects=args.objects, engine=engine,

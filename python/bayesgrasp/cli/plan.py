@@ -9,7 +9,7 @@ import numpy as np
 
 from . import camera_input
 from .args import (CliError, add_context_options, add_families_option, add_format_options, add_view_option, bounded_int,
-                   context, floats, out_dir, output_file, output_format)
+                   context, floats, out_dir, output_file, output_format, parse_set)
 
 METHODS = ["stability", "explore", "ml_pose", "open_loop"]
 
@@ -62,8 +62,9 @@ def _print_attempt(a: dict) -> None:
 
 
 def _loop(args, pose, attempts: int = 4, estimate=None, noise: float = 0.0, quiet: bool = False,
-          half_width=None, obj=None) -> dict:
-    """The episode on ``obj`` (default: --object by name)."""
+          start=None, obj=None) -> dict:
+    """The episode on ``obj`` (default: --object by name); ``start``: the vision start (its spread
+    is the belief's)."""
     from dataclasses import replace
 
     from ..experiments.episode import EpisodeSettings, run_episode
@@ -72,14 +73,12 @@ def _loop(args, pose, attempts: int = 4, estimate=None, noise: float = 0.0, quie
     if attempts < 1:
         raise CliError(f"--attempts: must be at least 1, got {attempts}")
     ctx = context(args)
-    if noise and ctx.measurement_noise and noise != ctx.measurement_noise:
-        raise CliError(f"--noise {noise} and --set episode.measurement_noise={ctx.measurement_noise}: give one")
+    if noise and "measurement_noise" in parse_set(getattr(args, "set", [])).get("episode", {}):
+        raise CliError("--noise and --set episode.measurement_noise: two names for one setting; give one")
     obj = args.object if obj is None else obj
     World.single(obj, pose=pose, hand=ctx.hand)  # a clear error for an unknown object or a pose off the table
     models = ctx.family_models(obj)
-    planner = ctx.planner_settings()
-    planner = planner if half_width is None else replace(planner, half_width=tuple(half_width))
-    ctx = replace(ctx, planner=planner, measurement_noise=noise or ctx.measurement_noise)
+    ctx = replace(ctx, planner=started(ctx.planner_settings(), start), measurement_noise=noise or ctx.measurement_noise)
     episode = EpisodeSettings(method=args.method, attempts=attempts)
     return run_episode(obj, pose, episode, ctx, seed=ctx.seed, estimate=estimate, models=models,
                        keep_planner=True, on_attempt=None if quiet else _print_attempt)
@@ -197,10 +196,9 @@ def plan(args) -> int:
 
         obj = load_object(args.object, units=args.units)
     start, view = _vision_start(args, obj, est, quiet=quiet)
-    half_width = None
     if start is not None:
-        est, half_width = start.estimate.tolist(), start.half_width.tolist()
-    r = _loop(args, pose, args.attempts, est, args.noise, quiet=quiet, half_width=half_width, obj=obj)
+        est = start.estimate.tolist()
+    r = _loop(args, pose, args.attempts, est, args.noise, quiet=quiet, start=start, obj=obj)
     if png:
         _belief_png(r, png)
     if fmt == "ros":
@@ -231,6 +229,11 @@ def _plan_doc(args, pose, r: dict, start, view, obj=None) -> dict:
     return doc
 
 
+def started(settings, start):
+    """The planner settings with the vision start's belief spread (``start`` None: as they are)."""
+    return settings if start is None else settings.with_(half_width=tuple(start.half_width.tolist()))
+
+
 def _vision_start(args, obj, estimate, quiet: bool):
     """The estimate and belief spread from registering ``obj`` (--object's mesh) to the camera
     data, and the camera data (None, None without them)."""
@@ -239,6 +242,9 @@ def _vision_start(args, obj, estimate, quiet: bool):
         return None, None
     if estimate is not None:
         raise CliError("--estimate: not with --cloud or --depth (the estimate comes from registering to them)")
+    if "half_width" in parse_set(getattr(args, "set", [])).get("planner", {}):
+        raise CliError("--set planner.half_width: not with --cloud or --depth (the belief's spread comes from "
+                       "registering to them)")
     from ..experiments.vision_start import vision_start
 
     start = vision_start(obj, view.object_points, view.viewpoint, seed=args.seed)

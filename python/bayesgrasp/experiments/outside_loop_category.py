@@ -188,7 +188,7 @@ class FusionEpisode(_CategoryBase):
         elif keys != s["models_keys"]:
             raise EpisodeError(f"{self.directory}: the episode was planned with other models: same --hand, --cache "
                                "and --set as at `episode new`")
-        _, self.mixture, self.planner = self.trial.start()
+        _, self.planner = self.trial.start()
         self._replay()
 
     @classmethod
@@ -226,9 +226,9 @@ class FusionEpisode(_CategoryBase):
 
     def _plan_next(self) -> None:
         plan = self.planner.plan()
-        w = self.mixture.weights
+        w = self.planner.belief.weights
         best = int(np.argmax(w))
-        grasp = predicted_top_grasp(self.hand, self.ctx.hand, self.trial.names[best], self.mixture.poses[best],
+        grasp = predicted_top_grasp(self.hand, self.ctx.hand, self.trial.names[best], self.planner.belief.poses[best],
                                     plan.action, self.trial.spread)
         self.state["next"] = {"attempt": len(self.state["steps"]) + 1, "round": len(self.state["steps"]),
                               "kind": "vision" if plan.round == 1 else "touch", "top_grasp": plan.action.tolist(),
@@ -237,7 +237,7 @@ class FusionEpisode(_CategoryBase):
 
     def belief(self) -> dict:
         """Each training model's weight and planar pose, and their SHA-256 (bit-for-bit checks)."""
-        b = self.mixture
+        b = self.planner.belief
         return {"weights": dict(zip(self.trial.names, b.weights.tolist())),
                 "poses": dict(zip(self.trial.names, b.poses.tolist())),
                 "particles_sha256": particles_digest(b.weights, b.poses)}

@@ -9,8 +9,8 @@ import numpy as np
 
 from .pose_uncertainty_plots import (plot_landscape, plot_one_dof, plot_per_attempt,
                                      plot_weight_vs_kernel)
-from .pose_uncertainty_stats import average_rows, by_object, episode_table
-from .report import finish, markdown, start, write_csv
+from .pose_uncertainty_stats import average_rows, episode_table
+from .report import by_object, finish, markdown, start, write_csv
 
 
 EPISODE_COLS = ("object", "attempt", "runs", "success", "lifted", "stable", "force_closure", "success_at_attempt",

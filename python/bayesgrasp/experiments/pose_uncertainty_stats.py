@@ -3,9 +3,11 @@ entropy_order, landscapes): per object and attempt, success, lifted, stable and 
 by attempt k and the belief after it; their mean over the objects."""
 from __future__ import annotations
 
-from typing import Dict, List
+from typing import List
 
 import numpy as np
+
+from .report import by_object
 
 
 ATTEMPTS = 4
@@ -16,12 +18,8 @@ def episode_table(results: list, attempts: int = ATTEMPTS) -> List[dict]:
     beside it lifted, stable (epsilon) and force closure by k; means over the runs that made
     attempt k of predicted stability, epsilon, plan time; pose error and KDE entropy of the belief
     after attempt k (carried forward once a run stopped)."""
-    by_obj: Dict[str, list] = {}
-    for key, r in results:
-        by_obj.setdefault(key.object, []).append(r)
     rows = []
-    for obj in sorted(by_obj):
-        runs = by_obj[obj]
+    for obj, runs in by_object(results).items():
         for k in range(1, attempts + 1):
             made = [r["attempts"][k - 1] for r in runs if len(r["attempts"]) >= k]
 
@@ -65,11 +63,3 @@ def average_rows(rows: List[dict], attempts: int = ATTEMPTS) -> List[dict]:
                 avg[f] = float(np.nanmean([r[f] for r in rk]))
         out.append(avg)
     return out
-
-
-def by_object(results: list) -> Dict[str, list]:
-    """The stored (key, result) pairs grouped by object, objects sorted by name."""
-    groups: Dict[str, list] = {}
-    for k, r in results:
-        groups.setdefault(k.object, []).append(r)
-    return dict(sorted(groups.items()))

@@ -6,9 +6,17 @@ from __future__ import annotations
 import csv
 import json
 from pathlib import Path
-from typing import List, Sequence
+from typing import Dict, List, Sequence
 
 import numpy as np
+
+
+def by_object(results: list) -> Dict[str, list]:
+    """Stored (key, result) pairs grouped by object: {object: [result, ...]}, objects sorted by name."""
+    groups: Dict[str, list] = {}
+    for k, r in results:
+        groups.setdefault(k.object, []).append(r)
+    return dict(sorted(groups.items()))
 
 
 def mpl():

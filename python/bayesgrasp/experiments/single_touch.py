@@ -37,11 +37,10 @@ from .registry import Experiment, register
 from .runner import ResultStore
 from .single_touch_plots import plot_errors
 from .single_touch_prose import findings, markdown_case
-from .single_touch_stats import case_rows, second_grasp_rows
+from .single_touch_stats import CASES, case_rows, second_grasp_rows
 
 OBJECTS = ("cube", "cylinder", "bottle/0", "mug", "mug2", "pitcher", "hammer/0")
 OPTIMIZERS = ("descent", "sa", "pso", "firefly")
-CASES = ("pose", "pose_and_scale", "orientation")
 BUDGET = 2000
 TRUE_XY = 0.05                      # true x, y uniform in +- this (m)
 ERROR_XY = 0.03                     # initial x, y errors uniform in +- this (m)

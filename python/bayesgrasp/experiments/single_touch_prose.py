@@ -6,7 +6,7 @@ from typing import Dict, List, Sequence
 
 import numpy as np
 
-from .single_touch_stats import case_rows, median_of, pooled, within
+from .single_touch_stats import CASES, case_rows, median_of, pooled, within
 
 
 def cell(s, digits=1) -> str:
@@ -37,7 +37,7 @@ def markdown_case(rows: List[dict], case: str, objects: Sequence[str], order: Se
 def findings(results: Dict[str, list], objects: Sequence[str]) -> List[dict]:
     """The thesis's findings, each a yes/no with the figures behind it (PSO unless stated); the
     objects in the order of ``objects``."""
-    r3, r4, r1 = (case_rows(results, c) for c in ("pose", "pose_and_scale", "orientation"))
+    r3, r4, r1 = (case_rows(results, c) for c in CASES)     # 3 DoF, 4 DoF, 1 DoF
     objs = [o for o in objects if any(r["object"] == o for r in r3)] or sorted({r["object"] for r in r3})
     shaped = [o for o in objs if median_of(r3, "pso", o, "orientation_deg_after") is not None]
     out = []

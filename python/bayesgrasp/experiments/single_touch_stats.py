@@ -7,6 +7,11 @@ from typing import Dict, List
 
 import numpy as np
 
+from .report import by_object
+
+#: pub1's three cases (Pub. I's unknowns): 3 DoF pose, pose and scale, orientation.
+CASES = ("pose", "pose_and_scale", "orientation")
+
 
 def quartiles(values) -> dict:
     v = np.asarray([x for x in values if x is not None], dtype=float)
@@ -21,10 +26,8 @@ def case_rows(results: Dict[str, list], case: str) -> List[dict]:
     the final fitness, evaluations and time."""
     rows = []
     for opt, res in results.items():
-        by_obj: Dict[str, list] = {}
-        for key, r in res:
-            by_obj.setdefault(key.object, []).append(r["cases"][case])
-        for obj, recs in by_obj.items():
+        for obj, runs in by_object(res).items():
+            recs = [r["cases"][case] for r in runs]
             row = {"optimizer": opt, "object": obj, "runs": len(recs),
                    "no_contact": int(sum(c["status"] != "estimated" for c in recs))}
             for when in ("before", "after"):
@@ -67,10 +70,8 @@ def second_grasp_rows(results: Dict[str, list]) -> List[dict]:
     """Fig. 2.1: success of the grasp planned on the initial guess vs on the updated model."""
     rows = []
     for opt, res in results.items():
-        by_obj: Dict[str, list] = {}
-        for key, r in res:
-            by_obj.setdefault(key.object, []).append(r["second_grasp"])
-        for obj, recs in by_obj.items():
+        for obj, runs in by_object(res).items():
+            recs = [r["second_grasp"] for r in runs]
             rows.append({"optimizer": opt, "object": obj, "runs": len(recs),
                          "success_initial": float(np.mean([g["initial"]["success"] for g in recs])),
                          "success_updated": float(np.mean([g["updated"]["success"] for g in recs]))})

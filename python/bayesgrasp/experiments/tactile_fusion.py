@@ -94,11 +94,11 @@ class FusionTrial:
         return ModelMixtureBelief(self.names, self.models, w, self.p0, self.settings, seed=self.seed)
 
     def start(self):
-        """The trial's random stream, the vision belief and its planner (seeded from the stream)."""
+        """The trial's random stream and the planner on the vision belief (seeded from the stream;
+        the belief is its ``belief``)."""
         rng = np.random.default_rng(self.seed)
-        belief = self.belief()
         part = self.part_check if self.settings.task_term == "part-aware" else None
-        return rng, belief, FusionPlanner(belief, self.task_grasps, seed=int(rng.integers(2**31)), part_check=part)
+        return rng, FusionPlanner(self.belief(), self.task_grasps, seed=int(rng.integers(2**31)), part_check=part)
 
     def part_check(self, grasps: np.ndarray, belief: ModelMixtureBelief):
         """The part check of top grasps (K, 3) over the models at the belief's poses and weights
@@ -119,7 +119,8 @@ class FusionTrial:
 
     def run(self, mode: str = "random", rounds: int = ROUNDS, on_round=None) -> dict:
         """G(0) (random or vision-planned) and up to ``rounds`` tactile rounds."""
-        rng, belief, planner = self.start()
+        rng, planner = self.start()
+        belief = planner.belief
         g0 = self.random_grasp(rng) if mode == "random" else planner.plan().action
         records = [self._record(0, self._execute(g0), belief)]
         if on_round:

@@ -9,7 +9,7 @@ linearly from 0 at ``drop_start`` to 1 at ``drop_end`` incidence (grazing surfac
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Optional, Sequence
+from typing import Sequence
 
 import numpy as np
 

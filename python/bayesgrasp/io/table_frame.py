@@ -12,7 +12,7 @@ camera. (Down-sampling the whole cloud first would spend most of the time on the
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Optional, Tuple
+from typing import Optional
 
 import numpy as np
 

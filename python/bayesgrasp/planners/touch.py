@@ -35,7 +35,7 @@ the readings::
 """
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from typing import Optional, Sequence, Union
 
 import numpy as np
@@ -230,7 +230,7 @@ class TouchPlan:
     touch: TouchGrasp
     action: np.ndarray
     kind: str
-    estimate: np.ndarray = field(default_factory=lambda: np.zeros(4))
+    estimate: np.ndarray
 
     def to_dict(self) -> dict:
         return {"kind": self.kind, "action": self.action.tolist(), "spread": float(self.touch.spread),
@@ -278,14 +278,15 @@ class TouchPlanner:
         a = absolute_planar_pose(best[None, :], self.estimate[None, :3])[0]
         return TouchPlan(top_grasp(*a, self.models.spread), a, "stability", self.estimate.copy())
 
-    def observe(self, grasp: Union[TouchPlan, TouchGrasp], readings: TouchReadings) -> EstimateResult:
-        """Fits the model to the readings of the executed grasp (a TouchPlan or a TouchGrasp); the
-        estimate is kept when the grasp missed the object."""
+    def observe(self, grasp: Union[TouchPlan, TouchGrasp], measurement: TouchReadings) -> EstimateResult:
+        """Fits the model to the measurement (the hand's TouchReadings) of the executed grasp (a
+        TouchPlan or a TouchGrasp); the estimate is kept when the grasp missed the object."""
+        readings = measurement
         touch = grasp.touch if isinstance(grasp, TouchPlan) else grasp
         if not isinstance(touch, TouchGrasp):
             raise TypeError(f"grasp: expected the executed TouchPlan or TouchGrasp, got {type(grasp).__name__}")
         if not isinstance(readings, TouchReadings):
-            raise TypeError(f"readings: expected the hand's TouchReadings, got {type(readings).__name__}")
+            raise TypeError(f"measurement: expected the hand's TouchReadings, got {type(readings).__name__}")
         r = self.model.estimate(touch, readings, self.estimate, self.settings.options())
         if r.status == EstimateStatus.estimated:
             self.estimate = np.asarray(r.state, dtype=float).copy()
