@@ -13,6 +13,7 @@ import json
 
 import numpy as np
 
+from ..experiments.episode import EpisodeSettings
 from . import camera_input
 from .args import (CliError, add_context_options, add_format_options, bounded_int, context, floats, output_format,
                    task_grasps_arg)
@@ -44,7 +45,7 @@ def add(sub) -> None:
                    help="with --category: training models to leave out (default: --object, if it is one)")
     n.add_argument("--task-grasps", default=None, metavar="FILE",
                    help="with --category: demonstrated grasps to use instead of generating them (as for `category`)")
-    n.add_argument("--attempts", type=bounded_int(1, 1000), default=4, help="grasps at most")
+    n.add_argument("--attempts", type=bounded_int(1, 1000), default=EpisodeSettings.attempts, help="grasps at most")
     n.add_argument("--dir", required=True, help="the episode's directory (created; must not hold an episode)")
     add_format_options(n)
     add_context_options(n)
@@ -82,7 +83,7 @@ def new(args) -> int:
             raise CliError(f"--{opt.replace('_', '-')}: only with --category")
     if args.object is None:
         raise CliError("--object: needed (the object whose pose is uncertain)")
-    method = args.method or "explore"
+    method = args.method or EpisodeSettings.method
     if method not in POSE_METHODS:
         raise CliError(f"--method: {method} needs --category and --task")
     est = floats(args.estimate, 3, "--estimate") if args.estimate else None

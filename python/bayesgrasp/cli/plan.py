@@ -11,7 +11,13 @@ from . import camera_input
 from .args import (CliError, add_context_options, add_families_option, add_format_options, add_view_option, bounded_int,
                    context, floats, out_dir, output_file, output_format, parse_set)
 
-METHODS = ["stability", "explore", "ml_pose", "open_loop"]
+from ..experiments.episode import EpisodeSettings
+from ..planners.registry import PLANNERS
+
+METHODS = list(PLANNERS)
+METHOD_HELP = ("stability: the most stable grasp (Eq. 3.1); explore: informative grasps while none is likely to hold "
+               "(Eq. 3.2); ml_pose: the most stable grasp at the most likely pose; open_loop: the most stable grasp "
+               "at the estimate, no update")
 
 
 def add(sub) -> None:
@@ -20,7 +26,7 @@ def add(sub) -> None:
                                    "read the fingers, update the belief, re-plan until it is lifted; writes "
                                    "belief_evolution.png and demo.json to --out.")
     d.add_argument("--object", default="mug", help="built-in object name or mesh file")
-    d.add_argument("--method", default="explore", choices=METHODS, help="stability: the most stable grasp (Eq. 3.1); explore: informative grasps while none is likely to hold (Eq. 3.2); ml_pose: the most stable grasp at the most likely pose; open_loop: the most stable grasp at the estimate, no update")
+    d.add_argument("--method", default=EpisodeSettings.method, choices=METHODS, help=METHOD_HELP)
     d.add_argument("--out", default="out/demo", help="directory for the PNG and results")
     add_context_options(d)
     add_families_option(d)
@@ -33,11 +39,11 @@ def add(sub) -> None:
                                    "attempts run out. To execute on your own robot, use `bayesgrasp episode`.")
     p.add_argument("--object", required=True, help="built-in object name or mesh file")
     p.add_argument("--true-pose", required=True, metavar="X,Y,YAW", help="the hidden pose: metres, metres, radians")
-    p.add_argument("--method", default="explore", choices=METHODS, help="stability: the most stable grasp (Eq. 3.1); explore: informative grasps while none is likely to hold (Eq. 3.2); ml_pose: the most stable grasp at the most likely pose; open_loop: the most stable grasp at the estimate, no update")
+    p.add_argument("--method", default=EpisodeSettings.method, choices=METHODS, help=METHOD_HELP)
     p.add_argument("--estimate", default=None, metavar="X,Y,YAW",
                    help="the initial pose estimate (default: from --cloud / --depth by registering the object's "
                         "mesh, its spread set by the fit; else the true pose + uniform noise within the belief)")
-    p.add_argument("--attempts", type=bounded_int(1, 1000), default=4, help="grasps at most")
+    p.add_argument("--attempts", type=bounded_int(1, 1000), default=EpisodeSettings.attempts, help="grasps at most")
     p.add_argument("--noise", type=float, default=0.0, help="joint-angle measurement noise std (rad)")
     p.add_argument("--png", default=None, help="write a PNG of the belief's evolution")
     add_format_options(p)
@@ -61,7 +67,7 @@ def _print_attempt(a: dict) -> None:
           f"({1e3 * a['plan_seconds']:.0f} ms to plan)", flush=True)
 
 
-def _loop(args, pose, attempts: int = 4, estimate=None, noise: float = 0.0, quiet: bool = False,
+def _loop(args, pose, attempts: int = EpisodeSettings.attempts, estimate=None, noise: float = 0.0, quiet: bool = False,
           start=None, obj=None) -> dict:
     """The episode on ``obj`` (default: --object by name); ``start``: the vision start (its spread
     is the belief's)."""
@@ -99,8 +105,10 @@ def demo(args) -> int:
     out = out_dir(args.out)
     rng = np.random.default_rng(args.seed)
     pose = [float(rng.uniform(-0.08, 0.08)), float(rng.uniform(-0.08, 0.08)), float(rng.uniform(-np.pi, np.pi))]
+    s = context(args).planner_settings()
     print(f"{args.object} at a hidden pose ({100 * pose[0]:.1f} cm, {100 * pose[1]:.1f} cm, "
-          f"{np.degrees(pose[2]):.0f} deg); belief: 500 particles, +-4 cm, +-45 deg; method {args.method}")
+          f"{np.degrees(pose[2]):.0f} deg); belief: {s.n_particles} particles, +-{100 * s.half_width[0]:g} cm, "
+          f"+-{np.degrees(s.half_width[2]):g} deg; method {args.method}")
     r = _loop(args, pose)
     f = r["final_belief"]
     print(f"{'success' if r['success'] else 'no successful grasp'} after {len(r['attempts'])} attempt(s); "
