@@ -22,7 +22,7 @@ import time
 import numpy as np
 
 from bayesgrasp.models import ModelSettings
-from bayesgrasp.planners import ExplorationPlanner, PlannerSettings, Reading, StabilityPlanner, get_models
+from bayesgrasp.planners import ExplorationPlanner, Plan, PlannerSettings, Reading, StabilityPlanner, get_models
 from bayesgrasp.experiments import EpisodeSettings, RunContext, run_episode
 
 OBJECTS = ("cube", "cylinder", "mug", "mug2", "pitcher")
@@ -57,8 +57,9 @@ def problem(obj, models, rng, seed):
     est = pose + rng.uniform(-1, 1, 3) * np.array([0.04, 0.04, np.radians(45)])
     ep = run_episode(obj, pose, EpisodeSettings(method="stability", attempts=1, stop_when_stable=False),
                      RunContext(success="epsilon", lift=False), seed=seed, estimate=est, models=models)
-    a0 = ep["attempts"][0]
-    return est, (np.array(a0["action"]), Reading(a0["joint_angles"], held=a0["stable"]))
+    a0 = ep["attempts"][0]     # a top grasp: the executed Plan names its family for the two-family planners
+    plan = Plan(np.array(a0["action"]), a0["kind"], a0["predicted_stability"], a0["predicted_stability"], family="top")
+    return est, (plan, Reading(a0["joint_angles"], held=a0["stable"]))
 
 
 def timed(planner_cls, models, est, seed, observe=None):
@@ -95,10 +96,9 @@ def main():
                 rows["stability"].append(t)
                 t, _ = timed(ExplorationPlanner, models, est, r, observe)
                 rows["explore"].append(t)
-                observe_top = None if observe is None else (*observe, "top")
-                t, _ = timed(StabilityPlanner, both, est, r, observe_top)
+                t, _ = timed(StabilityPlanner, both, est, r, observe)
                 rows["stability_both"].append(t)
-                t, _ = timed(ExplorationPlanner, both, est, r, observe_top)
+                t, _ = timed(ExplorationPlanner, both, est, r, observe)
                 rows["explore_both"].append(t)
             if r < max(2, a.reps // 5):
                 t, _ = timed(GPStability, models, est, r)
