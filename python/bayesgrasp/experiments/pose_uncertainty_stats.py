@@ -59,7 +59,8 @@ def average_rows(rows: List[dict], attempts: int = ATTEMPTS) -> List[dict]:
         avg = {"object": "mean", "attempt": k, "runs": int(sum(r["runs"] for r in rk)),
                "made": int(sum(r["made"] for r in rk))}
         for f in rk[0]:
-            if f not in avg:
-                avg[f] = float(np.nanmean([r[f] for r in rk]))
+            if f not in avg:       # the mean over the objects that have the figure (NaN: none has)
+                known = [r[f] for r in rk if not np.isnan(r[f])]
+                avg[f] = float(np.mean(known)) if known else float("nan")
         out.append(avg)
     return out
