@@ -92,8 +92,8 @@ def new(args) -> int:
         from ..objects import load_object
 
         obj = load_object(args.object, units=args.units)
-    start, _ = _vision_start(args, obj, est, quiet=fmt != "text")
     ctx = context(args, reads=("success", "models", "planner"))   # the robot reads the joints and the lift
+    start, _ = _vision_start(args, obj, est, fmt != "text", ctx.seed)
     settings = started(ctx.planner_settings(), start)     # --set planner.FIELD=VALUE
     if start is not None:
         est = start.estimate.tolist()
@@ -118,15 +118,15 @@ def _new_category(args, fmt: str) -> int:
     if method in POSE_METHODS:
         raise CliError(f"--method: {method} is a pose-uncertainty method; with --category one of "
                        f"{', '.join(CATEGORY_METHODS)}")
+    ctx = context(args, reads=("success", "models") if method == "fusion" else ())
     view = camera_input.observe(args)
     if view is not None:
         obs = camera_input.observation(view)
     elif args.object:
-        obs = observe(args.object, floats(args.object_pose, 3, "--object-pose"), seed=args.seed)
+        obs = observe(args.object, floats(args.object_pose, 3, "--object-pose"), seed=ctx.seed)
     else:
         raise CliError("--cloud, --depth or --object: the view to plan from")
     exclude = args.exclude if args.exclude is not None else [m for m in [args.object] if m]
-    ctx = context(args, reads=("success", "models") if method == "fusion" else ())
     common = dict(exclude=exclude, seed=ctx.seed, grasps=task_grasps_arg(args))
     if method == "fusion":
         ep = FusionEpisode.new(args.dir, obs, args.category, args.task, ctx, attempts=args.attempts, **common)

@@ -67,10 +67,10 @@ def _print_attempt(a: dict) -> None:
           f"({1e3 * a['plan_seconds']:.0f} ms to plan)", flush=True)
 
 
-def _loop(args, pose, attempts: int = EpisodeSettings.attempts, estimate=None, noise: float = 0.0, quiet: bool = False,
-          start=None, obj=None) -> dict:
-    """The episode on ``obj`` (default: --object by name); ``start``: the vision start (its spread
-    is the belief's)."""
+def _loop(args, ctx, pose, attempts: int = EpisodeSettings.attempts, estimate=None, noise: float = 0.0,
+          quiet: bool = False, start=None, obj=None) -> dict:
+    """The episode on ``obj`` (default: --object by name) in the command's run context ``ctx``;
+    ``start``: the vision start (its spread is the belief's)."""
     from dataclasses import replace
 
     from ..experiments.episode import EpisodeSettings, run_episode
@@ -78,7 +78,6 @@ def _loop(args, pose, attempts: int = EpisodeSettings.attempts, estimate=None, n
 
     if attempts < 1:
         raise CliError(f"--attempts: must be at least 1, got {attempts}")
-    ctx = context(args)
     if noise and "measurement_noise" in parse_set(getattr(args, "set", [])).get("episode", {}):
         raise CliError("--noise and --set episode.measurement_noise: two names for one setting; give one")
     obj = args.object if obj is None else obj
@@ -103,18 +102,19 @@ def demo(args) -> int:
     """The main job: a mug at a displaced pose the robot knows only to +-4 cm and +-45 deg;
     plan, grasp, read the fingers, update the belief, re-plan until the grasp is stable."""
     out = out_dir(args.out)
-    rng = np.random.default_rng(args.seed)
+    ctx = context(args)
+    rng = np.random.default_rng(ctx.seed)
     pose = [float(rng.uniform(-0.08, 0.08)), float(rng.uniform(-0.08, 0.08)), float(rng.uniform(-np.pi, np.pi))]
-    s = context(args).planner_settings()
+    s = ctx.planner_settings()
     print(f"{args.object} at a hidden pose ({100 * pose[0]:.1f} cm, {100 * pose[1]:.1f} cm, "
           f"{np.degrees(pose[2]):.0f} deg); belief: {s.n_particles} particles, +-{100 * s.half_width[0]:g} cm, "
           f"+-{np.degrees(s.half_width[2]):g} deg; method {args.method}")
-    r = _loop(args, pose)
+    r = _loop(args, ctx, pose)
     f = r["final_belief"]
     print(f"{'success' if r['success'] else 'no successful grasp'} after {len(r['attempts'])} attempt(s); "
           f"final belief error {100 * f['position_error']:.1f} cm, {np.degrees(f['yaw_error']):.0f} deg")
     png = _belief_png(r, out / "belief_evolution.png")
-    doc = _plan_json(args, pose, r)
+    doc = _plan_json(args, ctx, pose, r)
     (out / "demo.json").write_text(json.dumps(doc, indent=1))
     pictures = _attempt_pictures(doc, out)
     print(f"saved {png}, {out / 'demo.json'} (see it in 3D: bayesgrasp view {out / 'demo.json'}) and "
@@ -152,14 +152,14 @@ def _attempt_grasps(r: dict, hand_name: str) -> list:
     return [hand_grasp_record(hand, a["hand_pose"], a["joint_positions"], a["variant"]["spread"]) for a in r["attempts"]]
 
 
-def _contacts(args, pose, r: dict, obj) -> list:
+def _contacts(ctx, pose, r: dict, obj) -> list:
     """Each attempt's contacts (with their parts): its grasp simulated again without the lift
     (the same world, grasp and spread, so the same closing; checked against the attempt's pose)."""
     from ..world import World
 
     from ..models import Variant
 
-    world = World.single(obj, pose=pose, hand=context(args).hand)
+    world = World.single(obj, pose=pose, hand=ctx.hand)
     out = []
     for a in r["attempts"]:
         g = Variant(**a["variant"]).grasp(world, a["relative_grasp"], lift=False)
@@ -168,14 +168,14 @@ def _contacts(args, pose, r: dict, obj) -> list:
     return out
 
 
-def _plan_json(args, pose, r: dict, obj=None) -> dict:
+def _plan_json(args, ctx, pose, r: dict, obj=None) -> dict:
     """plan's JSON; each attempt carries the belief it was planned from (its heaviest particles)."""
     from ..io.view_fields import belief_json
 
     f = r["final_belief"]
-    grasps = _attempt_grasps(r, args.hand)
+    grasps = _attempt_grasps(r, ctx.hand)
     return {"object": args.object, "method": args.method, "true_pose": pose, "estimate": r["estimate"],
-            "success_criterion": args.success, "success": r["success"],
+            "success_criterion": ctx.success, "success": r["success"],
             "attempts": [{"plan_type": a["kind"], "family": a["family"], "variant": a["variant"],
                           "top_grasp": a["action"] if a["family"] == "top" else None,
                           "action": a["action"], "grasp": g, "predicted_stability": a["predicted_stability"],
@@ -184,7 +184,7 @@ def _plan_json(args, pose, r: dict, obj=None) -> dict:
                           "success": a["success"], "outcome": "success" if a["success"] else "failure",
                           "plan_seconds": a["plan_seconds"],
                           "joint_angles": a["joint_angles"], "belief": belief_json(*r["snapshots"][k]),
-                          "contacts": c} for k, (a, g, c) in enumerate(zip(r["attempts"], grasps, _contacts(args, pose, r, obj or args.object)))],
+                          "contacts": c} for k, (a, g, c) in enumerate(zip(r["attempts"], grasps, _contacts(ctx, pose, r, obj or args.object)))],
             "final_belief": {"mean": f["mean"], "std": f["std"], "entropy": f["kde_entropy"], "ess": f["ess"],
                              "position_error": f["position_error"], "yaw_error": f["yaw_error"],
                              **belief_json(*r["snapshots"][-1])}}
@@ -203,33 +203,34 @@ def plan(args) -> int:
         from ..objects import load_object
 
         obj = load_object(args.object, units=args.units)
-    start, view = _vision_start(args, obj, est, quiet=quiet)
+    ctx = context(args)
+    start, view = _vision_start(args, obj, est, quiet, ctx.seed)
     if start is not None:
         est = start.estimate.tolist()
-    r = _loop(args, pose, args.attempts, est, args.noise, quiet=quiet, start=start, obj=obj)
+    r = _loop(args, ctx, pose, args.attempts, est, args.noise, quiet=quiet, start=start, obj=obj)
     if png:
         _belief_png(r, png)
     if fmt == "ros":
         from ..io.grasp_schema import to_ros
 
         print(json.dumps({"attempts": [to_ros(g, grasp_id=f"attempt-{a['attempt']}", quality=a["predicted_stability"])
-                                       for a, g in zip(r["attempts"], _attempt_grasps(r, args.hand))]}))
+                                       for a, g in zip(r["attempts"], _attempt_grasps(r, ctx.hand))]}))
     elif fmt == "json":
-        print(json.dumps(_plan_doc(args, pose, r, start, view, obj)))
+        print(json.dumps(_plan_doc(args, ctx, pose, r, start, view, obj)))
     else:
         print(f"{'success' if r['success'] else 'no successful grasp'} after {len(r['attempts'])} attempt(s)")
     if args.view is not None:
         from .view import show_result
 
-        show_result(args, _plan_doc(args, pose, r, start, view, obj))
+        show_result(args, _plan_doc(args, ctx, pose, r, start, view, obj))
     return 0
 
 
-def _plan_doc(args, pose, r: dict, start, view, obj=None) -> dict:
+def _plan_doc(args, ctx, pose, r: dict, start, view, obj=None) -> dict:
     """plan's JSON, with the vision start (and its cloud) when the belief came from camera data."""
     from ..io.view_fields import cloud_json
 
-    doc = _plan_json(args, pose, r, obj)
+    doc = _plan_json(args, ctx, pose, r, obj)
     if start is not None:
         doc["vision"] = {"scene": args.cloud or args.depth, "estimate": start.estimate.tolist(),
                          "half_width": start.half_width.tolist(), "registration": start.registration.as_dict(),
@@ -242,9 +243,9 @@ def started(settings, start):
     return settings if start is None else settings.with_(half_width=tuple(start.half_width.tolist()))
 
 
-def _vision_start(args, obj, estimate, quiet: bool):
+def _vision_start(args, obj, estimate, quiet: bool, seed: int):
     """The estimate and belief spread from registering ``obj`` (--object's mesh) to the camera
-    data, and the camera data (None, None without them)."""
+    data (the registration seeded by ``seed``), and the camera data (None, None without them)."""
     view = camera_input.observe(args)
     if view is None:
         return None, None
@@ -255,7 +256,7 @@ def _vision_start(args, obj, estimate, quiet: bool):
                        "registering to them)")
     from ..experiments.vision_start import vision_start
 
-    start = vision_start(obj, view.object_points, view.viewpoint, seed=args.seed)
+    start = vision_start(obj, view.object_points, view.viewpoint, seed=seed)
     if not quiet:
         x, y, yaw = start.estimate
         hx, _, hyaw = start.half_width
