@@ -118,14 +118,14 @@ def _new_category(args, fmt: str) -> int:
     if method in POSE_METHODS:
         raise CliError(f"--method: {method} is a pose-uncertainty method; with --category one of "
                        f"{', '.join(CATEGORY_METHODS)}")
-    ctx = context(args, reads=("success", "models") if method == "fusion" else ())
     view = camera_input.observe(args)
+    if view is None and not args.object:
+        raise CliError("--cloud, --depth or --object: the view to plan from")
+    ctx = context(args, reads=("success", "models") if method == "fusion" else ())
     if view is not None:
         obs = camera_input.observation(view)
-    elif args.object:
-        obs = observe(args.object, floats(args.object_pose, 3, "--object-pose"), seed=ctx.seed)
     else:
-        raise CliError("--cloud, --depth or --object: the view to plan from")
+        obs = observe(args.object, floats(args.object_pose, 3, "--object-pose"), seed=ctx.seed)
     exclude = args.exclude if args.exclude is not None else [m for m in [args.object] if m]
     common = dict(exclude=exclude, seed=ctx.seed, grasps=task_grasps_arg(args))
     if method == "fusion":

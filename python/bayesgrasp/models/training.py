@@ -78,7 +78,7 @@ def lift_tests_in_chunks(lift: Callable[[np.ndarray], np.ndarray], rows: np.ndar
     def report() -> None:
         with lock:
             now, done = time.monotonic(), state["done"]
-            if now - state["last"] < PROGRESS_EVERY:
+            if now - state["last"] < PROGRESS_EVERY or done == len(rows):   # all done: the caller says so
                 return
             left = f"about {(now - start) / done * (len(rows) - done):.0f} s left" if done else \
                 f"{now - start:.0f} s so far"
