@@ -66,8 +66,8 @@ def run(name: str, out_dir, ctx: Optional[RunContext] = None, runs: Optional[int
         for series, _ in runs_of.values():
             store.check_settings(series, settings)
         prepare(exp, objects, ctx, engine)
-        series = [Series(name, tuple(objects), runs, fn, seed_name=exp.seeds) for name, fn in runs_of.values()]
-        done = run_all(series, store, ctx.seed, engine, progress=ctx.progress is not None, settings=settings)
+        todo = [Series(name, tuple(objects), runs, fn, seed_name=exp.seeds) for name, fn in runs_of.values()]
+        done = run_all(todo, store, ctx.seed, engine, progress=ctx.progress is not None, settings=settings)
         results: Dict[str, list] = {method: done[series] for method, (series, _) in runs_of.items()}
         store.flatten()
     finally:
