@@ -8,6 +8,18 @@ namespace bayesgrasp::bind {
 
 void bind_geometry(py::module_& m) {
   py::class_<MassProperties> mp(m, "MassProperties", "Mass properties of a solid of uniform density (mesh frame).");
+  mp.def(py::init([](double volume, double mass, const DArray& com, const DArray& inertia) {
+           MassProperties p;
+           p.volume = positive(volume, "volume");
+           p.mass = positive(mass, "mass");
+           p.com = vec3(com, "com");
+           const RowMatrixXd I = matrix(inertia, "inertia", 3);
+           if (I.rows() != 3) throw py::value_error("inertia: expected shape (3, 3), got " + shape_str(inertia));
+           p.inertia = I;
+           return p;
+         }),
+         py::arg("volume"), py::arg("mass"), py::arg("com"), py::arg("inertia"),
+         "Given mass properties: volume (m^3) and mass (kg) > 0, com (3,) m, inertia (3, 3) kg m^2 about com.");
   readonly(mp, "volume", &MassProperties::volume, "float", "m^3 (negative if the faces are wound inwards)");
   readonly(mp, "mass", &MassProperties::mass, "float", "kg");
   readonly(mp, "com", &MassProperties::com, "ndarray (3,)", "centre of mass, m");

@@ -250,12 +250,19 @@ void bind_results(py::module_& m) {
 }
 
 std::unique_ptr<LiftTester> make_tester(const py::handle& hand, const DArray& vertices, const IArray& faces,
-                                        const LiftOptions& options, const py::object& convex_pieces) {
+                                        const LiftOptions& options, const py::object& convex_pieces,
+                                        const py::object& mass_properties) {
   const HandModel h = hand_arg(hand);
   const TriMesh mesh = bind::mesh(vertices, faces, "object");
   const std::vector<Eigen::MatrixX3d> pieces = pieces_arg(convex_pieces);
+  std::optional<MassProperties> mass;
+  if (!mass_properties.is_none()) {
+    if (!py::isinstance<MassProperties>(mass_properties))
+      throw py::type_error("mass_properties: expected None or a MassProperties");
+    mass = mass_properties.cast<MassProperties>();
+  }
   py::gil_scoped_release release;  // the tetrahedra's ray casts take a while on big meshes
-  return std::make_unique<LiftTester>(h, mesh, options, pieces);
+  return std::make_unique<LiftTester>(h, mesh, options, pieces, mass);
 }
 
 }  // namespace
@@ -273,14 +280,16 @@ Args:
     options: LiftOptions (defaults if None).
     convex_pieces: None or a list of (K, 3) point arrays in the world frame, an approximate
         convex decomposition of the object (each piece's convex hull is used): needed by
-        shape 'decomposition', used by 'auto' for concave objects instead of the tetrahedra.)doc")
+        shape 'decomposition', used by 'auto' for concave objects instead of the tetrahedra.
+    mass_properties: None (the closed mesh's at options.density) or a MassProperties in the
+        world frame (an open scan's, a weighed object's).)doc")
       .def(py::init([](const py::handle& hand, const DArray& vertices, const IArray& faces, const py::object& options,
-                       const py::object& convex_pieces) {
+                       const py::object& convex_pieces, const py::object& mass_properties) {
              const LiftOptions o = options.is_none() ? LiftOptions{} : options.cast<LiftOptions>();
-             return make_tester(hand, vertices, faces, o, convex_pieces);
+             return make_tester(hand, vertices, faces, o, convex_pieces, mass_properties);
            }),
            py::arg("hand"), py::arg("vertices"), py::arg("faces"), py::arg("options") = py::none(),
-           py::arg("convex_pieces") = py::none())
+           py::arg("convex_pieces") = py::none(), py::arg("mass_properties") = py::none())
       .def_property_readonly("mass", [](const LiftTester& t) { return t.mass_properties().mass; }, "object mass, kg")
       .def_property_readonly("com", [](const LiftTester& t) { return Eigen::Vector3d(t.mass_properties().com); },
                              "object centre of mass (world)")

@@ -21,21 +21,20 @@ its centre of mass rose at least 10 cm - 2 cm - and stayed in it through the sha
 Concave objects (a mug, a pitcher) need a concave collision shape when the hand reaches into
 a concavity (the opening, the handle's hole). ``shape="auto"`` (default) then uses an
 approximate convex decomposition of the mesh - a compound of a few dozen convex hulls,
-computed once per mesh by CoACD (:func:`convex_decomposition`, cached as ``.npz``) - instead
+computed once per mesh by CoACD (:mod:`bayesgrasp.decomposition`, cached as ``.npz``) - instead
 of one tetrahedron per triangle (``shape="tetrahedra"``, far slower; see BENCHMARKS.md).
 """
 from __future__ import annotations
 
-import hashlib
 import os
 from pathlib import Path
-from typing import List, Optional, Sequence, Union
+from typing import Optional, Sequence
 
-from bayesgrasp._args import c_int, c_seed
+from bayesgrasp._args import c_int
 import numpy as np
 
 from bayesgrasp import _core
-from bayesgrasp.cache import atomic_write, cache_root, load_checked
+from bayesgrasp.decomposition import convex_decomposition, decomposition_cache_dir
 from bayesgrasp.sim import set_fields
 
 __all__ = ["BARRETT_HAND", "LiftBatch", "LiftOptions", "LiftResult", "LiftTester", "convex_decomposition",
@@ -68,89 +67,13 @@ def _hand(hand):
     return hand
 
 
-def decomposition_cache_dir() -> Path:
-    """Where :func:`convex_decomposition` keeps its results: ``$BAYESGRASP_CACHE`` (or
-    ``~/.cache/bayesgrasp``) / ``convex_decomposition``."""
-    return cache_root() / "convex_decomposition"
-
-
-
-def _read_pieces(path: Path) -> List[np.ndarray]:
-    with np.load(path, allow_pickle=False) as z:
-        return [np.array(z[f"piece_{i}"], dtype=np.float64) for i in range(int(z["count"]))]
-
-
-def convex_decomposition(vertices, faces, threshold: float = 0.05, seed: int = 0,
-                         cache_dir: Union[str, os.PathLike, None, bool] = None) -> List[np.ndarray]:
-    """Approximate convex decomposition of a closed triangle mesh (CoACD), cached per mesh.
-
-    Args:
-        vertices: (N, 3) float vertices (m). faces: (M, 3) int triangles.
-        threshold: CoACD's concavity threshold (smaller: more, tighter pieces). 0.05 (CoACD's
-            default) cuts the built-in mug into a few dozen pieces that keep its opening and
-            handle.
-        seed: CoACD's random seed (same mesh and seed give the same pieces).
-        cache_dir: directory of the ``.npz`` cache (None: :func:`decomposition_cache_dir`;
-            False: no cache). The key is a SHA-256 of the mesh's bytes and the parameters, so
-            a changed mesh is decomposed again.
-
-    Returns:
-        list of (K_i, 3) float64 arrays: the vertices of each convex piece, in the mesh's frame.
-    """
-    V = np.ascontiguousarray(vertices, dtype=np.float64)
-    F = np.ascontiguousarray(faces, dtype=np.int64)
-    if V.ndim != 2 or V.shape[1] != 3 or len(V) < 4:
-        raise ValueError(f"vertices: expected shape (N, 3) with N >= 4, got {V.shape}")
-    if not np.all(np.isfinite(V)):
-        raise ValueError("vertices: contain NaN or infinity")
-    if F.ndim != 2 or F.shape[1] != 3 or len(F) < 4:
-        raise ValueError(f"faces: expected shape (M, 3) with M >= 4, got {F.shape}")
-    if F.min() < 0 or F.max() >= len(V):
-        raise ValueError(f"faces: indices must be in [0, {len(V)}), got [{F.min()}, {F.max()}]")
-    if not (np.isfinite(threshold) and 0 < threshold <= 1):
-        raise ValueError(f"threshold: must be in (0, 1], got {threshold}")
-    import coacd  # only needed here
-
-    path = None
-    if cache_dir is not False:
-        h = hashlib.sha256()
-        h.update(V.tobytes())
-        h.update(F.astype(np.int32).tobytes())
-        h.update(f"coacd-{_coacd_version()}-t{threshold!r}-s{int(seed)}-{sorted(_COACD_SEARCH.items())}".encode())
-        path = Path(decomposition_cache_dir() if cache_dir is None else cache_dir) / f"{h.hexdigest()[:32]}.npz"
-        cached = load_checked(path, "convex decomposition cache file", _read_pieces)
-        if cached is not None:
-            return cached
-    coacd.set_log_level("error")
-    parts = coacd.run_coacd(coacd.Mesh(V, F.astype(np.int32)), threshold=float(threshold), seed=c_seed(seed, "seed"),
-                            **_COACD_SEARCH)
-    pieces = [np.ascontiguousarray(p[0], dtype=np.float64) for p in parts if len(p[0]) >= 4]
-    if not pieces:
-        raise ValueError("vertices, faces: CoACD found no convex piece (does the mesh enclose a volume?)")
-    if path is not None:
-        # atomic and checksummed: concurrent runs never read a half-written file (bayesgrasp.cache)
-        atomic_write(path, lambda tmp: np.savez(tmp, count=len(pieces), **{f"piece_{i}": p for i, p in enumerate(pieces)}))
-    return pieces
-
-
-#: CoACD's search, lighter than its defaults (the lift test needs pieces near the hand's contacts,
-#: not the tightest decomposition; BENCHMARKS.md gives its time and pieces on the mug).
-_COACD_SEARCH = {"mcts_iterations": 50, "mcts_nodes": 10, "resolution": 1000, "max_ch_vertex": 48}
-
-
-def is_concave(vertices, faces, hand=None) -> bool:
+def is_concave(vertices, faces, hand=None, mass_properties=None) -> bool:
     """Whether the lift test counts the object as concave (its convex hull's volume more than
-    5% above its own): then ``shape="auto"`` needs a convex decomposition."""
+    5% above its own, the mesh's or ``mass_properties``'): then ``shape="auto"`` needs a convex
+    decomposition."""
     o = make_options(shape="hull")  # cheap: no tetrahedra, no pieces
-    return _core.physics.LiftTester(_hand(hand), np.asarray(vertices, dtype=float), np.asarray(faces), o).concave
-
-
-def _coacd_version() -> str:
-    try:
-        from importlib.metadata import version
-        return version("coacd")
-    except Exception:  # noqa: BLE001 - the version only salts the cache key
-        return "unknown"
+    return _core.physics.LiftTester(_hand(hand), np.asarray(vertices, dtype=float), np.asarray(faces), o,
+                                    None, mass_properties).concave
 
 
 class LiftTester:
@@ -162,19 +85,23 @@ class LiftTester:
         convex_pieces: the object's convex decomposition for shapes ``auto`` (concave objects)
             and ``decomposition``: a list of (K, 3) point arrays in the world frame, or None to
             compute it with :func:`convex_decomposition` (cached) when needed.
+        mass_properties: None (the closed mesh's at ``density``) or a core MassProperties in the
+            world frame (an open scan's or a weighed object's: ObjectModel.mass_properties_core,
+            placed).
         **options: LiftOptions fields (mu, density, table, shape, time_step, ...).
     """
 
-    def __init__(self, hand, vertices, faces, convex_pieces: Optional[Sequence] = None, **options):
+    def __init__(self, hand, vertices, faces, convex_pieces: Optional[Sequence] = None, mass_properties=None,
+                 **options):
         V, F = np.asarray(vertices, dtype=float), np.asarray(faces)
         o = make_options(**options)
         if convex_pieces is None and o.shape in ("auto", "decomposition"):
-            if o.shape == "decomposition" or is_concave(V, F, hand):
+            if o.shape == "decomposition" or is_concave(V, F, hand, mass_properties):
                 convex_pieces = convex_decomposition(V, F)
         elif convex_pieces is not None and (isinstance(convex_pieces, (str, bytes, np.ndarray))
                                             or not isinstance(convex_pieces, Sequence)):
             raise ValueError("convex_pieces: expected None or a list of (K, 3) arrays")
-        self._t = _core.physics.LiftTester(_hand(hand), V, F, o, convex_pieces)
+        self._t = _core.physics.LiftTester(_hand(hand), V, F, o, convex_pieces, mass_properties)
 
     @property
     def concave(self) -> bool:

@@ -69,6 +69,29 @@ TEST(PhysicsLift, WellGraspedBoxIsLifted) {
   EXPECT_EQ(r.steps, static_cast<int>(std::ceil((o.squeeze_time + o.lift_time + o.shake_time + o.hold_time) / o.time_step - 1e-9)));
 }
 
+// Given mass properties replace the mesh's: a heavier box at the same grasp weighs what it is
+// given; ill-formed ones are refused by name.
+TEST(PhysicsLift, GivenMassPropertiesReplaceTheMeshIntegral) {
+  BoxScene s;
+  LiftOptions o;
+  o.density = 400.0;
+  MassProperties m = LiftTester(s.hand, s.box, o).mass_properties();
+  m.inertia *= 0.5 / m.mass;
+  m.mass = 0.5;
+  const LiftTester given(s.hand, s.box, o, {}, m);
+  EXPECT_DOUBLE_EQ(given.mass_properties().mass, 0.5);
+  EXPECT_FALSE(given.concave());
+  MassProperties bad = m;
+  bad.mass = -1.0;
+  EXPECT_THROW(LiftTester(s.hand, s.box, o, {}, bad), std::invalid_argument);
+  bad = m;
+  bad.inertia(0, 1) += 1.0;  // not symmetric
+  EXPECT_THROW(LiftTester(s.hand, s.box, o, {}, bad), std::invalid_argument);
+  bad = m;
+  bad.volume = 0.5 * m.volume;  // the hull is then 2x the volume: concave
+  EXPECT_TRUE(LiftTester(s.hand, s.box, o, {}, bad).concave());
+}
+
 TEST(PhysicsLift, OpenHandLeavesTheBoxOnTheTable) {
   BoxScene s;
   const Eigen::VectorXd q = s.hand.coupled_joints(0.0, 0.0);  // fingers open, nothing touches

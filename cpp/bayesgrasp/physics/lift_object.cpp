@@ -135,9 +135,9 @@ void add_tetrahedra(LiftObject& o, const TriMesh& object, const std::vector<btVe
 }  // namespace
 
 LiftObject prepare_object(const TriMesh& object, const LiftOptions& options,
-                          const std::vector<Eigen::MatrixX3d>& convex_pieces) {
+                          const std::vector<Eigen::MatrixX3d>& convex_pieces, const std::optional<MassProperties>& mass) {
   LiftObject o;
-  o.mass = bayesgrasp::mass_properties(object, options.density);  // throws if no volume
+  o.mass = mass ? *mass : bayesgrasp::mass_properties(object, options.density);  // throws if no volume
   set_body_frame(o);
   const Iso3 inv = o.body0.inverse();
   const Eigen::Index nv = object.V.rows();

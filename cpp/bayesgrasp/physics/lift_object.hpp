@@ -7,6 +7,7 @@
 #include <btBulletDynamicsCommon.h>
 
 #include <array>
+#include <optional>
 #include <vector>
 
 #include "bayesgrasp/hand/hand_model.hpp"
@@ -27,10 +28,13 @@ struct LiftObject {
   std::vector<std::vector<btVector3>> pieces;  // Decomposition: each piece's hull (body frame, Bullet units, shrunk)
 };
 
-/// Prepares the object (mesh and options already validated); throws std::invalid_argument for
-/// a mesh enclosing no volume or a convex piece that is not finite or spans no volume.
+/// Prepares the object (mesh, options and `mass` already validated); throws
+/// std::invalid_argument for a mesh enclosing no volume (when `mass` is not given) or a convex
+/// piece that is not finite or spans no volume. `mass`: given mass properties (world frame),
+/// else the mesh's at options.density.
 LiftObject prepare_object(const TriMesh& object, const LiftOptions& options,
-                          const std::vector<Eigen::MatrixX3d>& convex_pieces);
+                          const std::vector<Eigen::MatrixX3d>& convex_pieces,
+                          const std::optional<MassProperties>& mass = std::nullopt);
 
 /// The shape for one grasp (link poses in the world): the prepared shape, except that Auto on
 /// a concave object uses the hull unless some hand link reaches more than 1 mm into it (then

@@ -3,6 +3,8 @@
 // table (lift_object), the hand (hand_bodies), the script and its outcome (lift_script).
 #include "bayesgrasp/physics/lift_test.hpp"
 
+#include <Eigen/Eigenvalues>
+#include <algorithm>
 #include <cmath>
 #include <stdexcept>
 #include <string>
@@ -53,6 +55,19 @@ void validate(const LiftOptions& o) {
   if (!(physics::script_steps(o) >= 1)) throw std::invalid_argument("time_step: the script has no step");
 }
 
+void validate(const MassProperties& m) {
+  require_positive(m.volume, "mass_properties.volume");
+  require_positive(m.mass, "mass_properties.mass");
+  if (!m.com.allFinite()) throw std::invalid_argument("mass_properties.com contains NaN or infinity");
+  if (!m.inertia.allFinite()) throw std::invalid_argument("mass_properties.inertia contains NaN or infinity");
+  const double scale = std::max(1e-30, m.inertia.cwiseAbs().maxCoeff());
+  if (!((m.inertia - m.inertia.transpose()).cwiseAbs().maxCoeff() <= 1e-9 * scale))
+    throw std::invalid_argument("mass_properties.inertia must be symmetric");
+  const Eigen::SelfAdjointEigenSolver<Mat3> es(m.inertia);
+  if (!(es.eigenvalues().minCoeff() >= -1e-9 * scale))
+    throw std::invalid_argument("mass_properties.inertia must be positive semi-definite");
+}
+
 namespace {
 
 void check_pose(const Iso3& hand_pose, const std::string& name) {
@@ -62,10 +77,11 @@ void check_pose(const Iso3& hand_pose, const std::string& name) {
 }  // namespace
 
 LiftTester::LiftTester(const HandModel& hand, const TriMesh& object, const LiftOptions& options,
-                       const std::vector<Eigen::MatrixX3d>& convex_pieces)
+                       const std::vector<Eigen::MatrixX3d>& convex_pieces, const std::optional<MassProperties>& mass)
     : impl_(std::make_unique<Impl>()) {
   validate(options);
   validate_mesh(object);
+  if (mass) validate(*mass);
   if (!(options.finger_torque > 0))
     for (const Finger& f : hand.fingers())
       for (const Phalanx& p : f.phalanges)
@@ -74,7 +90,7 @@ LiftTester::LiftTester(const HandModel& hand, const TriMesh& object, const LiftO
                                       " (torque_nm in the hand file); pass finger_torque > 0");
   impl_->hand = hand;
   impl_->opt = options;
-  impl_->object = physics::prepare_object(object, options, convex_pieces);
+  impl_->object = physics::prepare_object(object, options, convex_pieces, mass);
 }
 
 LiftTester::~LiftTester() = default;

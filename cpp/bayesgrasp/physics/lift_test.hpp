@@ -119,6 +119,7 @@
 #include <vector>
 
 #include <Eigen/Core>
+#include <optional>
 
 #include "bayesgrasp/geometry/mesh.hpp"
 #include "bayesgrasp/hand/hand_model.hpp"
@@ -162,6 +163,10 @@ struct LiftOptions {
 
 /// Throws std::invalid_argument naming the first bad field (and a script of no or too many steps).
 void validate(const LiftOptions& options);
+
+/// Throws std::invalid_argument unless volume and mass are > 0, com finite and inertia finite,
+/// symmetric and positive semi-definite (given mass properties of a lift-test object).
+void validate(const MassProperties& mass);
 
 /// One contact between a hand link and the object in a traced step (world frame).
 struct LiftContact {
@@ -210,8 +215,12 @@ class LiftTester {
   /// Auto for concave objects. Throws std::invalid_argument for a bad mesh, a mesh
   /// enclosing no volume, bad options, a piece that is not finite or spans no volume, or a hand
   /// without a torque for some phalanx (torque_nm) when options.finger_torque is 0.
+  /// `mass`: the object's mass properties (world frame) when the caller knows them better than
+  /// the mesh's closed-surface integral at options.density does (an open scan, a weighed
+  /// object); checked by validate(MassProperties). None: computed from the mesh.
   LiftTester(const HandModel& hand, const TriMesh& object, const LiftOptions& options = {},
-             const std::vector<Eigen::MatrixX3d>& convex_pieces = {});
+             const std::vector<Eigen::MatrixX3d>& convex_pieces = {},
+             const std::optional<MassProperties>& mass = std::nullopt);
   ~LiftTester();
   LiftTester(LiftTester&&) noexcept;
   LiftTester& operator=(LiftTester&&) noexcept;

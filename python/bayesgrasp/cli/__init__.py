@@ -11,6 +11,7 @@ Sub-commands:
   fuse        vision then touch: per-model poses and weights from the fingers (Eqs. 4.4-4.6)
   register    simulated depth view, table segmentation, registration against models
   objects     list the built-in objects
+  parts       label a mesh's triangles by simple rules (its part label file)
   touch       what one touch tells about an object's pose and size (Pub. I)
 
 Comma-separated numbers may start with a minus sign: ``--top -0.01,0,0``.
@@ -20,12 +21,13 @@ from __future__ import annotations
 import argparse
 import os
 import sys
+import warnings
 
-from . import category, episode, experiment, fuse, grasp, objects, plan, register, results, touch, view
+from . import category, episode, experiment, fuse, grasp, objects, parts, plan, register, results, touch, view
 from .. import __version__
 from .args import CliError, join_negative_values
 
-COMMANDS = (grasp, plan, episode, category, fuse, experiment, results, register, objects, touch, view)
+COMMANDS = (grasp, plan, episode, category, fuse, experiment, results, register, objects, parts, touch, view)
 
 
 class HelpFormatter(argparse.RawDescriptionHelpFormatter):
@@ -57,12 +59,18 @@ def build_parser() -> argparse.ArgumentParser:
     return parser
 
 
+def _one_line_warning(message, category, filename, lineno, line=None) -> str:
+    """A warning as the command's user reads it: one line, no source location."""
+    return f"bayesgrasp: warning: {message}\n"
+
+
 def main(argv=None) -> int:
     parser = build_parser()
     args = parser.parse_args(join_negative_values(sys.argv[1:] if argv is None else list(argv)))
     if args.command is None:
         parser.print_help()
         return 0
+    warnings.formatwarning = _one_line_warning
     try:
         return args.run(args)
     except (CliError, ValueError, FileNotFoundError) as e:

@@ -97,6 +97,33 @@ def add_hand_option(p: argparse.ArgumentParser) -> None:
                    help="built-in hand name, hand file or URDF (with its NAME.hand.json sidecar)")
 
 
+def add_object_options(p: argparse.ArgumentParser, units: bool = True) -> None:
+    """--mass (and --units, unless the command's camera options give it) for --object's mesh."""
+    if units:
+        p.add_argument("--units", default=None, choices=["m", "cm", "mm"],
+                       help="length unit of an --object mesh file (default m)")
+    p.add_argument("--mass", type=float, default=None, metavar="KG",
+                   help="the object's weight (a scale's reading, kg): sets its density; default: its volume "
+                        "at 1000 kg/m^3 (a built-in's own density)")
+
+
+def object_arg(args: argparse.Namespace, option: str = "--object"):
+    """--object loaded once with --units and --mass (an ObjectModel); a problem with the mesh is a
+    CliError naming ``--object FILE``. Without --units or --mass: the name as given."""
+    name = getattr(args, option.lstrip("-").replace("-", "_"))
+    units, mass = getattr(args, "units", None), getattr(args, "mass", None)
+    if mass is not None and not (math.isfinite(mass) and mass > 0):
+        raise CliError(f"--mass: must be a weight > 0 kg, got {mass}")
+    if units is None and mass is None:
+        return name
+    from ..objects import load_object
+
+    try:
+        return load_object(name, units=units, mass=mass)
+    except (ValueError, FileNotFoundError) as e:
+        raise CliError(f"{option} {name}: {e}") from None
+
+
 def add_seed_option(p: argparse.ArgumentParser, help: str = "seed of every random draw (same seed, same result)") -> None:
     """--seed, as every command takes it (RunContext.seed)."""
     p.add_argument("--seed", type=bounded_int(0, SEED_MAX), default=0, help=help)

@@ -21,7 +21,8 @@ from pathlib import Path
 
 import numpy as np
 
-from .args import CliError, Renamed, add_format_options, add_hand_option, add_view_option, floats, output_file, output_format
+from .args import (CliError, Renamed, add_format_options, add_hand_option, add_object_options, add_view_option, floats,
+                   object_arg, output_file, output_format)
 
 
 def add(sub) -> None:
@@ -45,6 +46,7 @@ def add(sub) -> None:
     g.add_argument("--standoff", type=float, default=0.0,
                    help="with --top / --approach: back off this far from the first contact before closing (m)")
     add_hand_option(g)
+    add_object_options(g)
     g.add_argument("--keep-origin", action="store_true", help="keep a loaded mesh's own origin")
     g.add_argument("--no-lift", action="store_true", help="skip the physical lift test")
     g.add_argument("--lift-trace", action="store_true",
@@ -57,16 +59,13 @@ def add(sub) -> None:
 
 def run(args) -> int:
     from ..io.grasp_schema import hand_grasp_record, to_ros
-    from ..world import World
 
     if args.approach is None and (args.roll is not None or args.at is not None):
         raise CliError(f"{'--roll' if args.roll is not None else '--at'}: only with --approach")
     png = output_file(args.png, "--png")
     pose = floats(args.object_pose, 3, "--object-pose")
     request = _request(args)
-    # load_object names the problem (unknown name, missing file, not a mesh) in a ValueError
-    world = World.single(args.object, pose=pose, keep_origin=args.keep_origin, hand=args.hand,
-                         standoff=args.standoff)
+    world = _world(args, pose)
     grasp = _grasp(world, args, request)
     g = grasp.to_dict()
     out = {
@@ -79,6 +78,7 @@ def run(args) -> int:
         "hand_pose": np.asarray(g["hand_pose"]).tolist(),
         "mode": request["mode"], "frame": args.frame, "approach": request.get("approach"), "pose": request.get("pose"),
         "stopped_by_table": g["stopped_by_table"], "hand_pose_object": np.asarray(g["hand_pose_object"]).tolist(),
+        "mass": _mass_used(world.object),
     }
     out["grasp"] = hand_grasp_record(world.hand, g["hand_pose"], g["joint_angles"], world.spread if args.spread is None else args.spread)
     if args.lift_trace:
@@ -147,6 +147,34 @@ def _read_pose(path: str) -> list:
     return M.tolist()
 
 
+def _world(args, pose):
+    """The world with --object (in --units, weighing --mass) and, unless --no-lift, its lift test
+    prepared; a problem with the mesh is a CliError naming ``--object FILE``."""
+    from ..objects import load_object
+    from ..world import World
+
+    obj = object_arg(args)
+    try:
+        obj = load_object(obj)
+    except (ValueError, FileNotFoundError) as e:
+        raise CliError(f"--object {args.object}: {e}") from None
+    world = World.single(obj, pose=pose, keep_origin=args.keep_origin, hand=args.hand, standoff=args.standoff)
+    if not args.no_lift:
+        try:
+            world.lift_tester()
+        except ValueError as e:
+            raise CliError(f"--object {args.object}: {e}") from None
+    return world
+
+
+def _mass_used(obj) -> dict:
+    """The mass the lift test uses and where it comes from."""
+    how = {"mesh": "its closed mesh", "fill": "the solid its open mesh bounds (sampled)",
+           "shell": "its open mesh as a thin shell"}[obj.mass_method]
+    return {"kg": float(obj.mass), "from": "given (--mass)" if obj.given_mass is not None else how,
+            "density": float(obj.density)}
+
+
 def _grasp(world, args, request):
     """The world's grasp for the request; the world's ValueErrors (direction of zero length,
     target off the table, a pose that is not rigid, ...) are prefixed with the option."""
@@ -187,6 +215,7 @@ def _describe(out: dict) -> str:
 
 def _print(out: dict, name: str, pose) -> None:
     print(f"{out['hand']} on {name} at object pose {pose}, {_describe(out)} ({out['frame']} frame)")
+    print(f"  object mass {out['mass']['kg']:.3f} kg, from {out['mass']['from']}")
     if out["collision_at_start"]:
         print("  the open hand starts in collision: no grasp")
     if out["stopped_by_table"]:

@@ -357,7 +357,8 @@ def builtin(name: str, density: Optional[float] = None,
     return generate(p, name=name, use_boolean=use_boolean, density=density)
 
 
-def load_object(name_or_path, density: Optional[float] = None, units: Optional[str] = None) -> ObjectModel:
+def load_object(name_or_path, density: Optional[float] = None, units: Optional[str] = None,
+                mass: Optional[float] = None) -> ObjectModel:
     """A built-in object by name (``"mug"``, ``"mug/3"``, ``"bottle/7"``), a mesh file by path, or
     an in-memory ``trimesh.Trimesh`` / Open3D ``TriangleMesh``.
 
@@ -368,6 +369,7 @@ def load_object(name_or_path, density: Optional[float] = None, units: Optional[s
             :data:`~bayesgrasp.objects.mesh_io.DEFAULT_DENSITY` for files.
         units: the length unit of a file or mesh object (``"m"`` default, ``"cm"``, ``"mm"``); an
             extent outside 5 mm .. 2 m is refused with the likely unit named.
+        mass: kg (a scale's reading): sets the density to mass / volume (not with ``density``).
 
     Raises:
         ValueError: neither a built-in name nor an existing file (the message lists the names), or
@@ -380,20 +382,23 @@ def load_object(name_or_path, density: Optional[float] = None, units: Optional[s
 
     from .mesh_io import MESH_EXTENSIONS, load_mesh, mesh_from_object
 
+    if mass is not None and density is not None:
+        raise ValueError("mass, density: give one of them (the mass sets the density)")
     if isinstance(name_or_path, ObjectModel):
-        return name_or_path
+        return name_or_path if mass is None else name_or_path.with_mass(mass)
     if hasattr(name_or_path, "vertices") and (hasattr(name_or_path, "faces") or hasattr(name_or_path, "triangles")) \
             or hasattr(name_or_path, "to_legacy"):
-        return mesh_from_object(name_or_path, density=density, units=units)
+        return mesh_from_object(name_or_path, density=density, units=units, mass=mass)
     if not isinstance(name_or_path, (str, os.PathLike)):
         raise ValueError(f"name_or_path must be a built-in name or a file path, got "
                          f"{type(name_or_path).__name__}")
     s = os.fspath(name_or_path)
     if isinstance(name_or_path, str) and object_params(s) is not None:
-        return builtin(s, density=density)
+        obj = builtin(s, density=density)
+        return obj if mass is None else obj.with_mass(mass)
     p = Path(s)
     if p.is_file():
-        return load_mesh(p, density=density, units=units)
+        return load_mesh(p, density=density, units=units, mass=mass)
     if p.suffix.lower() in MESH_EXTENSIONS or os.sep in s and not _NAME_RE.match(s):
         raise FileNotFoundError(f"mesh file not found: '{s}' (and it is not a built-in object name)")
     raise ValueError(f"'{s}' is neither a built-in object nor an existing file; built-in objects: "

@@ -8,7 +8,8 @@ An :class:`ObjectModel` is a closed triangle mesh in metres (vertices ``(N, 3)``
 Bad input raises clear exceptions: a missing file :class:`FileNotFoundError`, a file that is not a
 mesh or has an unsupported extension :class:`ValueError`, a mesh without faces or with non-finite
 vertices :class:`ValueError`. A mesh that is not watertight only warns (:class:`MeshWarning`); its
-mass properties are then computed from its convex hull.
+mass properties are then those of the solid it bounds, found by sampling, or of a thin shell
+(:mod:`bayesgrasp.objects.mass`). ``mass=`` (kg, a scale's reading) sets the density instead.
 """
 from __future__ import annotations
 
@@ -20,6 +21,7 @@ from typing import Optional, Tuple, Union
 
 import numpy as np
 
+from . import mass as _mass
 from .topology import _check_solid, mesh_is_watertight, orient_outward
 
 #: Default density for meshes loaded from files, kg/m^3. Water's density: typical of household
@@ -33,13 +35,6 @@ MESH_EXTENSIONS = (".obj", ".stl", ".ply")
 
 class MeshWarning(UserWarning):
     """A mesh problem that does not stop loading (e.g. it is not watertight)."""
-
-
-def _core_mass_properties(V: np.ndarray, F: np.ndarray, density: float):
-    """The core's MassProperties of a closed mesh."""
-    from bayesgrasp import _core
-
-    return _core.geometry.mass_properties(V, F, float(density))
 
 
 @dataclass
@@ -57,8 +52,10 @@ class ObjectModel:
             (see :mod:`bayesgrasp.objects.parts`).
 
     Mass properties (``volume``, ``mass``, ``com``, ``inertia`` about the centre of mass, in this
-    frame) are computed once at construction. For a mesh that is not watertight they come from its
-    convex hull (``mass_from_hull`` is then True).
+    frame) are computed once at construction; ``mass_method`` says how: ``"mesh"`` (closed: exact),
+    ``"fill"`` (open: the solid it bounds, sampled) or ``"shell"`` (open and enclosing nothing: a
+    thin wall), see :mod:`bayesgrasp.objects.mass`. ``mass`` (kg), if given, sets the density
+    (mass / volume).
     """
 
     name: str
@@ -70,6 +67,9 @@ class ObjectModel:
     warn_if_open: bool = True
     parts: Optional[np.ndarray] = None
     part_names: Tuple[str, ...] = ()
+    given_mass: Optional[float] = None
+    #: mass properties already known in this frame (a rigid copy's), with their method
+    known_mass: Optional[tuple] = field(default=None, repr=False, compare=False)
 
     def __post_init__(self):
         V = np.ascontiguousarray(np.asarray(self.vertices, dtype=np.float64))
@@ -100,19 +100,26 @@ class ObjectModel:
             raise ValueError(f"part_names of '{self.name}' given without parts")
         _check_solid(self.vertices, self.faces, self.name)
         self._watertight = mesh_is_watertight(self.faces)
-        self.mass_from_hull = not self._watertight
-        if self._watertight:
-            mp = _core_mass_properties(self.vertices, self.faces, self.density)
+        if self.known_mass is not None:
+            self._mp, self.mass_method = self.known_mass
+        elif self._watertight:
+            self._mp, self.mass_method = _mass.closed_mass_properties(self.vertices, self.faces, self.density), "mesh"
         else:
+            self._mp, self.mass_method = _mass.open_mass_properties(self.vertices, self.faces, self.density)
             if self.warn_if_open:
-                warnings.warn(
-                    f"mesh '{self.name}' ({self.source or 'in memory'}) is not watertight: "
-                    "its mass properties are computed from its convex hull (best effort)",
-                    MeshWarning, stacklevel=3)
-            hull = self.to_trimesh().convex_hull
-            mp = _core_mass_properties(np.asarray(hull.vertices, dtype=np.float64),
-                                       np.asarray(hull.faces, dtype=np.int32), self.density)
-        self._mp = mp
+                how = ("the solid it bounds (sampled)" if self.mass_method == "fill" else
+                       f"a {1000 * _mass.DEFAULT_SHELL_THICKNESS:g} mm shell (it encloses no volume)")
+                warnings.warn(f"mesh '{self.name}' ({self.source or 'in memory'}) is not watertight: its mass "
+                              f"properties are those of {how}; pass mass= (--mass) to give its weight",
+                              MeshWarning, stacklevel=3)
+        self.known_mass = None
+        if self.given_mass is not None:
+            if not (np.isfinite(self.given_mass) and self.given_mass > 0):
+                raise ValueError(f"mass must be finite and > 0 kg, got {self.given_mass}")
+            self.given_mass = float(self.given_mass)
+            if self._mp.mass != self.given_mass:
+                self._mp = _mass.with_mass(self._mp, self.given_mass)
+            self.density = self.given_mass / self._mp.volume
 
     # ---- mass properties -------------------------------------------------------------------
     @property
@@ -170,7 +177,20 @@ class ObjectModel:
         V = self.vertices @ T[:3, :3].T + T[:3, 3]
         return ObjectModel(name or self.name, V, self.faces.copy(), self.density, self.source,
                            dict(self.params), warn_if_open=False,
-                           parts=None if self.parts is None else self.parts.copy(), part_names=self.part_names)
+                           parts=None if self.parts is None else self.parts.copy(), part_names=self.part_names,
+                           given_mass=self.given_mass, known_mass=(_mass.moved(self._mp, T), self.mass_method))
+
+    def with_mass(self, mass: float) -> "ObjectModel":
+        """A copy weighing ``mass`` kg (a scale's reading): same shape, density = mass / volume."""
+        return ObjectModel(self.name, self.vertices.copy(), self.faces.copy(), self.density, self.source,
+                           dict(self.params), warn_if_open=False,
+                           parts=None if self.parts is None else self.parts.copy(), part_names=self.part_names,
+                           given_mass=mass, known_mass=(self._mp, self.mass_method))
+
+    @property
+    def mass_properties_core(self):
+        """The core's MassProperties (this frame), e.g. for the lift test."""
+        return self._mp
 
     def part_of_faces(self, faces) -> np.ndarray:
         """The part names (array of str) of triangles given by index; ValueError without labels."""
@@ -202,7 +222,8 @@ class ObjectModel:
 
 
 def load_mesh(path: Union[str, os.PathLike], density: Optional[float] = None,
-              name: Optional[str] = None, units: Optional[str] = None) -> ObjectModel:
+              name: Optional[str] = None, units: Optional[str] = None,
+              mass: Optional[float] = None) -> ObjectModel:
     """Load an OBJ, STL or PLY triangle mesh as an :class:`ObjectModel` in metres.
 
     Vertices are merged (STL stores each triangle separately), inconsistent face winding is made
@@ -213,6 +234,7 @@ def load_mesh(path: Union[str, os.PathLike], density: Optional[float] = None,
         density: kg/m^3 (default :data:`DEFAULT_DENSITY`).
         name: object name (default: the file's stem).
         units: the file's length unit, ``"m"`` (default), ``"cm"`` or ``"mm"``.
+        mass: kg (a scale's reading): the density becomes mass / volume (not with ``density``).
 
     Raises:
         FileNotFoundError: the file does not exist.
@@ -220,7 +242,8 @@ def load_mesh(path: Union[str, os.PathLike], density: Optional[float] = None,
             extent outside 5 mm .. 2 m (the message names the likely unit).
 
     Warns:
-        MeshWarning: the mesh is not watertight (mass properties then from its convex hull).
+        MeshWarning: the mesh is not watertight (mass properties then of the solid it bounds, or
+            of a thin shell: :mod:`bayesgrasp.objects.mass`).
     """
     import trimesh
 
@@ -249,11 +272,15 @@ def load_mesh(path: Union[str, os.PathLike], density: Optional[float] = None,
     F = np.asarray(loaded.faces)
     if len(V) == 0 and len(F) == 0:
         raise ValueError(f"'{p}' is not a {ext[1:].upper()} mesh: no vertices or faces could be read")
-    return _object_from_arrays(V, F, f"'{p}'", name or p.stem, density, units, source=str(p), label_path=p)
+    if mass is not None and density is not None:
+        raise ValueError("mass, density: give one of them (the mass sets the density)")
+    obj = _object_from_arrays(V, F, f"'{p}'", name or p.stem, density, units, source=str(p), label_path=p,
+                              warn_if_open=mass is None)
+    return obj if mass is None else obj.with_mass(mass)
 
 
 def mesh_from_object(mesh, name: str = "mesh", density: Optional[float] = None,
-                     units: Optional[str] = None) -> ObjectModel:
+                     units: Optional[str] = None, mass: Optional[float] = None) -> ObjectModel:
     """An :class:`ObjectModel` from an in-memory mesh: a ``trimesh.Trimesh``, an
     ``open3d.geometry.TriangleMesh`` or an ``open3d.t.geometry.TriangleMesh`` (the input is not
     modified; the same repairs and checks as :func:`load_mesh`)."""
@@ -265,12 +292,16 @@ def mesh_from_object(mesh, name: str = "mesh", density: Optional[float] = None,
         V, F = np.asarray(mesh.vertices), np.asarray(mesh.triangles)
     else:
         raise ValueError(f"{name}: expected a trimesh.Trimesh or an Open3D TriangleMesh, got {type(mesh).__name__}")
-    return _object_from_arrays(np.array(V, dtype=np.float64), np.array(F), name, name, density, units,
-                               source=f"in memory ({type(mesh).__name__})")
+    if mass is not None and density is not None:
+        raise ValueError("mass, density: give one of them (the mass sets the density)")
+    obj = _object_from_arrays(np.array(V, dtype=np.float64), np.array(F), name, name, density, units,
+                              source=f"in memory ({type(mesh).__name__})", warn_if_open=mass is None)
+    return obj if mass is None else obj.with_mass(mass)
 
 
 def _object_from_arrays(V: np.ndarray, F: np.ndarray, what: str, name: str, density: Optional[float],
-                        units: Optional[str], source: str, label_path: Optional[Path] = None) -> ObjectModel:
+                        units: Optional[str], source: str, label_path: Optional[Path] = None,
+                        warn_if_open: bool = True) -> ObjectModel:
     """The shared checks and repairs of a mesh given as vertex and face arrays, scaled to metres."""
     import trimesh
 
@@ -297,21 +328,25 @@ def _object_from_arrays(V: np.ndarray, F: np.ndarray, what: str, name: str, dens
     F = np.asarray(mesh.faces, dtype=np.int64)
     # drop faces that collapse to a line or point (repeated indices)
     keep = (F[:, 0] != F[:, 1]) & (F[:, 1] != F[:, 2]) & (F[:, 2] != F[:, 0])
-    parts, part_names = _label_file(label_path, len(F)) if label_path is not None else (None, ())
+    parts, part_names = _label_file(label_path, keep) if label_path is not None else (None, ())
     F = F[keep]
     if len(F) == 0:
         raise ValueError(f"{what}: mesh has no non-degenerate faces")
     F = orient_outward(V, F)
     d = DEFAULT_DENSITY if density is None else density
-    return ObjectModel(name, V, F.astype(np.int32), d, source=source,
-                       parts=None if parts is None else parts[keep], part_names=part_names)
+    return ObjectModel(name, V, F.astype(np.int32), d, source=source, parts=parts, part_names=part_names,
+                       warn_if_open=warn_if_open)
 
 
-def _label_file(mesh_path: Path, n_faces: int):
-    """The mesh's part labels from ``<stem>.parts.json`` beside it, if there is one."""
+def _label_file(mesh_path: Path, keep: np.ndarray):
+    """The mesh's part labels from ``<stem>.parts.json`` beside it, if there is one, for the
+    loaded faces: a label per triangle of the file (file order; the degenerate ones' labels are
+    dropped with them) or, the same labels already without them, one per loaded face."""
     from .parts import label_file_for, load_part_labels
 
     f = label_file_for(mesh_path)
     if not f.is_file():
         return None, ()
-    return load_part_labels(f, n_faces)
+    n_file, n_loaded = len(keep), int(np.count_nonzero(keep))
+    parts, names = load_part_labels(f, (n_file, n_loaded))
+    return (parts[keep] if len(parts) == n_file else parts), names

@@ -108,8 +108,11 @@ def check_part_labels(labels, names: Sequence[str], n_faces: int, what: str = "p
     return np.ascontiguousarray(a, dtype=np.int32), names
 
 
-def load_part_labels(path, n_faces: int) -> PartLabels:
-    """A user's label file: JSON ``{"parts": [names], "faces": [part index per triangle]}``."""
+def load_part_labels(path, n_faces) -> PartLabels:
+    """A user's label file: JSON ``{"parts": [names], "faces": [part index per triangle]}``.
+
+    ``n_faces``: the triangle count the labels must have, or a pair (the file's triangles, the
+    loaded mesh's faces after its degenerate triangles were dropped): either count is accepted."""
     p = Path(path)
     try:
         doc = json.loads(p.read_text())
@@ -117,7 +120,17 @@ def load_part_labels(path, n_faces: int) -> PartLabels:
         raise ValueError(f"part labels {p}: cannot read ({e})") from None
     if not isinstance(doc, dict) or "parts" not in doc or "faces" not in doc:
         raise ValueError(f"part labels {p}: expected an object with keys 'parts' and 'faces'")
-    return check_part_labels(doc["faces"], doc["parts"], n_faces, what=f"part labels {p}")
+    what = f"part labels {p}"
+    if isinstance(n_faces, tuple):
+        n_file, n_loaded = n_faces
+        got = np.shape(doc["faces"])
+        if got in ((n_file,), (n_loaded,)):
+            return check_part_labels(doc["faces"], doc["parts"], got[0], what=what)
+        counts = (f"{n_file}, one per triangle of the mesh file in file order" if n_file == n_loaded else
+                  f"{n_file}, one per triangle of the mesh file in file order, or {n_loaded}, one per "
+                  f"face of the loaded mesh ({n_file - n_loaded} degenerate triangles dropped)")
+        raise ValueError(f"{what}: expected {counts}; got shape {got}")
+    return check_part_labels(doc["faces"], doc["parts"], n_faces, what=what)
 
 
 def label_file_for(mesh_path) -> Path:

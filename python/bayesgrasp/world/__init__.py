@@ -41,6 +41,7 @@ from .. import physics, quality
 from .. import DEFAULT_HAND
 from ..hand import Hand
 from ..objects import ObjectModel, Scene
+from ..objects.mass import moved
 from ..objects.scene import planar_pose_matrix
 from ..sim import GraspSimulator
 from .results import ContactRecord, WorldGrasp, WorldGraspBatch
@@ -286,14 +287,21 @@ class World:
                           bool(b.stopped_by_table[0]), b.hand_pose_object[0], b.joint_names)
 
     def lift_tester(self) -> physics.LiftTester:
+        """The object's lift tests (prepared once per pose). A closed mesh of its own density
+        weighs what its world-frame mesh integrates to (the core computes it); an open scan or a
+        weighed object takes the ObjectModel's mass properties, placed in the world."""
         if self._lift is None:
             pieces = None
-            if physics.is_concave(self.vertices, self.faces, self.hand.core):
+            obj, T = self.object, self.scene.object_pose(self.object_index)
+            given = obj.mass_method != "mesh" or obj.given_mass is not None
+            mass = moved(obj.mass_properties_core, T) if given else None
+            if physics.is_concave(self.vertices, self.faces, self.hand.core, mass):
                 # Decompose the object-frame mesh (cached across poses), then place the pieces.
-                obj, T = self.object, self.scene.object_pose(self.object_index)
-                pieces = [p @ T[:3, :3].T + T[:3, 3] for p in physics.convex_decomposition(obj.vertices, obj.faces)]
+                pieces = [p @ T[:3, :3].T + T[:3, 3]
+                          for p in physics.convex_decomposition(obj.vertices, obj.faces, name=obj.name)]
             self._lift = physics.LiftTester(self.hand.core, self.vertices, self.faces, convex_pieces=pieces,
-                                            mu=self.mu, density=self.object.density, table=self.table)
+                                            mass_properties=mass, mu=self.mu, density=self.object.density,
+                                            table=self.table)
         return self._lift
 
 
