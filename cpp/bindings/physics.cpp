@@ -312,6 +312,24 @@ Args:
 angles (HandModel layout); trace_every: record a LiftTrace every that many steps (0: none).
 A LiftResult (its ``trace`` the LiftTrace or None).)doc")
       .def(
+          "shapes",
+          [](const LiftTester& t, const DArray& hand_poses, const DArray& joints) {
+            const std::vector<Iso3> P = poses(hand_poses, "hand_poses");
+            const RowMatrixXd J = matrix(joints, "joints", -1, true);
+            std::vector<LiftOptions::Shape> s;
+            {
+              py::gil_scoped_release release;
+              s = t.shapes(P, J);
+            }
+            py::list out;
+            for (const LiftOptions::Shape x : s) out.append(shape_name(x));
+            return out;
+          },
+          py::arg("hand_poses"), py::arg("joints"),
+          R"doc(The shape each grasp's lift test would use ('hull', 'tetrahedra' or 'decomposition'),
+without simulating: under 'auto' on a concave object the hull unless a hand link reaches into it.
+hand_poses: (N, 4, 4); joints: (N, J). A list of str.)doc")
+      .def(
           "run_batch",
           [](const LiftTester& t, const DArray& hand_poses, const DArray& joints, int threads) {
             const std::vector<Iso3> P = poses(hand_poses, "hand_poses");

@@ -28,7 +28,7 @@ from __future__ import annotations
 
 import os
 from pathlib import Path
-from typing import Optional, Sequence
+from typing import List, Sequence
 
 from bayesgrasp._args import c_int
 import numpy as np
@@ -79,29 +79,52 @@ def is_concave(vertices, faces, hand=None, mass_properties=None) -> bool:
 class LiftTester:
     """Lift tests of one object (V, F in the world frame) with one hand.
 
+    A concave object's convex decomposition is made when the first grasp needs it, not before:
+    under ``shape="auto"`` a grasp whose hand stays outside the object's hull is tested on the
+    hull, so a can grasped around its side never waits for CoACD (the verdicts are those of the
+    tester with the pieces given up front: the same shape for every grasp).
+
     Args:
         hand: path to a hand JSON file (None: the built-in Barrett hand) or a HandModel.
         vertices: (N, 3) object vertices (m). faces: (M, 3) int triangles.
         convex_pieces: the object's convex decomposition for shapes ``auto`` (concave objects)
-            and ``decomposition``: a list of (K, 3) point arrays in the world frame, or None to
-            compute it with :func:`convex_decomposition` (cached) when needed.
+            and ``decomposition``: a list of (K, 3) point arrays in the world frame, a callable
+            returning that list when first needed, or None to compute it with
+            :func:`convex_decomposition` (cached) when first needed.
         mass_properties: None (the closed mesh's at ``density``) or a core MassProperties in the
             world frame (an open scan's or a weighed object's: ObjectModel.mass_properties_core,
             placed).
         **options: LiftOptions fields (mu, density, table, shape, time_step, ...).
     """
 
-    def __init__(self, hand, vertices, faces, convex_pieces: Optional[Sequence] = None, mass_properties=None,
-                 **options):
+    def __init__(self, hand, vertices, faces, convex_pieces=None, mass_properties=None, **options):
         V, F = np.asarray(vertices, dtype=float), np.asarray(faces)
         o = make_options(**options)
-        if convex_pieces is None and o.shape in ("auto", "decomposition"):
-            if o.shape == "decomposition" or is_concave(V, F, hand, mass_properties):
-                convex_pieces = convex_decomposition(V, F)
-        elif convex_pieces is not None and (isinstance(convex_pieces, (str, bytes, np.ndarray))
-                                            or not isinstance(convex_pieces, Sequence)):
-            raise ValueError("convex_pieces: expected None or a list of (K, 3) arrays")
-        self._t = _core.physics.LiftTester(_hand(hand), V, F, o, convex_pieces, mass_properties)
+        pending = None
+        if callable(convex_pieces):
+            pending, convex_pieces = convex_pieces, None
+        elif convex_pieces is None:
+            pending = lambda: convex_decomposition(V, F)  # noqa: E731
+        elif isinstance(convex_pieces, (str, bytes, np.ndarray)) or not isinstance(convex_pieces, Sequence):
+            raise ValueError("convex_pieces: expected None, a callable or a list of (K, 3) arrays")
+        if o.shape not in ("auto", "decomposition"):
+            pending = None
+        elif pending is not None and o.shape == "decomposition":
+            convex_pieces, pending = pending(), None
+        self._make = lambda pieces: _core.physics.LiftTester(_hand(hand), V, F, o, pieces, mass_properties)  # noqa: E731
+        self._t = self._make(convex_pieces)
+        self._pending = pending if pending is not None and self._t.concave else None
+
+    def _decompose(self) -> None:
+        """Makes the postponed decomposition and the tester that uses it."""
+        if self._pending is not None:
+            pieces, self._pending = self._pending(), None
+            self._t = self._make(pieces)
+
+    def _ready_for(self, hand_poses: np.ndarray, joints: np.ndarray) -> None:
+        """Decomposes first if one of these grasps needs the concave shape."""
+        if self._pending is not None and any(s != "hull" for s in self._t.shapes(hand_poses, joints)):
+            self._decompose()
 
     @property
     def concave(self) -> bool:
@@ -110,7 +133,8 @@ class LiftTester:
 
     @property
     def num_pieces(self) -> int:
-        """Convex pieces of the decomposition in use (0: none)."""
+        """Convex pieces of the decomposition in use (0: none; asking makes a postponed one)."""
+        self._decompose()
         return self._t.num_pieces
 
     @property
@@ -120,20 +144,31 @@ class LiftTester:
     @property
     def shape(self) -> str:
         """Shape prepared: 'hull', 'tetrahedra' or 'decomposition' (auto on a concave object
-        still uses the hull for grasps that stay outside it; see the results' ``shape``)."""
+        still uses the hull for grasps that stay outside it; see the results' ``shape``; asking
+        makes a postponed decomposition)."""
+        self._decompose()
         return self._t.shape
+
+    def shapes(self, hand_poses, joints) -> List[str]:
+        """The shape each grasp's test would use, without simulating ('tetrahedra' where a
+        postponed decomposition would be made)."""
+        return self._t.shapes(np.asarray(hand_poses, dtype=float), np.asarray(joints, dtype=float))
 
     def run(self, hand_pose, joints, trace_every: int = 0) -> LiftResult:
         """One lift test (lifted, displacement, hold_displacement, rotation, squeeze_displacement, height_gain,
         finite, steps, tetrahedra, shape, breakaway). ``trace_every`` > 0: ``result.trace`` records
         every that many steps (see :class:`bayesgrasp.lift_trace.LiftTrace`); 0: None."""
-        return self._t.run(np.asarray(hand_pose, dtype=float), np.asarray(joints, dtype=float), c_int(trace_every, "trace_every"))
+        T, q = np.asarray(hand_pose, dtype=float), np.asarray(joints, dtype=float)
+        if self._pending is not None and T.shape == (4, 4) and q.ndim == 1 and np.all(np.isfinite(T)):
+            self._ready_for(T[None], q[None])
+        return self._t.run(T, q, c_int(trace_every, "trace_every"))
 
     def run_batch(self, hand_poses, joints, threads=1) -> LiftBatch:
         """N lift tests ((N, 4, 4) poses, (N, J) joints) in C++ threads (0 = all cores): the
         LiftResult fields as (N,) arrays, ``shape`` the list of shapes used."""
-        return self._t.run_batch(np.asarray(hand_poses, dtype=float), np.asarray(joints, dtype=float),
-                                 c_int(threads, "threads"))
+        P, J = np.asarray(hand_poses, dtype=float), np.asarray(joints, dtype=float)
+        self._ready_for(P, J)
+        return self._t.run_batch(P, J, c_int(threads, "threads"))
 
 
 def lift_test(hand, hand_pose, joints, vertices, faces, **options) -> LiftResult:

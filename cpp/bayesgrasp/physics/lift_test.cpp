@@ -130,18 +130,35 @@ LiftResult LiftTester::simulate(const Iso3& hand_pose, const Eigen::VectorXd& jo
   return res;
 }
 
-std::vector<LiftResult> LiftTester::run_batch(
-    const std::vector<Iso3>& poses, const Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>& joints,
-    int threads) const {
+void LiftTester::check_batch(const std::vector<Iso3>& poses,
+                             const Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>& joints) const {
   if (static_cast<Eigen::Index>(poses.size()) != joints.rows())
     throw std::invalid_argument("poses and joints have different numbers of grasps (" + std::to_string(poses.size()) +
                                 " vs " + std::to_string(joints.rows()) + ")");
-  const long n = static_cast<long>(poses.size());
-  // Validate everything first, so that a bad row fails before any work is done.
-  for (long i = 0; i < n; ++i) {
+  for (size_t i = 0; i < poses.size(); ++i) {
     check_pose(poses[i], "hand pose " + std::to_string(i));
-    impl_->hand.check_joints(joints.row(i).transpose(), 1e-6, ("joints[" + std::to_string(i) + "]").c_str());
+    impl_->hand.check_joints(joints.row(static_cast<Eigen::Index>(i)).transpose(), 1e-6,
+                             ("joints[" + std::to_string(i) + "]").c_str());
   }
+}
+
+std::vector<LiftOptions::Shape> LiftTester::shapes(
+    const std::vector<Iso3>& poses, const Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>& joints) const {
+  check_batch(poses, joints);
+  std::vector<LiftOptions::Shape> out;
+  out.reserve(poses.size());
+  for (size_t i = 0; i < poses.size(); ++i)
+    out.push_back(physics::shape_for_grasp(
+        impl_->object, impl_->hand,
+        impl_->hand.link_poses(poses[i], joints.row(static_cast<Eigen::Index>(i)).transpose())));
+  return out;
+}
+
+std::vector<LiftResult> LiftTester::run_batch(
+    const std::vector<Iso3>& poses, const Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>& joints,
+    int threads) const {
+  check_batch(poses, joints);  // everything first, so that a bad row fails before any work is done
+  const long n = static_cast<long>(poses.size());
   return parallel_map<LiftResult>(n, threads, 1, [&](long i) { return simulate(poses[i], joints.row(i).transpose(), nullptr); });
 }
 

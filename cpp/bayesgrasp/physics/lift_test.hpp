@@ -243,6 +243,12 @@ class LiftTester {
   /// `trace_every` > 0: the result carries a trace of every trace_every-th step (0: none).
   LiftResult run(const Iso3& hand_pose, const Eigen::VectorXd& joints, int trace_every = 0) const;
 
+  /// The shape each grasp's lift test would use (row i of `joints` with poses[i]; no simulation):
+  /// under Auto on a concave object, ConvexHull unless a hand link reaches into the hull. Lets a
+  /// caller postpone a concave object's decomposition until a grasp needs it. Throws as run_batch.
+  std::vector<LiftOptions::Shape> shapes(const std::vector<Iso3>& poses,
+                                         const Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>& joints) const;
+
   /// N lift tests (row i of `joints` with poses[i]) in `threads` threads (0 = all cores,
   /// common/parallel.hpp thread_count; negative is an error), each with its own Bullet
   /// world. Results in input order, identical to run() one by one.
@@ -254,6 +260,8 @@ class LiftTester {
 
  private:
   LiftResult simulate(const Iso3& hand_pose, const Eigen::VectorXd& joints, LiftTrace* trace) const;  // validated input
+  void check_batch(const std::vector<Iso3>& poses,
+                   const Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>& joints) const;
   std::unique_ptr<Impl> impl_;
 };
 

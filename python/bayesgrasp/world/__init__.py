@@ -291,14 +291,13 @@ class World:
         weighs what its world-frame mesh integrates to (the core computes it); an open scan or a
         weighed object takes the ObjectModel's mass properties, placed in the world."""
         if self._lift is None:
-            pieces = None
             obj, T = self.object, self.scene.object_pose(self.object_index)
             given = obj.mass_method != "mesh" or obj.given_mass is not None
             mass = moved(obj.mass_properties_core, T) if given else None
-            if physics.is_concave(self.vertices, self.faces, self.hand.core, mass):
-                # Decompose the object-frame mesh (cached across poses), then place the pieces.
-                pieces = [p @ T[:3, :3].T + T[:3, 3]
-                          for p in physics.convex_decomposition(obj.vertices, obj.faces, name=obj.name)]
+
+            def pieces():   # when a grasp first needs them: the object-frame mesh's (cached across poses), placed
+                return [p @ T[:3, :3].T + T[:3, 3]
+                        for p in physics.convex_decomposition(obj.vertices, obj.faces, name=obj.name)]
             self._lift = physics.LiftTester(self.hand.core, self.vertices, self.faces, convex_pieces=pieces,
                                             mass_properties=mass, mu=self.mu, density=self.object.density,
                                             table=self.table)
