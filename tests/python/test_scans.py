@@ -199,3 +199,24 @@ def test_part_rules_label_a_scan_in_file_order(tmp_path):
     assert set(expected) == {0, 1, 2}
     labels, names = label_by_rules(o.vertices, o.faces, [("top", "z", ">", 1.0)])
     assert names == ["body", "top"] and not labels.any()
+
+
+def test_grasp_cli_names_the_mesh_and_takes_units_and_mass(tmp_path, capsys):
+    from bayesgrasp.cli import main
+
+    flat = tmp_path / "flat.stl"
+    trimesh.Trimesh([[0, 0, 0], [0.05, 0, 0], [0, 0.05, 0], [0.05, 0.05, 0]], [[0, 1, 2], [1, 3, 2]],
+                    process=False).export(flat)
+    assert main(["grasp", "--object", str(flat), "--top", "0,0,0"]) == 2
+    assert f"error: --object {flat}: " in capsys.readouterr().err
+    box_mm = tmp_path / "box_mm.stl"
+    trimesh.creation.box(extents=[60, 50, 120]).export(box_mm)
+    assert main(["grasp", "--object", str(box_mm), "--top", "0,0,0", "--no-lift"]) == 2
+    assert "--units mm" in capsys.readouterr().err                        # the error names the option ...
+    assert main(["grasp", "--object", str(box_mm), "--top", "0,0,0", "--units", "mm", "--mass", "0.4",
+                 "--json"]) == 0                                          # ... which grasp takes
+    doc = json.loads(capsys.readouterr().out)
+    assert doc["mass"] == {"kg": pytest.approx(0.4), "from": "given (--mass)",
+                           "density": pytest.approx(0.4 / (0.06 * 0.05 * 0.12))}
+    assert main(["grasp", "--object", str(box_mm), "--top", "0,0,0", "--units", "mm", "--mass", "-1"]) == 2
+    assert "--mass: must be a weight > 0 kg" in capsys.readouterr().err

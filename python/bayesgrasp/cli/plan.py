@@ -8,8 +8,9 @@ from pathlib import Path
 import numpy as np
 
 from . import camera_input
-from .args import (CliError, add_context_options, add_families_option, add_format_options, add_view_option, bounded_int,
-                   context, floats, out_dir, output_file, output_format, parse_set)
+from .args import (CliError, add_context_options, add_families_option, add_format_options, add_object_options,
+                   add_view_option, bounded_int, context, floats, object_arg, out_dir, output_file, output_format,
+                   parse_set)
 
 from ..experiments.episode import EpisodeSettings
 from ..planners.registry import PLANNERS
@@ -50,6 +51,7 @@ def add(sub) -> None:
     add_view_option(p)
     add_context_options(p)
     add_families_option(p)
+    add_object_options(p, units=False)
     camera_input.add(p)
     p.set_defaults(run=plan)
 
@@ -199,10 +201,10 @@ def plan(args) -> int:
         raise CliError(f"--noise: must be >= 0, got {args.noise}")
     png = output_file(args.png, "--png")
     obj = args.object
-    if args.units or camera_input.given(args):       # the mesh read once, in its unit
+    if args.units or args.mass is not None or camera_input.given(args):   # the mesh read once, in its unit
         from ..objects import load_object
 
-        obj = load_object(args.object, units=args.units)
+        obj = load_object(object_arg(args))
     ctx = context(args)
     start, view = _vision_start(args, obj, est, quiet, ctx.seed)
     if start is not None:
