@@ -200,15 +200,38 @@ def canonical(path: Path, mass: float):
     return o.transformed(T)
 
 
+def table(doc: dict) -> str:
+    """The BENCHMARKS.md table of a results file."""
+    pct = lambda v: "" if v is None else f"{100 * v:.0f}%"  # noqa: E731
+    lines = ["| object | mass kg (method) | first s | warm s | first/warm | grid lifted (top, side) | "
+             "plan lifted after 1 / within 4 | registration |", "|---|---|---|---|---|---|---|---|"]
+    for n, r in doc["objects"].items():
+        f, g, p, reg = r.get("first_warm"), r.get("grid"), r.get("plan"), r.get("register")
+        cells = [n, f"{r['mass_kg']:.3f} ({r['mass_method']}, {r['volume_cm3']:.0f} cm^3)"]
+        cells += ([f"{f['first']['wall_s']:.1f}", f"{f['warm']['wall_s']:.1f}", f"{f['ratio']:.2f}x"] if f else ["", "", ""])
+        cells.append(f"{pct(g['share'])} ({g['top']['lifted']}/{g['top']['valid']}, {g['side']['lifted']}/"
+                     f"{g['side']['valid']})" if g else "")
+        cells.append(f"{pct(p['after_1'])} / {pct(p['after_4'])}" + (f" ({p['errors']} errors)" if p['errors'] else "")
+                     if p else "")
+        cells.append(("ok" if reg["success"] else f"fails: {reg['top_model']} best, {reg['rot_deg']:.0f} deg, "
+                      f"{reg['trans_mm']:.0f} mm") if reg else "")
+        lines.append("| " + " | ".join(cells) + " |")
+    return "\n".join(lines)
+
+
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    ap.add_argument("--ycb-dir", required=True)
+    ap.add_argument("--ycb-dir", default=None)
     ap.add_argument("--objects", default=",".join(MASS_G))
     ap.add_argument("--only", default="first_warm,big,grid,register,plan")
     ap.add_argument("--runs", type=int, default=10, help="plan runs per object")
     ap.add_argument("--seed", type=int, default=0)
     ap.add_argument("--out", default="bench/results/ycb_objects.json")
+    ap.add_argument("--table", action="store_true", help="print the markdown table of --out and stop")
     a = ap.parse_args()
+    if a.table:
+        print(table(json.loads(Path(a.out).read_text())))
+        return
     parts = set(a.only.split(","))
     names = a.objects.split(",")
     out_path = Path(a.out)
