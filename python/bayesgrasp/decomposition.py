@@ -200,6 +200,9 @@ def convex_decomposition(vertices, faces, threshold: float = 0.05, seed: int = 0
         cached = load_checked(path, "convex decomposition cache file", _read_pieces)
         if cached is not None:
             return cached
+    if say is not None:
+        say(f"  decomposing {what} for the lift test (once per mesh, then cached; {len(F)} triangles"
+            + (f", simplified to {max_faces})" if len(F) > max_faces else ")"))
     Vs, Fs = simplify(V, F, max_faces)
     try:
         pieces, dropped = solid_pieces(_run_coacd(Vs, Fs, threshold, seed, _search(len(F), max_faces), say, what))

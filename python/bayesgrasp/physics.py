@@ -112,8 +112,13 @@ class LiftTester:
         elif pending is not None and o.shape == "decomposition":
             convex_pieces, pending = pending(), None
         self._make = lambda pieces: _core.physics.LiftTester(_hand(hand), V, F, o, pieces, mass_properties)  # noqa: E731
-        self._t = self._make(convex_pieces)
+        # While the decomposition waits, the whole hull stands in as its one piece: it decides the
+        # shape per grasp as the real pieces would (the hull unless a link reaches into it), and a
+        # grasp that does not stay outside triggers the decomposition before it is simulated.
+        self._t = self._make([V] if pending is not None else convex_pieces)
         self._pending = pending if pending is not None and self._t.concave else None
+        if pending is not None and self._pending is None:
+            self._t = self._make(None)   # convex: the hull, prepared as without pieces
 
     def _decompose(self) -> None:
         """Makes the postponed decomposition and the tester that uses it."""
@@ -150,8 +155,8 @@ class LiftTester:
         return self._t.shape
 
     def shapes(self, hand_poses, joints) -> List[str]:
-        """The shape each grasp's test would use, without simulating ('tetrahedra' where a
-        postponed decomposition would be made)."""
+        """The shape each grasp's test would use, without simulating ('hull' or, where the hand
+        reaches into the hull, the concave shape: 'decomposition', made then if postponed)."""
         return self._t.shapes(np.asarray(hand_poses, dtype=float), np.asarray(joints, dtype=float))
 
     def run(self, hand_pose, joints, trace_every: int = 0) -> LiftResult:

@@ -14,6 +14,7 @@ mass properties are then those of the solid it bounds, found by sampling, or of 
 from __future__ import annotations
 
 import os
+import sys
 import warnings
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -28,6 +29,9 @@ from .topology import _check_solid, mesh_is_watertight, orient_outward
 #: objects as a whole (a full bottle, a plastic box, a wooden toy are 500-1200 kg/m^3); pass
 #: ``density=`` to load_mesh / load_object for anything else. Built-in objects carry their own.
 DEFAULT_DENSITY = 1000.0
+
+#: Meshes of more triangles than this say on stderr what their loading is doing (it takes seconds).
+BIG_MESH = 50_000
 
 #: File extensions load_mesh reads (and ObjectModel.save writes).
 MESH_EXTENSIONS = (".obj", ".stl", ".ply")
@@ -68,7 +72,7 @@ class ObjectModel:
     parts: Optional[np.ndarray] = None
     part_names: Tuple[str, ...] = ()
     given_mass: Optional[float] = None
-    #: mass properties already known in this frame (a rigid copy's), with their method
+    #: (mass properties in this frame, their method, watertight) already known: a rigid copy's
     known_mass: Optional[tuple] = field(default=None, repr=False, compare=False)
 
     def __post_init__(self):
@@ -99,12 +103,13 @@ class ObjectModel:
         elif self.part_names:
             raise ValueError(f"part_names of '{self.name}' given without parts")
         _check_solid(self.vertices, self.faces, self.name)
-        self._watertight = mesh_is_watertight(self.faces)
         if self.known_mass is not None:
-            self._mp, self.mass_method = self.known_mass
-        elif self._watertight:
+            self._mp, self.mass_method, self._watertight = self.known_mass
+        elif mesh_is_watertight(self.faces):
+            self._watertight = True
             self._mp, self.mass_method = _mass.closed_mass_properties(self.vertices, self.faces, self.density), "mesh"
         else:
+            self._watertight = False
             self._mp, self.mass_method = _mass.open_mass_properties(self.vertices, self.faces, self.density)
             if self.warn_if_open:
                 how = ("the solid it bounds (sampled)" if self.mass_method == "fill" else
@@ -178,14 +183,14 @@ class ObjectModel:
         return ObjectModel(name or self.name, V, self.faces.copy(), self.density, self.source,
                            dict(self.params), warn_if_open=False,
                            parts=None if self.parts is None else self.parts.copy(), part_names=self.part_names,
-                           given_mass=self.given_mass, known_mass=(_mass.moved(self._mp, T), self.mass_method))
+                           given_mass=self.given_mass, known_mass=(_mass.moved(self._mp, T), self.mass_method, self._watertight))
 
     def with_mass(self, mass: float) -> "ObjectModel":
         """A copy weighing ``mass`` kg (a scale's reading): same shape, density = mass / volume."""
         return ObjectModel(self.name, self.vertices.copy(), self.faces.copy(), self.density, self.source,
                            dict(self.params), warn_if_open=False,
                            parts=None if self.parts is None else self.parts.copy(), part_names=self.part_names,
-                           given_mass=mass, known_mass=(self._mp, self.mass_method))
+                           given_mass=mass, known_mass=(self._mp, self.mass_method, self._watertight))
 
     @property
     def mass_properties_core(self):
@@ -321,6 +326,9 @@ def _object_from_arrays(V: np.ndarray, F: np.ndarray, what: str, name: str, dens
         raise ValueError(f"{what}: mesh has {bad} vertices with NaN or infinite coordinates")
     V = V * scale
     check_extent(V[np.unique(F)], what, units)
+    big = len(F) > BIG_MESH
+    if big:
+        print(f"  reading {what}: {len(F):,} triangles (merging, orienting, then weighing)", file=sys.stderr, flush=True)
     mesh = trimesh.Trimesh(vertices=V, faces=F, process=False)
     mesh.merge_vertices(merge_tex=True, merge_norm=True)
     mesh.remove_unreferenced_vertices()
@@ -333,6 +341,8 @@ def _object_from_arrays(V: np.ndarray, F: np.ndarray, what: str, name: str, dens
     if len(F) == 0:
         raise ValueError(f"{what}: mesh has no non-degenerate faces")
     F = orient_outward(V, F)
+    if big:
+        print(f"  weighing {what}", file=sys.stderr, flush=True)
     d = DEFAULT_DENSITY if density is None else density
     return ObjectModel(name, V, F.astype(np.int32), d, source=source, parts=parts, part_names=part_names,
                        warn_if_open=warn_if_open)
