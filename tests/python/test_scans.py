@@ -220,3 +220,7 @@ def test_grasp_cli_names_the_mesh_and_takes_units_and_mass(tmp_path, capsys):
                            "density": pytest.approx(0.4 / (0.06 * 0.05 * 0.12))}
     assert main(["grasp", "--object", str(box_mm), "--top", "0,0,0", "--units", "mm", "--mass", "-1"]) == 2
     assert "--mass: must be a weight > 0 kg" in capsys.readouterr().err
+    # touch reads the mesh in --units too (and takes no --mass: it lifts nothing)
+    assert main(["touch", "--object", str(box_mm), "--units", "mm", "--true-pose", "0.01,0,0.1", "--estimate", "0,0,0",
+                 "--budget", "40", "--json"]) == 0
+    assert json.loads(capsys.readouterr().out)["errors_before"]["position_error"] == pytest.approx(0.01)

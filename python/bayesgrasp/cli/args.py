@@ -97,11 +97,14 @@ def add_hand_option(p: argparse.ArgumentParser) -> None:
                    help="built-in hand name, hand file or URDF (with its NAME.hand.json sidecar)")
 
 
-def add_object_options(p: argparse.ArgumentParser, units: bool = True) -> None:
-    """--mass (and --units, unless the command's camera options give it) for --object's mesh."""
+def add_object_options(p: argparse.ArgumentParser, units: bool = True, mass: bool = True) -> None:
+    """--units (unless the command's camera options give it) and --mass (for commands that lift)
+    for --object's mesh."""
     if units:
         p.add_argument("--units", default=None, choices=["m", "cm", "mm"],
                        help="length unit of an --object mesh file (default m)")
+    if not mass:
+        return
     p.add_argument("--mass", type=float, default=None, metavar="KG",
                    help="the object's weight (a scale's reading, kg): sets its density; default: its volume "
                         "at 1000 kg/m^3 (a built-in's own density)")

@@ -11,8 +11,8 @@ import json
 
 import numpy as np
 
-from .args import (CliError, add_format_options, add_hand_option, add_seed_option, add_view_option, bounded_int,
-                   context, floats, output_file, output_format)
+from .args import (CliError, add_format_options, add_hand_option, add_object_options, add_seed_option, add_view_option,
+                   bounded_int, context, floats, object_arg, output_file, output_format)
 
 
 def add(sub) -> None:
@@ -34,6 +34,7 @@ def add(sub) -> None:
     t.add_argument("--spread", type=float, default=None, help="finger spread of the touch (rad); default: the hand's")
     add_seed_option(t, "the optimiser's seed")
     add_hand_option(t)
+    add_object_options(t, mass=False)
     add_format_options(t)
     add_view_option(t)
     t.add_argument("--png", default=None, metavar="PATH", help="write the fitness landscape to this PNG")
@@ -60,8 +61,9 @@ def run(args) -> int:
     ctx = context(args, progress=False)
     given = {k: getattr(args, k) for k in ("optimizer", "budget", "contact_term") if getattr(args, k) is not None}
     settings = T.TouchSettings(unknowns=case, seed=ctx.seed, spread=args.spread, threads=0, **given)
-    planner = T.TouchPlanner(args.object, guess, settings, hand=ctx.hand)
-    world = T.touch_world(args.object, truth[:3], truth[3], planner.model.hand)
+    obj = object_arg(args)                          # in --units, read once
+    planner = T.TouchPlanner(obj, guess, settings, hand=ctx.hand)
+    world = T.touch_world(obj, truth[:3], truth[3], planner.model.hand)
     grasp = planner.plan().touch
     readings = T.read(world, grasp)
     r = planner.observe(grasp, readings)
@@ -108,7 +110,8 @@ def _result(args, planner, grasp, readings, r, truth, guess, case) -> dict:
                      "contact_links": [n for n, c in zip(names, readings.contact) if c],
                      "hand_pose": np.asarray(readings.hand_pose).tolist()},
         **{k: v for k, v in r.to_dict().items() if k not in ("initial", "state", "stopped", "cpu_seconds")},
-        "errors_before": _errors(args.object, guess, truth), "errors_after": _errors(args.object, est, truth),
+        "errors_before": _errors(planner.model.object, guess, truth),
+        "errors_after": _errors(planner.model.object, est, truth),
     }
 
 
