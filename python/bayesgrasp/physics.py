@@ -27,6 +27,7 @@ of one tetrahedron per triangle (``shape="tetrahedra"``, far slower; see BENCHMA
 from __future__ import annotations
 
 import os
+import threading
 from pathlib import Path
 from typing import List, Sequence
 
@@ -115,20 +116,29 @@ class LiftTester:
         # While the decomposition waits, the whole hull stands in as its one piece: it decides the
         # shape per grasp as the real pieces would (the hull unless a link reaches into it), and a
         # grasp that does not stay outside triggers the decomposition before it is simulated.
+        # (A convex object never uses pieces: the stand-in is then simply unused.)
         self._t = self._make([V] if pending is not None else convex_pieces)
         self._pending = pending if pending is not None and self._t.concave else None
-        if pending is not None and self._pending is None:
-            self._t = self._make(None)   # convex: the hull, prepared as without pieces
+        self._lock = threading.Lock()
 
     def _decompose(self) -> None:
-        """Makes the postponed decomposition and the tester that uses it."""
-        if self._pending is not None:
-            pieces, self._pending = self._pending(), None
-            self._t = self._make(pieces)
+        """Makes the postponed decomposition and the tester that uses it (once; if it fails, it
+        is tried again next time rather than the stand-in used)."""
+        with self._lock:
+            if self._pending is not None:
+                self._t = self._make(self._pending())
+                self._pending = None
 
     def _ready_for(self, hand_poses: np.ndarray, joints: np.ndarray) -> None:
-        """Decomposes first if one of these grasps needs the concave shape."""
-        if self._pending is not None and any(s != "hull" for s in self._t.shapes(hand_poses, joints)):
+        """Decomposes first if one of these grasps needs the concave shape. Bad input is left to
+        the test itself, whose errors name the arguments as given."""
+        if self._pending is None:
+            return
+        try:
+            shapes = self._t.shapes(hand_poses, joints)
+        except ValueError:
+            return
+        if any(s != "hull" for s in shapes):
             self._decompose()
 
     @property
@@ -147,6 +157,11 @@ class LiftTester:
         return self._t.mass
 
     @property
+    def com(self) -> np.ndarray:
+        """(3,) the object's centre of mass in the world, m."""
+        return np.asarray(self._t.com)
+
+    @property
     def shape(self) -> str:
         """Shape prepared: 'hull', 'tetrahedra' or 'decomposition' (auto on a concave object
         still uses the hull for grasps that stay outside it; see the results' ``shape``; asking
@@ -155,8 +170,8 @@ class LiftTester:
         return self._t.shape
 
     def shapes(self, hand_poses, joints) -> List[str]:
-        """The shape each grasp's test would use, without simulating ('hull' or, where the hand
-        reaches into the hull, the concave shape: 'decomposition', made then if postponed)."""
+        """The shape each grasp's test would use, without simulating: 'hull', or where the hand
+        reaches into the hull the concave shape ('decomposition' also while it is postponed)."""
         return self._t.shapes(np.asarray(hand_poses, dtype=float), np.asarray(joints, dtype=float))
 
     def run(self, hand_pose, joints, trace_every: int = 0) -> LiftResult:
@@ -164,16 +179,18 @@ class LiftTester:
         finite, steps, tetrahedra, shape, breakaway). ``trace_every`` > 0: ``result.trace`` records
         every that many steps (see :class:`bayesgrasp.lift_trace.LiftTrace`); 0: None."""
         T, q = np.asarray(hand_pose, dtype=float), np.asarray(joints, dtype=float)
-        if self._pending is not None and T.shape == (4, 4) and q.ndim == 1 and np.all(np.isfinite(T)):
+        trace_every = c_int(trace_every, "trace_every")
+        if T.shape == (4, 4) and q.ndim == 1:
             self._ready_for(T[None], q[None])
-        return self._t.run(T, q, c_int(trace_every, "trace_every"))
+        return self._t.run(T, q, trace_every)
 
     def run_batch(self, hand_poses, joints, threads=1) -> LiftBatch:
         """N lift tests ((N, 4, 4) poses, (N, J) joints) in C++ threads (0 = all cores): the
         LiftResult fields as (N,) arrays, ``shape`` the list of shapes used."""
         P, J = np.asarray(hand_poses, dtype=float), np.asarray(joints, dtype=float)
+        threads = c_int(threads, "threads")
         self._ready_for(P, J)
-        return self._t.run_batch(P, J, c_int(threads, "threads"))
+        return self._t.run_batch(P, J, threads)
 
 
 def lift_test(hand, hand_pose, joints, vertices, faces, **options) -> LiftResult:

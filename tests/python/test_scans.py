@@ -59,22 +59,41 @@ def test_open_cup_mass_matches_the_analytic_hollow_cylinder():
 
 
 def test_a_sheet_that_encloses_nothing_is_a_thin_shell():
-    # an open box of five faces, each one triangle pair: no inside at all
+    # a card folded by 2 degrees (two 5 cm squares, one triangle pair each): the fill finds only the
+    # sliver under the fold, less than a quarter of the 3 mm shell, so the object is the shell
+    s, h = 0.05, 0.05 * np.tan(np.radians(2.0))
+    V = np.array([[0, 0, 0], [0, s, 0], [s, 0, h], [s, s, h], [2 * s, 0, 0], [2 * s, s, 0]], float)
+    F = np.array([[0, 2, 1], [1, 2, 3], [2, 4, 5], [2, 5, 3]])
+    with pytest.warns(MeshWarning, match="3 mm shell"):
+        o = ObjectModel("folded card", V, F, density=1000.0)
+    assert o.mass_method == "shell"
+    assert o.mass == pytest.approx(1000.0 * 0.003 * 2 * s * np.hypot(s, h))   # area x thickness x density
+    np.testing.assert_allclose(o.com, [s, s / 2, h / 2], atol=1e-12)
+
+
+def test_shell_mass_properties_of_two_square_laminae():
+    # an L of two 5 cm squares (floor and wall): centre of mass and the inertia about y analytic
+    s = 0.05
+    V = np.array([[0, 0, 0], [s, 0, 0], [s, s, 0], [0, s, 0], [0, 0, s], [0, s, s]], float)
+    F = np.array([[0, 1, 2], [0, 2, 3], [0, 3, 5], [0, 5, 4]])
+    p = shell_mass_properties(V, F, 1000.0, thickness=0.002)
+    assert p.mass == pytest.approx(1000.0 * 2 * s ** 2 * 0.002)
+    np.testing.assert_allclose(p.com, [s / 4, s / 2, s / 4], atol=1e-12)
+    # each lamina (mass m) about its own centre: m s^2 / 12 about y; both s^2 / 8 off the common centre in x-z
+    m = p.mass / 2
+    assert p.inertia[1, 1] == pytest.approx(2 * m * s ** 2 / 12 + 2 * m * s ** 2 / 8)
+    assert p.inertia[0, 0] == pytest.approx(p.inertia[2, 2])                    # the L is symmetric in x <-> z
+
+
+def test_a_one_sheet_open_box_reads_as_the_solid_box():
+    # the documented ambiguity: five faces of a box are also a solid box with its lid missing
     s = 0.05
     V = np.array([[0, 0, 0], [s, 0, 0], [s, s, 0], [0, s, 0], [0, 0, s], [s, 0, s], [s, s, s], [0, s, s]], float)
     F = np.array([[0, 2, 1], [0, 3, 2], [0, 1, 5], [0, 5, 4], [1, 2, 6], [1, 6, 5], [2, 3, 7], [2, 7, 6],
                   [3, 0, 4], [3, 4, 7]])
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore", MeshWarning)
+    with pytest.warns(MeshWarning, match="pass mass="):
         o = ObjectModel("tray", V, F, density=1000.0)
-    ref = shell_mass_properties(V, F, 1000.0)
-    if o.mass_method == "shell":
-        assert o.mass == pytest.approx(ref.mass)
-    # either way it never weighs more than the box filled solid
-    assert o.mass <= 1000.0 * s ** 3 + 1e-12
-    # the shell: five faces of s^2 at 3 mm
-    assert ref.mass == pytest.approx(1000.0 * 5 * s ** 2 * 0.003)
-    assert ref.com[2] == pytest.approx((4 * s / 2) / 5)
+    assert o.mass_method == "fill" and o.volume == pytest.approx(s ** 3, rel=0.01)
 
 
 def test_given_mass_sets_the_density_and_the_lift_test_uses_it(tmp_path):
@@ -100,6 +119,34 @@ def test_given_mass_sets_the_density_and_the_lift_test_uses_it(tmp_path):
     w = World.single(box.with_mass(0.3))
     assert w.lift_tester().mass == pytest.approx(0.3)
     assert World.single(box).lift_tester().mass == pytest.approx(c.mass, rel=0.02)
+
+
+def test_an_open_meshs_mass_properties_follow_it_into_the_world():
+    cup = _open_cup()
+    with pytest.warns(MeshWarning):
+        o = ObjectModel("cup", cup.vertices, cup.faces, density=RHO).with_mass(0.2)
+    from bayesgrasp.world import World
+
+    w = World.single(o, pose=(0.1, -0.05, 0.7))
+    lt = w.lift_tester()
+    placed = w.scene.object_mass_properties_world(0)
+    assert lt.mass == pytest.approx(0.2)
+    np.testing.assert_allclose(lt.com, placed["com"], atol=1e-12)
+    np.testing.assert_allclose(w.com, placed["com"], atol=1e-12)
+    # the cup's axis is off the origin of its frame after the placement: the com moved with it
+    assert abs(lt.com[0] - 0.1) < 1e-3 and abs(lt.com[1] + 0.05) < 1e-3
+    # a rigid copy carries the sampled properties; sampling the moved mesh again agrees (1%)
+    T = np.eye(4)
+    T[:3, :3] = [[0, -1, 0], [1, 0, 0], [0, 0, 1]]
+    T[:3, 3] = [0.02, 0.03, 0.0]
+    moved, fresh = o.transformed(T), ObjectModel("cup", o.vertices @ T[:3, :3].T + T[:3, 3], o.faces, o.density,
+                                                 warn_if_open=False)
+    assert moved.mass == pytest.approx(fresh.mass, rel=0.01)
+    np.testing.assert_allclose(moved.com, fresh.com, atol=1e-3)
+    np.testing.assert_allclose(moved.inertia, fresh.inertia, atol=0.01 * np.abs(fresh.inertia).max())
+    # a scaled copy is a new shape: weighed again at the same density (8x the mass at 2x the size)
+    big = o.transformed(np.diag([2.0, 2.0, 2.0, 1.0]))
+    assert big.given_mass is None and big.mass == pytest.approx(8 * 0.2, rel=0.02)
 
 
 def test_lift_tester_refuses_bad_mass_properties():

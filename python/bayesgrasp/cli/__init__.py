@@ -70,7 +70,7 @@ def main(argv=None) -> int:
     if args.command is None:
         parser.print_help()
         return 0
-    warnings.formatwarning = _one_line_warning
+    formatwarning, warnings.formatwarning = warnings.formatwarning, _one_line_warning
     try:
         return args.run(args)
     except (CliError, ValueError, FileNotFoundError) as e:
@@ -79,6 +79,8 @@ def main(argv=None) -> int:
     except BrokenPipeError:  # output piped into e.g. `head`, which stopped reading
         os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
         return 0
+    finally:
+        warnings.formatwarning = formatwarning
 
 
 if __name__ == "__main__":

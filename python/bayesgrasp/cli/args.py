@@ -111,14 +111,12 @@ def add_object_options(p: argparse.ArgumentParser, units: bool = True, mass: boo
 
 
 def object_arg(args: argparse.Namespace, option: str = "--object"):
-    """--object loaded once with --units and --mass (an ObjectModel); a problem with the mesh is a
-    CliError naming ``--object FILE``. Without --units or --mass: the name as given."""
+    """--object loaded once, in --units and weighing --mass (an ObjectModel); a problem with the
+    mesh is a CliError naming ``--object FILE``."""
     name = getattr(args, option.lstrip("-").replace("-", "_"))
     units, mass = getattr(args, "units", None), getattr(args, "mass", None)
     if mass is not None and not (math.isfinite(mass) and mass > 0):
         raise CliError(f"--mass: must be a weight > 0 kg, got {mass}")
-    if units is None and mass is None:
-        return name
     from ..objects import load_object
 
     try:

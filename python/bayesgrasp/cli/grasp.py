@@ -150,14 +150,9 @@ def _read_pose(path: str) -> list:
 def _world(args, pose):
     """The world with --object (in --units, weighing --mass) and, unless --no-lift, its lift test
     prepared; a problem with the mesh is a CliError naming ``--object FILE``."""
-    from ..objects import load_object
     from ..world import World
 
     obj = object_arg(args)
-    try:
-        obj = load_object(obj)
-    except (ValueError, FileNotFoundError) as e:
-        raise CliError(f"--object {args.object}: {e}") from None
     world = World.single(obj, pose=pose, keep_origin=args.keep_origin, hand=args.hand, standoff=args.standoff)
     if not args.no_lift:
         try:

@@ -202,9 +202,7 @@ def plan(args) -> int:
     png = output_file(args.png, "--png")
     obj = args.object
     if args.units or args.mass is not None or camera_input.given(args):   # the mesh read once, in its unit
-        from ..objects import load_object
-
-        obj = load_object(object_arg(args))
+        obj = object_arg(args)
     ctx = context(args)
     start, view = _vision_start(args, obj, est, quiet, ctx.seed)
     if start is not None:

@@ -21,6 +21,7 @@ from ..objects import ObjectModel, load_object
 from ..world import World
 from .families import Variant
 from .grasp_models import DEFAULT_CALIBRATION, GraspModels
+from ..objects.mass import cache_salt
 from .settings import CACHE_VERSION, ModelSettings
 from .training import choose_spread, choose_variant, fit_calibration, side_variants, simulate_training_data, success_labels
 
@@ -33,12 +34,14 @@ def default_cache_dir() -> Path:
 
 
 def cache_key(obj: ObjectModel, hand_text: str, settings: ModelSettings) -> str:
-    """The models' identity: cache version, the object's mesh, the hand file and the settings."""
+    """The models' identity: cache version, the object's mesh (and its mass properties where the lift test
+    does not weigh its closed mesh), the hand file and the settings."""
     h = hashlib.sha256()
     h.update(f"v{CACHE_VERSION}".encode())
     h.update(np.ascontiguousarray(obj.vertices, dtype=np.float64).tobytes())
     h.update(np.ascontiguousarray(obj.faces, dtype=np.int64).tobytes())
     h.update(hand_text.encode())
+    h.update(cache_salt(obj))      # the lift test's mass, where it is not the closed mesh's
     fields = asdict(settings)
     if fields["family"] == "top":  # top models keep the keys they had before there were families
         del fields["family"]

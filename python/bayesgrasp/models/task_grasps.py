@@ -27,6 +27,7 @@ from .. import DEFAULT_HAND
 from ..cache import atomic_write_text, load_checked
 from ..objects import ObjectModel, load_object
 from ..world import World
+from ..objects.mass import cache_salt
 from .settings import CACHE_VERSION
 from .training import lift_tests_in_chunks
 from .tasks import TaskGrasp, TaskRule
@@ -223,6 +224,7 @@ def _key(obj: ObjectModel, hand_text: str, rule: TaskRule, s: TaskGraspSettings)
     h.update(np.ascontiguousarray(obj.vertices, dtype=np.float64).tobytes())
     h.update(np.ascontiguousarray(obj.faces, dtype=np.int64).tobytes())
     h.update(hand_text.encode())
+    h.update(cache_salt(obj))      # the lift test's mass, where it is not the closed mesh's
     h.update(repr(rule).encode())
     h.update(json.dumps(asdict(s), sort_keys=True, default=list).encode())
     return h.hexdigest()[:20]

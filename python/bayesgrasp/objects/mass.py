@@ -16,12 +16,17 @@ material, so an open mesh is measured by what it encloses instead:
   counted 4.5% of such a cup's cavity as material.) Volume = inside cells x cell volume; centre of
   mass and inertia are the sums over the inside cells (each a point of its cell's mass plus the
   cell's own box inertia).
-* ``"shell"``: a surface that encloses (almost) nothing, e.g. a cup modelled as one sheet, is a
-  thin shell of thickness ``shell_thickness``: each triangle a lamina of mass density x area x
-  thickness, with its exact second moment (integral of x x^T over a triangle = A/12 (a a^T + b b^T +
-  c c^T + s s^T), s = a + b + c).
+* ``"shell"``: a surface that encloses (almost) nothing from anywhere - a bent sheet, a lid, a
+  plate scanned as one layer - is a thin shell of thickness ``shell_thickness``: each triangle a
+  lamina of mass density x area x thickness, with its exact second moment (integral of x x^T over
+  a triangle = A/12 (a a^T + b b^T + c c^T + s s^T), s = a + b + c).
 
 The fill is used unless it finds less than a quarter of the shell's volume (then the shell).
+
+What geometry cannot tell: a container modelled as one sheet with its opening left open (a cup
+without wall thickness) is the same surface as a solid whose top face is missing; the fill reads
+both as solid. Real scans model the wall's two sides (the YCB mug's fill is its wall, 138 cm^3,
+not its 525 cm^3 hull); for a one-sheet container, ``mass=`` gives the weight.
 """
 from __future__ import annotations
 
@@ -146,3 +151,14 @@ def moved(mp, T: np.ndarray):
     R = T[:3, :3]
     return _core_mass_properties(mp.volume, mp.mass, R @ np.asarray(mp.com) + T[:3, 3],
                                  R @ np.asarray(mp.inertia) @ R.T)
+
+
+def cache_salt(obj) -> bytes:
+    """What a cache key of lift-tested results must add for an object whose lift test does not
+    weigh its closed mesh at its density (an open scan, a weighed object): its mass properties.
+    Empty otherwise, so the keys of closed meshes stay what they were."""
+    if obj.mass_method == "mesh" and obj.given_mass is None:
+        return b""
+    mp = obj.mass_properties_core
+    return (f"mass-{obj.mass_method}-{mp.mass!r}-{np.asarray(mp.com).tolist()}-"
+            f"{np.asarray(mp.inertia).ravel().tolist()}").encode()

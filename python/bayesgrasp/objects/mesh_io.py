@@ -72,7 +72,7 @@ class ObjectModel:
     parts: Optional[np.ndarray] = None
     part_names: Tuple[str, ...] = ()
     given_mass: Optional[float] = None
-    #: (mass properties in this frame, their method, watertight) already known: a rigid copy's
+    #: (mass properties in this frame or None, their method, watertight) already known: a copy's
     known_mass: Optional[tuple] = field(default=None, repr=False, compare=False)
 
     def __post_init__(self):
@@ -103,13 +103,12 @@ class ObjectModel:
         elif self.part_names:
             raise ValueError(f"part_names of '{self.name}' given without parts")
         _check_solid(self.vertices, self.faces, self.name)
-        if self.known_mass is not None:
-            self._mp, self.mass_method, self._watertight = self.known_mass
-        elif mesh_is_watertight(self.faces):
-            self._watertight = True
+        known_mp, known_method, self._watertight = self.known_mass or (None, None, mesh_is_watertight(self.faces))
+        if known_mp is not None:
+            self._mp, self.mass_method = known_mp, known_method
+        elif self._watertight:
             self._mp, self.mass_method = _mass.closed_mass_properties(self.vertices, self.faces, self.density), "mesh"
         else:
-            self._watertight = False
             self._mp, self.mass_method = _mass.open_mass_properties(self.vertices, self.faces, self.density)
             if self.warn_if_open:
                 how = ("the solid it bounds (sampled)" if self.mass_method == "fill" else
@@ -175,15 +174,23 @@ class ObjectModel:
         return int(len(self.faces))
 
     def transformed(self, T: np.ndarray, name: Optional[str] = None) -> "ObjectModel":
-        """A copy with vertices mapped by the rigid 4x4 transform ``T``."""
+        """A copy with vertices mapped by the 4x4 transform ``T`` (rigid: the same object, its
+        mass too; otherwise, e.g. scaled, a new shape at this density)."""
         T = np.asarray(T, dtype=np.float64)
         if T.shape != (4, 4) or not np.all(np.isfinite(T)):
             raise ValueError(f"T must be a finite 4x4 transform, got shape {T.shape}")
         V = self.vertices @ T[:3, :3].T + T[:3, 3]
+        # A closed mesh's mass properties are recomputed on the moved mesh (as they always were: the
+        # same bits as a fresh load); an open one's sampled ones are carried under a rigid motion
+        # (sampling again would cost seconds) and sampled again under any other transform.
+        R = T[:3, :3]
+        rigid = np.allclose(R.T @ R, np.eye(3), atol=1e-12) and np.linalg.det(R) > 0
+        carried = self.mass_method != "mesh" and rigid
+        known = (_mass.moved(self._mp, T) if carried else None, self.mass_method if carried else None, self._watertight)
         return ObjectModel(name or self.name, V, self.faces.copy(), self.density, self.source,
                            dict(self.params), warn_if_open=False,
                            parts=None if self.parts is None else self.parts.copy(), part_names=self.part_names,
-                           given_mass=self.given_mass, known_mass=(_mass.moved(self._mp, T), self.mass_method, self._watertight))
+                           given_mass=self.given_mass if rigid else None, known_mass=known)
 
     def with_mass(self, mass: float) -> "ObjectModel":
         """A copy weighing ``mass`` kg (a scale's reading): same shape, density = mass / volume."""
@@ -250,6 +257,18 @@ def load_mesh(path: Union[str, os.PathLike], density: Optional[float] = None,
         MeshWarning: the mesh is not watertight (mass properties then of the solid it bounds, or
             of a thin shell: :mod:`bayesgrasp.objects.mass`).
     """
+    if mass is not None and density is not None:
+        raise ValueError("mass, density: give one of them (the mass sets the density)")
+    p = Path(path)
+    V, F = read_triangles(p)
+    obj = _object_from_arrays(V, F, f"'{p}'", name or p.stem, density, units, source=str(p), label_path=p,
+                              warn_if_open=mass is None)
+    return obj if mass is None else obj.with_mass(mass)
+
+
+def read_triangles(path: Union[str, os.PathLike]) -> Tuple[np.ndarray, np.ndarray]:
+    """(V, F) of a mesh file as stored: every triangle in file order, nothing merged or dropped
+    (the file's own units). FileNotFoundError / ValueError as :func:`load_mesh`."""
     import trimesh
 
     p = Path(path)
@@ -277,11 +296,7 @@ def load_mesh(path: Union[str, os.PathLike], density: Optional[float] = None,
     F = np.asarray(loaded.faces)
     if len(V) == 0 and len(F) == 0:
         raise ValueError(f"'{p}' is not a {ext[1:].upper()} mesh: no vertices or faces could be read")
-    if mass is not None and density is not None:
-        raise ValueError("mass, density: give one of them (the mass sets the density)")
-    obj = _object_from_arrays(V, F, f"'{p}'", name or p.stem, density, units, source=str(p), label_path=p,
-                              warn_if_open=mass is None)
-    return obj if mass is None else obj.with_mass(mass)
+    return V, F
 
 
 def mesh_from_object(mesh, name: str = "mesh", density: Optional[float] = None,

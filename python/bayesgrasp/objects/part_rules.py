@@ -32,16 +32,19 @@ def parse_rule(text: str) -> Rule:
     return m.group(1), m.group(2), m.group(3), float(m.group(4))
 
 
-def _centred(V: np.ndarray) -> np.ndarray:
-    lo, hi = V.min(axis=0), V.max(axis=0)
+def _centred(V: np.ndarray, F: np.ndarray) -> np.ndarray:
+    """V in the frame a Scene places the mesh in (bounds of the vertices the faces use)."""
+    used = V[np.unique(F)]
+    lo, hi = used.min(axis=0), used.max(axis=0)
     return V - np.array([(lo[0] + hi[0]) / 2, (lo[1] + hi[1]) / 2, lo[2]])
 
 
 def label_by_rules(vertices, faces, rules: Sequence[Rule], default: str = "body") -> Tuple[np.ndarray, List[str]]:
     """(labels per triangle, part names) by the rules (module docstring); names: the default
     first, then each rule's part in order of first mention."""
-    V = _centred(np.asarray(vertices, dtype=float))
-    C = V[np.asarray(faces)].mean(axis=1)
+    F = np.asarray(faces)
+    V = _centred(np.asarray(vertices, dtype=float), F)
+    C = V[F].mean(axis=1)
     value = {"x": C[:, 0], "y": C[:, 1], "z": C[:, 2], "r": np.hypot(C[:, 0], C[:, 1])}
     names = [default] + [n for n in dict.fromkeys(r[0] for r in rules) if n != default]
     labels = np.zeros(len(C), dtype=np.int32)
@@ -56,16 +59,12 @@ def label_by_rules(vertices, faces, rules: Sequence[Rule], default: str = "body"
 def write_label_file(mesh_path, rules: Sequence[Rule], default: str = "body", units=None) -> Path:
     """Labels the triangles of ``mesh_path`` in file order by the rules and writes
     ``<stem>.parts.json`` beside it; returns its path."""
-    import trimesh
-
     from ..io.units import unit_scale
+    from .mesh_io import read_triangles
 
     p = Path(mesh_path)
-    if not p.is_file():
-        raise FileNotFoundError(f"mesh file not found: '{p}'")
-    m = trimesh.load(str(p), process=False, force="mesh")
-    V = np.asarray(m.vertices, dtype=float) * unit_scale(units)
-    labels, names = label_by_rules(V, np.asarray(m.faces), rules, default)
+    V, F = read_triangles(p)                            # the file's triangles, as load_mesh reads them
+    labels, names = label_by_rules(V * unit_scale(units), F, rules, default)
     out = label_file_for(p)
     out.write_text(json.dumps({"parts": names, "faces": labels.tolist()}))
     return out

@@ -123,7 +123,10 @@ def load_part_labels(path, n_faces) -> PartLabels:
     what = f"part labels {p}"
     if isinstance(n_faces, tuple):
         n_file, n_loaded = n_faces
-        got = np.shape(doc["faces"])
+        try:
+            got = np.shape(doc["faces"])
+        except ValueError:                      # a ragged list
+            raise ValueError(f"{what}: 'faces' must be a flat list of part indices") from None
         if got in ((n_file,), (n_loaded,)):
             return check_part_labels(doc["faces"], doc["parts"], got[0], what=what)
         counts = (f"{n_file}, one per triangle of the mesh file in file order" if n_file == n_loaded else
