@@ -213,6 +213,19 @@ def test_grasp_from_a_pose_file(capsys, tmp_path):
     np.testing.assert_allclose(w["hand_pose"], T, atol=1e-12)
 
 
+
+def test_grasp_json_output_is_a_hand_pose_file(capsys, tmp_path):
+    # the round trip: grasp --json's own output, given back as --hand-pose, closes the same grasp
+    first = grasp_json(capsys, "--object", "mug", "--top", "0.01,0,0.4", "--object-pose", "0.05,0.02,0.3")
+    (tmp_path / "g.json").write_text(json.dumps(first))
+    for frame in ("object", "world"):
+        again = grasp_json(capsys, "--object", "mug", "--hand-pose", str(tmp_path / "g.json"), "--frame", frame,
+                           "--object-pose", "0.05,0.02,0.3")
+        np.testing.assert_allclose(again["hand_pose"], first["hand_pose"], atol=1e-12)
+        np.testing.assert_allclose(again["joint_angles"], first["joint_angles"], atol=1e-9)
+        assert again["lifted"] == first["lifted"]
+
+
 @pytest.mark.parametrize("args, needle", [
     (["--approach", "0,0,0"], "--approach: direction"),
     (["--approach", "0,0,-1", "--at", "0,0,-0.05"], "--approach: target: below the table"),

@@ -315,3 +315,13 @@ def test_open_mesh_warns_and_weighs_the_solid_it_bounds(tmp_path):
     # the sampled solid is the cube (jittered-grid sampling: within 1%)
     assert o.volume == pytest.approx(0.06 ** 3, rel=0.01)
     np.testing.assert_allclose(o.com, c.com, atol=1e-3)
+
+
+def test_a_near_miss_of_a_built_in_name_says_which_was_meant():
+    with pytest.raises(ValueError, match=r"'mgu' is neither a built-in object nor an existing file \(did you mean 'mug'\?\)"):
+        load_object("mgu")
+    with pytest.raises(ValueError, match=r"\(did you mean 'bottle/3'\?\)"):
+        load_object("bottel/3")
+    with pytest.raises(ValueError) as e:
+        load_object("xyzzy")
+    assert "did you mean" not in str(e.value)

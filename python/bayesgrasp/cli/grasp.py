@@ -9,8 +9,8 @@ Exactly one of:
   first contact with the object or the table, then closes; the roll turns the hand about
   -direction (roll 0: the palm-down top-grasp hand tilted by the smallest rotation taking -z
   onto the direction; ``--approach 0,0,-1 --roll YAW --at X,Y,0`` is ``--top X,Y,YAW``);
-* ``--hand-pose FILE.json``: the hand closes at a 4x4 pose (a JSON list of 4 rows, or
-  ``{"pose": [...]}``).
+* ``--hand-pose FILE.json``: the hand closes at a 4x4 pose (a JSON list of 4 rows,
+  ``{"pose": [...]}``, or what ``grasp --json`` wrote: the same grasp again).
 
 Everything is in the object's frame unless ``--frame world``.
 """
@@ -33,8 +33,8 @@ def add(sub) -> None:
     mode.add_argument("--top", metavar="X,Y,YAW", help="top grasp: metres, metres, radians")
     mode.add_argument("--approach", metavar="DX,DY,DZ", help="approach direction (any length but zero)")
     mode.add_argument("--hand-pose", "--pose", dest="hand_pose", action=Renamed, old=["--pose"], metavar="FILE.json",
-                      help="4x4 hand pose: a JSON list of 4 rows or {\"pose\": ...} (--pose: the old spelling, "
-                           "deprecated)")
+                      help="4x4 hand pose: a JSON list of 4 rows, {\"pose\": ...} or the output of grasp --json "
+                           "(--pose: the old spelling, deprecated)")
     g.add_argument("--roll", type=float, default=None, help="with --approach: roll about -direction (radians; default 0)")
     g.add_argument("--at", metavar="X,Y,Z", default=None,
                    help="with --approach: a point on the palm's line of motion (default: the centre of the object's "
@@ -127,17 +127,22 @@ def _request(args) -> dict:
         target = None if args.at is None else floats(args.at, 3, "--at")
         return {"mode": "approach", "approach": {"direction": direction, "roll": float(args.roll or 0.0),
                                                  "target": target}}
-    return {"mode": "pose", "pose": _read_pose(args.hand_pose)}
+    return {"mode": "pose", "pose": _read_pose(args.hand_pose, args.frame)}
 
 
-def _read_pose(path: str) -> list:
+def _read_pose(path: str, frame: str = "object") -> list:
+    """The 4x4 pose of a --hand-pose file: a list of 4 rows, ``{"pose": ...}``, or the JSON that
+    ``grasp --json`` writes (its hand pose in --frame: ``hand_pose_object`` or ``hand_pose``)."""
     try:
         doc = json.loads(Path(path).read_text())
     except OSError as e:
         raise CliError(f"--hand-pose: cannot read {path}: {e.strerror or e}") from None
     except ValueError as e:
         raise CliError(f"--hand-pose: {path} is not JSON: {e}") from None
-    m = doc.get("pose") if isinstance(doc, dict) else doc
+    if isinstance(doc, dict) and "hand_pose_object" in doc and "hand_pose" in doc:   # grasp --json's output
+        m = doc["hand_pose_object" if frame == "object" else "hand_pose"]
+    else:
+        m = doc.get("pose") if isinstance(doc, dict) else doc
     try:
         M = np.asarray(m, dtype=float)
     except (TypeError, ValueError):

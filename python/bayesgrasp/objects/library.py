@@ -353,8 +353,16 @@ def builtin(name: str, density: Optional[float] = None,
     """A built-in object by name (``mug``, ``mug/3``, ``bottle/7``, ...)."""
     p = object_params(name)
     if p is None:
-        raise ValueError(f"unknown built-in object '{name}'; available: {', '.join(list_objects())}")
+        raise ValueError(f"unknown built-in object '{name}'{_did_you_mean(name)}; available: {', '.join(list_objects())}")
     return generate(p, name=name, use_boolean=use_boolean, density=density)
+
+
+def _did_you_mean(name: str) -> str:
+    """The hint " (did you mean 'mug'?)" for a near miss of a built-in name (difflib), else ""."""
+    import difflib
+
+    close = difflib.get_close_matches(name, list_objects(), n=1, cutoff=0.6)
+    return f" (did you mean '{close[0]}'?)" if close else ""
 
 
 def load_object(name_or_path, density: Optional[float] = None, units: Optional[str] = None,
@@ -401,5 +409,5 @@ def load_object(name_or_path, density: Optional[float] = None, units: Optional[s
         return load_mesh(p, density=density, units=units, mass=mass)
     if p.suffix.lower() in MESH_EXTENSIONS or os.sep in s and not _NAME_RE.match(s):
         raise FileNotFoundError(f"mesh file not found: '{s}' (and it is not a built-in object name)")
-    raise ValueError(f"'{s}' is neither a built-in object nor an existing file; built-in objects: "
+    raise ValueError(f"'{s}' is neither a built-in object nor an existing file{_did_you_mean(s)}; built-in objects: "
                      f"{', '.join(list_objects())} (category members accept any index, e.g. mug/12)")
