@@ -105,9 +105,11 @@ def test_fusion_episode_equals_the_fuse_command(capsys, tmp_path, options):
         ex = top_grasp(world, np.array(nxt["top_grasp"]), np.array(POSE), nxt["grasp"]["spread"])
         doc = cli_json(capsys, "episode", "observe", d, "--joints", ",".join(map(repr, ex["joint_angles"].tolist())),
                        "--lifted", "yes" if ex["lifted"] else "no", "--json")
-    # fuse makes round 1 even after a lifted round 0 (the thesis's accounting); an episode ends at a lift
+    # fuse and an episode both end at the first lift (the experiment, as the thesis ran it, makes
+    # round 1 even after a lifted round 0)
     rounds = inproc["rounds"]
     n = next((k + 1 for k, r in enumerate(rounds) if r["lifted"]), len(rounds))
+    assert n == len(rounds)
     assert n >= 2, "the scene should take a tactile round (a round-0 lift tests no update)"
     assert grasps == [r["top_grasp"] for r in rounds[:n]]
     assert [b["weights"] for b in beliefs] == [r["weights"] for r in rounds[:n]]

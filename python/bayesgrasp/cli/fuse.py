@@ -65,7 +65,8 @@ def run(args) -> int:
     hand = Hand.load(ctx.hand)
     rounds = []
     fmt = output_format(args)
-    r = trial.run(args.start, rounds=args.rounds, on_round=None if fmt != "text" else _print_round(trial.names))
+    r = trial.run(args.start, rounds=args.rounds, on_round=None if fmt != "text" else _print_round(trial.names),
+                  stop_at_lift=True)
     for rec in r["rounds"]:
         rounds.append({"round": rec["round"], "top_grasp": rec["action"],
                        "grasp": hand_grasp_record(hand, rec["hand_pose"], rec["joint_positions"], trial.spread),
@@ -73,7 +74,7 @@ def run(args) -> int:
                        "weights": dict(zip(trial.names, rec["weights"])),
                        "poses": dict(zip(trial.names, rec["poses"])), "underflow": rec["underflow"],
                        **({"part": rec["part"]} if "part" in rec else {})})
-    success = any(x["lifted"] for x in rounds)
+    success = bool(rounds[-1]["lifted"])       # it stops at the first lift: the last grasp's outcome
     doc = {"scene_object": args.scene_object, "object_pose": pose, "category": args.category, "task": args.task,
            "start": args.start, "belief": args.belief, "task_term": args.task_term, "rounds": rounds, "success": success,
            "scene": (args.cloud or args.depth) if view is not None else "simulated view",

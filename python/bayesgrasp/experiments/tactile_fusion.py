@@ -117,8 +117,10 @@ class FusionTrial:
             self.pose[1] + np.sin(self.pose[2]) * c[0] + np.cos(self.pose[2]) * c[1]
         return np.array([cx + rng.uniform(-0.03, 0.03), cy + rng.uniform(-0.03, 0.03), rng.uniform(-np.pi, np.pi)])
 
-    def run(self, mode: str = "random", rounds: int = ROUNDS, on_round=None) -> dict:
-        """G(0) (random or vision-planned) and up to ``rounds`` tactile rounds."""
+    def run(self, mode: str = "random", rounds: int = ROUNDS, on_round=None, stop_at_lift: bool = False) -> dict:
+        """G(0) (random or vision-planned) and up to ``rounds`` tactile rounds, until a grasp after
+        round 1 is lifted (the thesis's protocol always runs round 1); ``stop_at_lift``: from the
+        first lifted grasp on, round 0 included (the robot's rule: the object is up)."""
         rng, planner = self.start()
         belief = planner.belief
         g0 = self.random_grasp(rng) if mode == "random" else planner.plan().action
@@ -127,7 +129,7 @@ class FusionTrial:
             on_round(records[-1])
         for t in range(1, rounds + 1):
             last = records[-1]
-            if t > 1 and any(r["lifted"] for r in records):
+            if (t > 1 or stop_at_lift) and any(r["lifted"] for r in records):
                 break
             up = planner.observe(last["action"], last["measurement"])
             plan = planner.plan()
