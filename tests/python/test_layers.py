@@ -42,7 +42,7 @@ EXTENSIONS = {"_core"}   # compiled from cpp/bindings: no source in the package
 LAYERS = [
     {"", "_core", "_args", "cache", "hand_urdf"},  # peers: they import nothing of the package
     # the numerical modules, ordered by their imports; peers in a row import none of each other
-    {"hand", "gp", "belief", "optim", "quality", "lift_trace", "io"},
+    {"hand", "gp", "belief", "optim", "quality", "lift_trace", "io", "decomposition"},
     {"sim", "vision"},               # sim -> hand; vision -> belief
     {"physics"},                     # physics -> sim
     {"objects"},

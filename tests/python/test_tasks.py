@@ -65,7 +65,7 @@ def test_labels_survive_a_rigid_transform_and_user_label_files(tmp_path):
     assert m.part_names == ("a", "b") and m.parts.tolist() == labels
     assert m.part_of_faces([0, 1]).tolist() == ["a", "b"]
     (tmp_path / "box.parts.json").write_text(json.dumps({"parts": ["a"], "faces": [0, 1]}))
-    with pytest.raises(ValueError, match="one label per triangle"):
+    with pytest.raises(ValueError, match="expected 12, one per triangle of the mesh file in file order"):
         load_mesh(path)
     with pytest.raises(ValueError, match="labels must lie"):
         load_part_labels(_write(tmp_path / "x.json", {"parts": ["a"], "faces": [1] * 12}), 12)
