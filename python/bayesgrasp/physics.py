@@ -68,13 +68,11 @@ def _hand(hand):
     return hand
 
 
-def is_concave(vertices, faces, hand=None, mass_properties=None) -> bool:
+def is_concave(vertices, faces, hand=None) -> bool:
     """Whether the lift test counts the object as concave (its convex hull's volume more than
-    5% above its own, the mesh's or ``mass_properties``'): then ``shape="auto"`` needs a convex
-    decomposition."""
+    5% above its own): then ``shape="auto"`` needs a convex decomposition."""
     o = make_options(shape="hull")  # cheap: no tetrahedra, no pieces
-    return _core.physics.LiftTester(_hand(hand), np.asarray(vertices, dtype=float), np.asarray(faces), o,
-                                    None, mass_properties).concave
+    return _core.physics.LiftTester(_hand(hand), np.asarray(vertices, dtype=float), np.asarray(faces), o).concave
 
 
 class LiftTester:

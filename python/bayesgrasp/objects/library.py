@@ -388,10 +388,9 @@ def load_object(name_or_path, density: Optional[float] = None, units: Optional[s
     import os
     from pathlib import Path
 
-    from .mesh_io import MESH_EXTENSIONS, load_mesh, mesh_from_object
+    from .mesh_io import MESH_EXTENSIONS, check_mass_or_density, load_mesh, mesh_from_object
 
-    if mass is not None and density is not None:
-        raise ValueError("mass, density: give one of them (the mass sets the density)")
+    check_mass_or_density(mass, density)
     if isinstance(name_or_path, ObjectModel):
         return name_or_path if mass is None else name_or_path.with_mass(mass)
     if hasattr(name_or_path, "vertices") and (hasattr(name_or_path, "faces") or hasattr(name_or_path, "triangles")) \

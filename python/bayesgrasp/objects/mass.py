@@ -42,8 +42,6 @@ FILL_RAYS = 15
 #: Wall thickness of the shell model, m (a thin plastic or ceramic wall).
 DEFAULT_SHELL_THICKNESS = 0.003
 
-MASS_METHODS = ("mesh", "fill", "shell")
-
 
 def _core_mass_properties(volume: float, mass: float, com, inertia):
     from bayesgrasp import _core

@@ -110,7 +110,7 @@ class ObjectModel:
             self._mp, self.mass_method = _mass.closed_mass_properties(self.vertices, self.faces, self.density), "mesh"
         else:
             self._mp, self.mass_method = _mass.open_mass_properties(self.vertices, self.faces, self.density)
-            if self.warn_if_open:
+            if self.warn_if_open and self.given_mass is None:   # weighed: its volume only sets the density
                 how = ("the solid it bounds (sampled)" if self.mass_method == "fill" else
                        f"a {1000 * _mass.DEFAULT_SHELL_THICKNESS:g} mm shell (it encloses no volume)")
                 warnings.warn(f"mesh '{self.name}' ({self.source or 'in memory'}) is not watertight: its mass "
@@ -257,13 +257,16 @@ def load_mesh(path: Union[str, os.PathLike], density: Optional[float] = None,
         MeshWarning: the mesh is not watertight (mass properties then of the solid it bounds, or
             of a thin shell: :mod:`bayesgrasp.objects.mass`).
     """
-    if mass is not None and density is not None:
-        raise ValueError("mass, density: give one of them (the mass sets the density)")
+    check_mass_or_density(mass, density)
     p = Path(path)
     V, F = read_triangles(p)
-    obj = _object_from_arrays(V, F, f"'{p}'", name or p.stem, density, units, source=str(p), label_path=p,
-                              warn_if_open=mass is None)
-    return obj if mass is None else obj.with_mass(mass)
+    return _object_from_arrays(V, F, f"'{p}'", name or p.stem, density, units, source=str(p), label_path=p, mass=mass)
+
+
+def check_mass_or_density(mass: Optional[float], density: Optional[float]) -> None:
+    """ValueError when both are given: the mass sets the density."""
+    if mass is not None and density is not None:
+        raise ValueError("mass, density: give one of them (the mass sets the density)")
 
 
 def read_triangles(path: Union[str, os.PathLike]) -> Tuple[np.ndarray, np.ndarray]:
@@ -312,16 +315,14 @@ def mesh_from_object(mesh, name: str = "mesh", density: Optional[float] = None,
         V, F = np.asarray(mesh.vertices), np.asarray(mesh.triangles)
     else:
         raise ValueError(f"{name}: expected a trimesh.Trimesh or an Open3D TriangleMesh, got {type(mesh).__name__}")
-    if mass is not None and density is not None:
-        raise ValueError("mass, density: give one of them (the mass sets the density)")
-    obj = _object_from_arrays(np.array(V, dtype=np.float64), np.array(F), name, name, density, units,
-                              source=f"in memory ({type(mesh).__name__})", warn_if_open=mass is None)
-    return obj if mass is None else obj.with_mass(mass)
+    check_mass_or_density(mass, density)
+    return _object_from_arrays(np.array(V, dtype=np.float64), np.array(F), name, name, density, units,
+                               source=f"in memory ({type(mesh).__name__})", mass=mass)
 
 
 def _object_from_arrays(V: np.ndarray, F: np.ndarray, what: str, name: str, density: Optional[float],
                         units: Optional[str], source: str, label_path: Optional[Path] = None,
-                        warn_if_open: bool = True) -> ObjectModel:
+                        mass: Optional[float] = None) -> ObjectModel:
     """The shared checks and repairs of a mesh given as vertex and face arrays, scaled to metres."""
     import trimesh
 
@@ -360,7 +361,7 @@ def _object_from_arrays(V: np.ndarray, F: np.ndarray, what: str, name: str, dens
         print(f"  weighing {what}", file=sys.stderr, flush=True)
     d = DEFAULT_DENSITY if density is None else density
     return ObjectModel(name, V, F.astype(np.int32), d, source=source, parts=parts, part_names=part_names,
-                       warn_if_open=warn_if_open)
+                       given_mass=mass)
 
 
 def _label_file(mesh_path: Path, keep: np.ndarray):
