@@ -67,6 +67,27 @@ def test_bad_engines_are_refused():
         LocalEngine(0)
 
 
+def test_an_unreachable_cluster_is_refused_in_seconds_before_anything_is_written(tmp_path, capsys):
+    """A Ray head that does not answer: one line naming --address within seconds (Ray's own client
+    retries for minutes), and neither the cache nor the output directory is created."""
+    from bayesgrasp.experiments.engines import check_address
+
+    with pytest.raises(ValueError, match=r"^address: no Ray head at 127.0.0.1:1 "):
+        check_address("127.0.0.1:1")                 # nothing listens on port 1
+    with pytest.raises(ValueError, match="cannot resolve host 'head.invalid'"):
+        check_address("head.invalid:6379")
+    with pytest.raises(ValueError, match="expected HOST:PORT"):
+        check_address("HEAD")
+    cache, out = tmp_path / "shared" / "cache", tmp_path / "out"
+    t0 = time.perf_counter()
+    assert main(["experiment", "pub2", "--engine", "ray", "--address", "127.0.0.1:1", "--cache", str(cache),
+                 "--out", str(out)]) == 2
+    assert time.perf_counter() - t0 < 30
+    err = capsys.readouterr().err
+    assert "--address: no Ray head at 127.0.0.1:1" in err and len(err.strip().splitlines()) == 1
+    assert not cache.exists() and not out.exists()
+
+
 def test_ray_and_local_store_identical_results_and_share_the_models(ray_engine, tmp_path):
     cache = str(tmp_path / "cache")
     ctx = RunContext(cache_dir=cache, model_settings=ModelSettings(**SMALL), families=("top", "side"))

@@ -101,6 +101,8 @@ class RayEngine:
         self._started = False
         if not ray.is_initialized():
             kw = dict(include_dashboard=False, log_to_driver=False, logging_level="ERROR", configure_logging=False)
+            if address:
+                check_address(address)                  # one line within seconds, not Ray's minutes of retries
             try:
                 if address:
                     ray.init(address=address, **kw)
@@ -128,6 +130,32 @@ class RayEngine:
         if self._started and self._ray.is_initialized():
             self._ray.shutdown()
         self._started = False
+
+
+#: seconds to wait for a Ray head's port before the address is declared unreachable
+ADDRESS_TIMEOUT = 5.0
+
+
+def check_address(address: str, timeout: float = ADDRESS_TIMEOUT) -> None:
+    """Checks that a Ray head listens at ``address`` ("HOST:PORT") by opening a TCP connection to
+    it within ``timeout`` seconds (Ray's own client retries for minutes). "auto" and
+    "ray://..." addresses are left to Ray. ValueError "address: ..." naming the address."""
+    import socket
+
+    if address == "auto" or "://" in address:
+        return
+    host, sep, port = address.rpartition(":")
+    if not sep or not host or not port.isdigit() or not 0 < int(port) < 65536:
+        raise ValueError(f"address: expected HOST:PORT (e.g. 10.0.0.5:6379) or auto, got {address!r}")
+    try:
+        with socket.create_connection((host, int(port)), timeout=timeout):
+            pass
+    except socket.gaierror as e:
+        raise ValueError(f"address: cannot resolve host {host!r} of {address} ({e.strerror or e})") from None
+    except OSError as e:
+        why = "no answer" if isinstance(e, socket.timeout) else (e.strerror or str(e))
+        raise ValueError(f"address: no Ray head at {address} ({why} within {timeout:g} s); "
+                         f"start one there with `ray start --head --port {port}`") from None
 
 
 def make_engine(name: str = "local", workers: int = 1, address: Optional[str] = None):
