@@ -207,6 +207,22 @@ def test_no_table_and_nothing_above_it_are_named(box_scan):
         to_table_frame(flat)
 
 
+def test_a_cloud_already_in_the_table_frame_read_as_a_camera_s_gets_the_option_named(box_scan):
+    """A table-frame cloud read as a camera's: the table plane passes through the origin (the
+    camera), so nothing is above it; the error says so and names --cloud-frame table, which then
+    finds the box. A camera's own cloud with nothing on the table gets no such hint."""
+    _, scan = box_scan
+    P = cloud_from_depth(scan.depth, scan.intrinsics)
+    Q = P @ scan.extrinsic[:3, :3].T + scan.extrinsic[:3, 3]           # the table's frame
+    with pytest.raises(ValueError, match=r"nothing above the table.*lies on the table plane.*--cloud-frame table"):
+        to_table_frame(Q)
+    _check_box(to_table_frame(Q, frame="table"), centre=(0.02, -0.01))
+    g = np.stack(np.meshgrid(np.linspace(-0.3, 0.3, 60), np.linspace(-0.3, 0.3, 60)), -1).reshape(-1, 2)
+    with pytest.raises(ValueError, match="nothing above the table") as e:
+        to_table_frame(np.column_stack([g, np.full(len(g), 1.0)]))
+    assert "--cloud-frame" not in str(e.value)
+
+
 def test_unreadable_and_unknown_files_are_named(tmp_path):
     (tmp_path / "bad.ply").write_text("this is not a ply file\n")
     with pytest.raises(ValueError, match="bad.ply: unreadable"):

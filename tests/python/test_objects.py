@@ -163,10 +163,20 @@ def test_category_members_are_distinct(cat):
     assert len(sigs) == len(objs)
 
 
-def test_members_beyond_the_list_are_reproducible():
-    a, b = load_object("bottle/25"), load_object("bottle/25")
+def test_members_beyond_the_list_are_reproducible_and_announced():
+    import warnings
+
+    from bayesgrasp.objects import NewMemberWarning
+
+    with pytest.warns(NewMemberWarning, match=r"bottle/25: not one of the library's bottle/0 \.\.\. bottle/10"):
+        a = load_object("bottle/25")
+    with pytest.warns(NewMemberWarning):
+        b = load_object("bottle/25")
     np.testing.assert_array_equal(a.vertices, b.vertices)
     assert a.params == object_params("bottle/25")
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", NewMemberWarning)
+        load_object("bottle/10"), load_object("mug/6"), load_object("mug")    # listed: no notice
 
 
 @pytest.mark.skipif(not boolean_available(), reason="manifold3d not installed")

@@ -149,6 +149,29 @@ def test_register_several_models_weights_and_open3d_like_input():
         np.testing.assert_array_equal(a.transform, b.transform)
 
 
+def test_no_model_that_fits_is_warned_and_a_fitting_one_is_not():
+    """Weights always sum to 1 over the models that registered; when none covers GOOD_FITNESS of
+    the cloud (an L-block seen, cylinders and a box offered), a RegistrationWarning names the best."""
+    import warnings
+
+    from bayesgrasp.vision import RegistrationWarning
+    from bayesgrasp.vision.registration import GOOD_FITNESS
+
+    L = l_block()
+    V, F = moved(L, planar(0.0, 0.0, 0.3))
+    cam = Camera.looking_at(eye=(0.5, -0.4, 0.5), target=V.mean(axis=0))
+    cloud = cam.capture([(V, F)], seed=7)
+    with pytest.warns(RegistrationWarning, match="no model fits the cloud well: the best fitness is") as w:
+        r = register(cloud, [cylinder(0.01, 0.3), cylinder(0.12, 0.01)], viewpoint=cam.eye, names=["rod", "disc"])
+    ok = [x for x in r if x.success]
+    assert ok and max(x.fitness for x in ok) < GOOD_FITNESS and sum(x.weight for x in r) == pytest.approx(1.0)
+    assert len(w) == 1
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", RegistrationWarning)
+        r = register(cloud, [cylinder(0.04, 0.12), L], viewpoint=cam.eye, names=["cyl", "L"])
+    assert r[1].fitness >= GOOD_FITNESS
+
+
 def test_bad_inputs():
     L = l_block()
     with pytest.raises(ValueError, match="cloud"):

@@ -127,8 +127,11 @@ def to_table_frame(cloud, extrinsic=None, *, frame: str = "camera", viewpoint=No
     if frame == "camera":
         vp = T[:3, 3].copy()
     on_table = np.abs(Q[:, 2]) <= opts.plane_threshold
-    obj = downsample(to_open3d(Q[above_table(Q, on_table, opts)]), opts.voxel)
-    obj = remove_outliers(largest_cluster(obj, opts), opts)
+    try:
+        obj = downsample(to_open3d(Q[above_table(Q, on_table, opts)]), opts.voxel)
+        obj = remove_outliers(largest_cluster(obj, opts), opts)
+    except ValueError as e:
+        raise ValueError(f"{e}{_table_frame_hint(frame, plane)}") from None
     O = np.asarray(obj.points)
     check_extent(O, "the object's cloud", units)
     if T_given is None and frame == "camera":            # origin under the object's centre
@@ -203,6 +206,19 @@ def above_table(Q: np.ndarray, on_table: np.ndarray, opts: TableFrameOptions) ->
         raise ValueError(f"nothing above the table: no point {opts.min_height * 1000:g} mm to "
                          f"{opts.max_height:g} m above it")
     return idx
+
+
+#: a camera this close to the table plane it found (m) cannot have seen the object from above
+CAMERA_ON_TABLE = 0.02
+
+
+def _table_frame_hint(frame: str, plane: np.ndarray) -> str:
+    """The hint for a cloud read in the camera frame whose origin lies on the table plane found:
+    it is most likely in the table frame already."""
+    if frame != "camera" or abs(float(plane[3])) > CAMERA_ON_TABLE:
+        return ""
+    return (f"; the cloud's origin, taken as the camera, lies on the table plane ({abs(float(plane[3])) * 1000:.0f} mm "
+            f"from it): if the cloud is already in the table frame, pass --cloud-frame table (frame='table')")
 
 
 def largest_cluster(pcd, opts: TableFrameOptions):

@@ -6,7 +6,7 @@
 >>> i = scene.add_object(mug, x=0.1, y=0.0, yaw=0.3)
 >>> V, F = scene.object_mesh_world(i)   # (N, 3) float64, (M, 3) int32 in the world frame
 """
-from .library import (CATEGORY_SIZES, builtin, categories, category, generate, list_objects, load_object,
+from .library import (CATEGORY_SIZES, NewMemberWarning, builtin, categories, category, generate, list_objects, load_object,
                       object_params, sample_params)
 from .primitives import boolean_available
 from .mesh_io import DEFAULT_DENSITY, MESH_EXTENSIONS, MeshWarning, ObjectModel, load_mesh, mesh_from_object
@@ -14,7 +14,7 @@ from .topology import mesh_is_watertight
 from .scene import Scene, TableScene
 
 __all__ = [
-    "CATEGORY_SIZES", "DEFAULT_DENSITY", "MESH_EXTENSIONS", "MeshWarning", "ObjectModel", "Scene",
+    "CATEGORY_SIZES", "DEFAULT_DENSITY", "MESH_EXTENSIONS", "MeshWarning", "NewMemberWarning", "ObjectModel", "Scene",
     "TableScene", "boolean_available", "builtin", "categories", "category", "generate",
     "list_objects", "load_mesh", "load_object", "mesh_from_object", "mesh_is_watertight", "object_params",
     "sample_params",

@@ -354,7 +354,23 @@ def builtin(name: str, density: Optional[float] = None,
     p = object_params(name)
     if p is None:
         raise ValueError(f"unknown built-in object '{name}'{_did_you_mean(name)}; available: {', '.join(list_objects())}")
+    _warn_if_new_member(name)
     return generate(p, name=name, use_boolean=use_boolean, density=density)
+
+
+class NewMemberWarning(UserWarning):
+    """A category member beyond the library's listed ones: a new shape generated from its seed
+    (nothing is cached for it yet: its models are built on first use)."""
+
+
+def _warn_if_new_member(name: str) -> None:
+    import warnings
+
+    m = _NAME_RE.match(name)
+    if m and m.group(1) in CATEGORY_SIZES and int(m.group(2)) >= CATEGORY_SIZES[m.group(1)]:
+        cat, n = m.group(1), CATEGORY_SIZES[m.group(1)]
+        warnings.warn(f"{name}: not one of the library's {cat}/0 ... {cat}/{n - 1}; a new {cat} generated from its "
+                      f"seed (its models, if needed, are built on first use: minutes)", NewMemberWarning, stacklevel=3)
 
 
 def _did_you_mean(name: str) -> str:

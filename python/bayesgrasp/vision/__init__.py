@@ -50,10 +50,10 @@ from bayesgrasp import _core
 from .camera import Camera, Intrinsics, NoiseModel, SegmentationOptions, SegmentationResult, Table, segment_table
 from .inputs import as_cloud, as_mesh
 from .registration import (FeatureEstimator, RegistrationOptions, RegistrationResult, RegistrationStatus,
-                           Registrar, model_samples, register, registration_options)
+                           RegistrationWarning, Registrar, model_samples, register, registration_options)
 
 __all__ = [
-    "Camera", "SegmentationResult", "RegistrationResult", "Registrar", "segment_table", "register",
+    "Camera", "SegmentationResult", "RegistrationResult", "RegistrationWarning", "Registrar", "segment_table", "register",
     "model_samples", "rotation_error", "as_cloud", "as_mesh", "registration_options",
     "RegistrationOptions", "FeatureOptions", "CorrespondenceOptions", "RansacOptions", "IcpOptions", "UpPrior",
     "FeatureEstimator", "RegistrationStatus", "Intrinsics", "Table", "NoiseModel", "SegmentationOptions",

@@ -105,9 +105,31 @@ class RegistrationResult:
                 "delta": self.delta, "phi": self.phi, "weight": self.weight}
 
 
+class RegistrationWarning(UserWarning):
+    """Models registered, but none fits the cloud well: the shape weights still sum to 1 over them."""
+
+
+#: the fitness (share of the cloud's points within the inlier distance) below which no model is
+#: taken to fit: a right model placed right covers nearly all of a view (>= 0.9 on our views)
+GOOD_FITNESS = 0.8
+
+
+def _warn_if_no_fit(raw: Sequence, names: Sequence) -> None:
+    import warnings
+
+    ok = [(float(r.fitness), n) for r, n in zip(raw, names) if r.success]
+    if ok and max(ok)[0] < GOOD_FITNESS:
+        best, name = max(ok, key=lambda t: t[0])
+        warnings.warn(f"no model fits the cloud well: the best fitness is {best:.2f} ({name}; a fit covers "
+                      f">= {GOOD_FITNESS} of the points); the weights still sum to 1 over the {len(ok)} models "
+                      f"that registered: is the object of the models' kind?", RegistrationWarning, stacklevel=3)
+
+
 def _results(raw: Sequence, names: Sequence) -> List[RegistrationResult]:
-    """Python results from the core's, with the shape weights over the models of the call."""
+    """Python results from the core's, with the shape weights over the models of the call
+    (:class:`RegistrationWarning` when none fits well)."""
     weights = shape_weights([r.phi for r in raw], [r.success for r in raw])
+    _warn_if_no_fit(raw, names)
     return [RegistrationResult(
         success=bool(r.success), reason=r.reason, transform=np.array(r.transform), fitness=float(r.fitness),
         rmse=float(r.rmse), delta=float(r.delta), phi=float(r.phi), weight=float(w), up_cos=float(r.up_cos),
