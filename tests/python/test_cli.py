@@ -189,7 +189,7 @@ def test_grasp_side_approach_of_the_cylinder(capsys, tmp_path):
     assert main(["grasp", "--object", "cylinder", "--approach", "2,0,0", "--at", "0,0,0.06", "--spread", "0",
                  "--no-lift", "--json", "--png", str(png)]) == 0
     d = json.loads(capsys.readouterr().out)
-    assert set(TOP_KEYS) <= set(d) and d["mode"] == "approach" and d["frame"] == "object"
+    assert set(TOP_KEYS) <= set(d) and d["mode"] == "approach" and d["input_frame"] == "object" and d["grasp"]["frame"] == "world"
     assert d["approach"] == {"direction": [2.0, 0.0, 0.0], "roll": 0.0, "target": [0.0, 0.0, 0.06]}
     H = np.array(d["hand_pose"])
     np.testing.assert_allclose(H[:3, 2], [1, 0, 0], atol=1e-12)             # approaching along +x

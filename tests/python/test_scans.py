@@ -271,3 +271,40 @@ def test_grasp_cli_names_the_mesh_and_takes_units_and_mass(tmp_path, capsys):
     assert main(["touch", "--object", str(box_mm), "--units", "mm", "--true-pose", "0.01,0,0.1", "--estimate", "0,0,0",
                  "--budget", "40", "--json"]) == 0
     assert json.loads(capsys.readouterr().out)["errors_before"]["position_error"] == pytest.approx(0.01)
+
+
+TINY_SET = ["--set", "models.n_samples=120", "--set", "models.n_inducing=20", "--set", "models.max_iter=10",
+            "--set", "models.n_lift_samples=20", "--set", "models.n_calibration=0", "--set", "models.n_pilot=20",
+            "--set", "models.spread=0.0", "--set", "models.xy_range=0.03"]
+
+
+def test_every_command_that_reads_a_mesh_takes_units_and_its_results_keep_them(tmp_path, capsys, monkeypatch):
+    """--units through one helper in every command with --object (demo, plan, grasp, touch, episode;
+    register, category and fuse through the camera options); the unit is stored with the result, so
+    `view` and a later `episode observe` read the mesh alike."""
+    from bayesgrasp.cli import build_parser, main
+    from bayesgrasp.viewer import read_result, scene_from_result
+
+    parser = build_parser()
+    sub = next(a for a in parser._actions if a.dest == "command").choices
+    for name, p in sub.items():
+        dests = {a.dest for a in p._actions}
+        if ("object" in dests or "scene_object" in dests) and name != "view":   # view: the unit stored in the result
+            assert "units" in dests, f"{name} reads a mesh but takes no --units"
+    box_mm = tmp_path / "box_mm.stl"
+    trimesh.creation.box(extents=[60, 50, 120]).export(box_mm)
+    assert main(["grasp", "--object", str(box_mm), "--top", "0,0,0", "--units", "mm", "--no-lift", "--json"]) == 0
+    g = tmp_path / "g.json"
+    g.write_text(capsys.readouterr().out)
+    assert json.loads(g.read_text())["units"] == "mm"
+    scene = scene_from_result(read_result(g))
+    assert scene.object.extent == pytest.approx([0.06, 0.05, 0.12])
+    monkeypatch.chdir(tmp_path)
+    cache = ["--cache", str(tmp_path / "cache")]
+    assert main(["episode", "new", "--object", str(box_mm), "--units", "mm", "--estimate", "0,0,0", "--method",
+                 "stability", "--dir", "ep", *TINY_SET, *cache]) == 0
+    capsys.readouterr()
+    state = json.loads((tmp_path / "ep" / "episode.json").read_text())["state"]
+    assert state["object"] == str(box_mm) and state["units"] == "mm"
+    assert main(["episode", "observe", "ep", "--joints", "0,1.2,0.8,1.2,0.8,1.2,0.8", "--lifted", "no", *cache]) == 0
+    assert "attempt 2" in capsys.readouterr().out

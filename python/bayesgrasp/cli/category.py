@@ -58,7 +58,7 @@ def run(args) -> int:
     grasps = task_grasps_arg(args)
     out = plan_and_execute(ep, args.category, args.task, args.method, ctx, seed=ctx.seed, grasps=grasps)
     doc = {"grasp": _grasp_record(out, ctx), "planned_pose": out["pose"], "method": args.method,
-           "category": args.category, "task": args.task, "scene_object": args.scene_object,
+           "category": args.category, "task": args.task, "scene_object": args.scene_object, "units": args.units,
            "object_pose": pose if args.scene_object else None, "executed": out["executed"],
            "scene": (args.cloud or args.depth) if view is not None else "simulated view",
            "models": [{"model": m, "weight": out["weights"][m], "contribution": out["contributions"][m],

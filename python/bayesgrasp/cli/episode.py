@@ -100,7 +100,7 @@ def new(args) -> int:
     if est is None:
         raise CliError("--estimate: needed (or --cloud / --depth to register the object to)")
     ep = PoseEpisode.new(args.dir, obj, est, ctx, method=method, attempts=args.attempts, seed=ctx.seed,
-                         planner=settings)
+                         planner=settings, units=args.units)
     _print_next(ep, fmt)
     return 0
 
@@ -109,6 +109,7 @@ def _new_category(args, fmt: str) -> int:
     """A category task (Pub. V) or vision-then-touch (Pub. VI) episode from one view."""
     from ..experiments.category import observe
     from ..experiments.outside_loop_category import CategoryTaskEpisode, FusionEpisode
+    from ..objects import load_object
 
     if not (args.category and args.task):
         raise CliError("--category, --task: give both")
@@ -125,7 +126,8 @@ def _new_category(args, fmt: str) -> int:
     if view is not None:
         obs = camera_input.observation(view)
     else:
-        obs = observe(args.object, floats(args.object_pose, 3, "--object-pose"), seed=ctx.seed)
+        obj = load_object(args.object, units=args.units) if args.units else args.object   # in its unit
+        obs = observe(obj, floats(args.object_pose, 3, "--object-pose"), seed=ctx.seed)
     exclude = args.exclude if args.exclude is not None else [m for m in [args.object] if m]
     common = dict(exclude=exclude, seed=ctx.seed, grasps=task_grasps_arg(args))
     if method == "fusion":

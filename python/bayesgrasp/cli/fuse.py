@@ -75,7 +75,7 @@ def run(args) -> int:
                        "poses": dict(zip(trial.names, rec["poses"])), "underflow": rec["underflow"],
                        **({"part": rec["part"]} if "part" in rec else {})})
     success = bool(rounds[-1]["lifted"])       # it stops at the first lift: the last grasp's outcome
-    doc = {"scene_object": args.scene_object, "object_pose": pose, "category": args.category, "task": args.task,
+    doc = {"scene_object": args.scene_object, "units": args.units, "object_pose": pose, "category": args.category, "task": args.task,
            "start": args.start, "belief": args.belief, "task_term": args.task_term, "rounds": rounds, "success": success,
            "scene": (args.cloud or args.depth) if view is not None else "simulated view",
            "cloud": cloud_json(trial.episode.observation.cloud)}

@@ -69,14 +69,14 @@ def run(args) -> int:
     grasp = _grasp(world, args, request)
     g = grasp.to_dict()
     out = {
-        "object": args.object, "object_pose": pose, "top": request.get("top"), "hand": world.hand.name,
+        "object": args.object, "units": args.units, "object_pose": pose, "top": request.get("top"), "hand": world.hand.name,
         "joint_angles": [float(v) for v in g["joint_angles"]],
         "joint_names": list(world.hand.core.joint_names),
         "contacts": g["contacts"], "epsilon": g["epsilon"], "volume": g["volume"],
         "lifted": g["lifted"], "lift_displacement": g["lift_displacement"],
         "collision_at_start": g["collision_at_start"],
         "hand_pose": np.asarray(g["hand_pose"]).tolist(),
-        "mode": request["mode"], "frame": args.frame, "approach": request.get("approach"), "pose": request.get("pose"),
+        "mode": request["mode"], "input_frame": args.frame, "approach": request.get("approach"), "pose": request.get("pose"),
         "stopped_by_table": g["stopped_by_table"], "hand_pose_object": np.asarray(g["hand_pose_object"]).tolist(),
         "mass": _mass_used(world.object),
     }
@@ -89,7 +89,7 @@ def run(args) -> int:
     elif fmt == "json":
         print(json.dumps(out))
     else:
-        _print(out, args.object, pose)
+        _print(out, args.object, pose, world.hand.prismatic_joints)
     if png:
         from ..viz import plot_grasp
 
@@ -213,15 +213,16 @@ def _describe(out: dict) -> str:
     return "closing at the given pose"
 
 
-def _print(out: dict, name: str, pose) -> None:
-    print(f"{out['hand']} on {name} at object pose {pose}, {_describe(out)} ({out['frame']} frame)")
+def _print(out: dict, name: str, pose, prismatic) -> None:
+    """The text report; ``prismatic`` per joint: a jaw's travel is printed in mm, an angle in degrees."""
+    print(f"{out['hand']} on {name} at object pose {pose}, {_describe(out)} ({out['input_frame']} frame)")
     print(f"  object mass {out['mass']['kg']:.3f} kg, from {out['mass']['from']}")
     if out["collision_at_start"]:
         print("  the open hand starts in collision: no grasp")
     if out["stopped_by_table"]:
         print("  the approach was stopped by the table before it touched the object")
-    print("  joint angles (deg): " + ", ".join(f"{n}={np.degrees(v):.1f}"
-                                                 for n, v in zip(out["joint_names"], out["joint_angles"])))
+    print("  joints: " + ", ".join(f"{n}={1000 * v:.1f} mm" if jaw else f"{n}={np.degrees(v):.1f} deg"
+                                   for n, v, jaw in zip(out["joint_names"], out["joint_angles"], prismatic)))
     print(f"  contacts: {len(out['contacts'])}")
     for c in out["contacts"]:
         where = "table" if c["on_table"] else (c["part"] or "object")

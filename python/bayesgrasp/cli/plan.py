@@ -31,6 +31,7 @@ def add(sub) -> None:
     d.add_argument("--out", default="out/demo", help="directory for the PNG and results")
     add_context_options(d)
     add_families_option(d)
+    add_object_options(d)
     d.set_defaults(run=demo)
 
     p = sub.add_parser("plan", help="run the planning loop on an object at a hidden true pose",
@@ -104,6 +105,7 @@ def demo(args) -> int:
     """The main job: a mug at a displaced pose the robot knows only to +-4 cm and +-45 deg;
     plan, grasp, read the fingers, update the belief, re-plan until the grasp is stable."""
     out = out_dir(args.out)
+    obj = object_arg(args) if args.units or args.mass is not None else args.object   # a mesh in its unit, weighed
     ctx = context(args)
     rng = np.random.default_rng(ctx.seed)
     pose = [float(rng.uniform(-0.08, 0.08)), float(rng.uniform(-0.08, 0.08)), float(rng.uniform(-np.pi, np.pi))]
@@ -111,12 +113,12 @@ def demo(args) -> int:
     print(f"{args.object} at a hidden pose ({100 * pose[0]:.1f} cm, {100 * pose[1]:.1f} cm, "
           f"{np.degrees(pose[2]):.0f} deg); belief: {s.n_particles} particles, +-{100 * s.half_width[0]:g} cm, "
           f"+-{np.degrees(s.half_width[2]):g} deg; method {args.method}")
-    r = _loop(args, ctx, pose)
+    r = _loop(args, ctx, pose, obj=obj)
     f = r["final_belief"]
     print(f"{'success' if r['success'] else 'no successful grasp'} after {len(r['attempts'])} attempt(s); "
           f"final belief error {100 * f['position_error']:.1f} cm, {np.degrees(f['yaw_error']):.0f} deg")
     png = _belief_png(r, out / "belief_evolution.png")
-    doc = _plan_json(args, ctx, pose, r)
+    doc = _plan_json(args, ctx, pose, r, None if isinstance(obj, str) else obj)
     (out / "demo.json").write_text(json.dumps(doc, indent=1))
     pictures = _attempt_pictures(doc, out)
     print(f"saved {png}, {out / 'demo.json'} (see it in 3D: bayesgrasp view {out / 'demo.json'}) and "
@@ -176,7 +178,7 @@ def _plan_json(args, ctx, pose, r: dict, obj=None) -> dict:
 
     f = r["final_belief"]
     grasps = _attempt_grasps(r, ctx.hand)
-    return {"object": args.object, "method": args.method, "true_pose": pose, "estimate": r["estimate"],
+    return {"object": args.object, "units": args.units, "method": args.method, "true_pose": pose, "estimate": r["estimate"],
             "success_criterion": ctx.success, "success": r["success"],
             "attempts": [{"plan_type": a["kind"], "family": a["family"], "variant": a["variant"],
                           "top_grasp": a["action"] if a["family"] == "top" else None,

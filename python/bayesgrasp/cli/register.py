@@ -48,7 +48,7 @@ def run(args) -> int:
     doc = {"scene": source, "scene_points": int(len(points)), "models": [r.as_dict() for r in res],
            "cloud": cloud_json(points)}
     if args.scene_object:
-        doc.update(scene_object=str(args.scene_object), pose=pose)
+        doc.update(scene_object=str(args.scene_object), units=args.units, pose=pose)
     if args.json:
         print(json.dumps(doc, indent=2))
     else:

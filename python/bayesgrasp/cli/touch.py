@@ -100,7 +100,7 @@ def _result(args, planner, grasp, readings, r, truth, guess, case) -> dict:
     names = list(planner.model.hand.core.link_names)
     est = np.asarray(planner.estimate, dtype=float)
     return {
-        "object": args.object, "case": case, "optimizer": planner.settings.optimizer,
+        "object": args.object, "units": args.units, "case": case, "optimizer": planner.settings.optimizer,
         "contact_term": planner.settings.contact_term,
         "true_state": truth.tolist(), "initial": guess.tolist(), "estimate": est.tolist(),
         "top_grasp": {"x": grasp.x, "y": grasp.y, "yaw": grasp.yaw, "spread": grasp.spread},

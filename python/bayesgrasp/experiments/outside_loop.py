@@ -234,6 +234,12 @@ def particles_digest(*arrays) -> str:
     return hashlib.sha256(b"".join(np.ascontiguousarray(a, dtype=float).tobytes() for a in arrays)).hexdigest()
 
 
+def _stored_name(obj: ObjectModel) -> str:
+    """How an episode's state names an object to load it again: a mesh file by its path, a
+    built-in by its name."""
+    return obj.source if obj.source and Path(obj.source).is_file() else obj.name
+
+
 # ---- the pose-uncertainty episode (Pub. II-IV) --------------------------------------------------
 class PoseEpisode(DiskEpisode):
     """An episode under pose uncertainty (Pub. II-IV): ``PoseEpisode.new(directory, "mug",
@@ -243,8 +249,9 @@ class PoseEpisode(DiskEpisode):
 
     def __init__(self, directory: Path, state: dict, ctx: RunContext, obj: Optional[ObjectModel] = None):
         super().__init__(directory, state, ctx)
-        self.object = obj if obj is not None else load_object(state["object"])
-        self.models: GraspModels = ctx.models(obj if obj is not None else state["object"])
+        units = state.get("units")                      # a mesh file in mm or cm is read in its unit again
+        self.object = obj if obj is not None else load_object(state["object"], units=units)
+        self.models: GraspModels = ctx.models(obj if obj is not None else self.object if units else state["object"])
         if self.models.info.get("key") != state["models_key"]:
             raise EpisodeError(f"{self.directory}: the episode was planned with other models (key "
                                f"{state['models_key']}, now {self.models.info.get('key')}): same --hand, --cache "
@@ -254,7 +261,9 @@ class PoseEpisode(DiskEpisode):
     @classmethod
     def new(cls, directory, obj: Union[str, ObjectModel], estimate: Sequence[float], ctx: RunContext,
             method: str = "explore", attempts: int = 4, seed: int = 0,
-            planner: Optional[PlannerSettings] = None) -> "PoseEpisode":
+            planner: Optional[PlannerSettings] = None, units: Optional[str] = None) -> "PoseEpisode":
+        """``obj``: a built-in name, a mesh file or an ObjectModel (a file's is stored by its path);
+        ``units``: the mesh file's length unit, stored so that a later process reads it alike."""
         directory = Path(directory)
         if method not in METHODS:
             raise EpisodeError(f"--method: one of {', '.join(METHODS)}; got {method!r}")
@@ -265,9 +274,12 @@ class PoseEpisode(DiskEpisode):
         if est.shape != (3,) or not np.all(np.isfinite(est)):
             raise EpisodeError(f"--estimate: expected three finite numbers (x, y, yaw), got {estimate}")
         settings = planner or PlannerSettings()
-        obj_model = load_object(obj) if isinstance(obj, str) else obj
-        models = ctx.models(obj if isinstance(obj, str) else obj_model)
-        state.update({"object": obj if isinstance(obj, str) else obj_model.name, "models_key": models.info.get("key"),
+        obj_model = load_object(obj, units=units) if isinstance(obj, str) else obj
+        models = ctx.models(obj if isinstance(obj, str) and not units else obj_model)
+        stored = obj if isinstance(obj, str) else _stored_name(obj_model)
+        if units:
+            state["units"] = units
+        state.update({"object": stored, "models_key": models.info.get("key"),
                       "method": method, "estimate": est.tolist(), "planner": settings_json(settings)})
         episode = cls(directory, state, ctx, obj_model)
         episode._create()

@@ -95,11 +95,12 @@ def read_result(path) -> dict:
     return doc
 
 
-def _object(name) -> Optional[ObjectModel]:
+def _object(name, units: Optional[str] = None) -> Optional[ObjectModel]:
+    """The result's object, its mesh file read in the unit the command was given (``units``)."""
     if name is None:
         return None
     try:
-        return load_object(name)
+        return load_object(name, units=units)
     except (OSError, ValueError, KeyError) as e:
         raise ResultError(f"object {name!r}: cannot be loaded ({e}); was its mesh file moved?") from None
 
@@ -125,7 +126,7 @@ def scene_from_result(doc: dict) -> ResultScene:
 def _grasp(doc) -> ResultScene:
     step = Step("grasp", doc["grasp"], _verdict(doc.get("lifted")), _contacts(doc.get("contacts")),
                 trace=doc.get("lift_trace"))
-    return ResultScene("grasp", _object(doc["object"]), np.asarray(doc.get("object_pose") or (0, 0, 0), float), [step],
+    return ResultScene("grasp", _object(doc["object"], doc.get("units")), np.asarray(doc.get("object_pose") or (0, 0, 0), float), [step],
                        title=f"{doc['object']}: {step.outcome}, epsilon {doc.get('epsilon', 0.0):.3f}")
 
 
@@ -133,7 +134,7 @@ def _plan(doc) -> ResultScene:
     steps = [Step(f"attempt {k + 1} ({a.get('plan_type', '')})", a["grasp"], _verdict(a.get("lifted")),
                   _contacts(a.get("contacts")), belief=a.get("belief")) for k, a in enumerate(doc["attempts"])]
     vision = doc.get("vision") or {}
-    return ResultScene("plan", _object(doc["object"]), np.asarray(doc["true_pose"], float), steps, cloud=_cloud(vision),
+    return ResultScene("plan", _object(doc["object"], doc.get("units")), np.asarray(doc["true_pose"], float), steps, cloud=_cloud(vision),
                        title=f"{doc['object']}: {'success' if doc.get('success') else 'no grasp lifted'}")
 
 
@@ -141,7 +142,7 @@ def _category(doc) -> ResultScene:
     pose = doc.get("object_pose")
     step = Step(f"{doc['task']} ({doc['method']})", doc["grasp"], _verdict(doc.get("lifted")),
                 _contacts(doc.get("contacts")), _registered(doc.get("models", [])))
-    return ResultScene("category", _object(doc.get("scene_object")), None if pose is None else np.asarray(pose, float),
+    return ResultScene("category", _object(doc.get("scene_object"), doc.get("units")), None if pose is None else np.asarray(pose, float),
                        [step], cloud=_cloud(doc), title=f"{doc.get('scene_object') or doc.get('scene')}, {doc['task']}: "
                                      f"{'success' if doc.get('success') else doc.get('failure') or 'planned'}")
 
@@ -149,7 +150,7 @@ def _category(doc) -> ResultScene:
 def _fuse(doc) -> ResultScene:
     steps = [Step(f"round {r['round']}", r["grasp"], _verdict(r.get("lifted")),
                   models=_planar_models(r["poses"], r["weights"])) for r in doc["rounds"]]
-    return ResultScene("fuse", _object(doc["scene_object"]), np.asarray(doc["object_pose"], float), steps,
+    return ResultScene("fuse", _object(doc["scene_object"], doc.get("units")), np.asarray(doc["object_pose"], float), steps,
                        cloud=_cloud(doc),
                        title=f"{doc['scene_object']}: vision then touch, "
                              f"{'success' if doc.get('success') else 'no grasp lifted'}")
@@ -159,13 +160,13 @@ def _touch(doc) -> ResultScene:
     """The object at its true pose, the touch, and the model at the fitted estimate (weight 1)."""
     truth, est = doc["true_state"], doc["estimate"]
     step = Step("touch", doc.get("grasp"), "touched", models=[(doc["object"], planar_transform(est[:3]), 1.0)])
-    return ResultScene("touch", _object(doc["object"]), np.asarray(truth[:3], float), [step],
+    return ResultScene("touch", _object(doc["object"], doc.get("units")), np.asarray(truth[:3], float), [step],
                        title=f"{doc['object']}: one touch, {doc.get('optimizer', '')} estimate overlaid")
 
 
 def _register(doc) -> ResultScene:
     pose = doc.get("pose")
-    return ResultScene("register", _object(doc.get("scene_object")), None if pose is None else np.asarray(pose, float),
+    return ResultScene("register", _object(doc.get("scene_object"), doc.get("units")), None if pose is None else np.asarray(pose, float),
                        [Step("registration", None, "", models=_registered(doc["models"]))], cloud=_cloud(doc),
                        title=f"{doc.get('scene')}: {len(doc['models'])} model(s) registered")
 
