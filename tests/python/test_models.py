@@ -140,3 +140,28 @@ def test_a_long_lift_batch_still_reports(monkeypatch):
     assert out.tolist() == [True, False, True, False, True]
     assert any(x.startswith("  lift tests: 0/5 done") for x in lines)   # during the first batch
     assert any("2/5 done, about" in x for x in lines) and any("4/5 done, about" in x for x in lines)
+
+
+def test_models_of_several_objects_says_what_is_missing_and_the_time_left(tmp_path):
+    """RunContext.models_of: the objects not cached are announced before the first build, the time
+    left after each build but the last; a second call finds them all cached and says nothing of
+    building (models_cached reads the cache without loading a GP)."""
+    from bayesgrasp.experiments import RunContext
+    from bayesgrasp.models import models_cached
+
+    tiny = ModelSettings(n_samples=120, n_inducing=20, xy_range=0.03, max_iter=10, seed=5, n_lift_samples=20,
+                         n_calibration=0, n_pilot=20, spread=0.0)
+    said = []
+    ctx = RunContext(cache_dir=str(tmp_path), model_settings=tiny, progress=said.append)
+    build_models("cube", settings=tiny, cache_dir=tmp_path)          # one of the three already cached
+    assert models_cached("cube", settings=tiny, cache_dir=tmp_path)
+    assert not models_cached("cylinder", settings=tiny, cache_dir=tmp_path)
+    models = ctx.models_of(["cube", "cylinder", "mug"])
+    assert [m.loaded_from_cache for m in models] == [True, False, False]
+    plan = [m for m in said if m.startswith("models: ")]
+    assert plan[0].startswith("models: 2 of 3 not cached")
+    assert len(plan) == 2 and plan[1].startswith("models: 1 of 2 built in") and "min left" in plan[1]
+    said.clear()
+    ctx2 = RunContext(cache_dir=str(tmp_path), model_settings=tiny, progress=said.append)
+    ctx2.models_of(["cube", "cylinder", "mug"])
+    assert not [m for m in said if m.startswith("models: ")]

@@ -28,3 +28,24 @@ def test_pub6_writes_csv_tables_and_a_plot(tmp_path):
     assert len(list(csv.DictReader(open(tmp_path / "targets.csv")))) == 5
     assert (tmp_path / "cumulative_success.png").stat().st_size > 5000
     assert "cumulative_success.png" in (tmp_path / "summary.md").read_text()
+    assert "issue" not in (tmp_path / "summary.md").read_text()           # a product's report names no tracker
+
+
+def test_pub5_scales_writes_its_grid_as_a_picture(tmp_path):
+    """pub5_scales' report draws each density's success over the s_t x s_R grid (as every
+    experiment writes a PNG); the numbers in its cells are the grid table's."""
+    import numpy as np
+    from PIL import Image
+
+    from bayesgrasp.experiments.category_scales import DENSITIES, GRID, write_report as scales_report
+
+    def run(obj, wins):
+        return {"object": obj, "tasks": {"top": {m: {"success": m in wins} for m in DENSITIES}}}
+
+    results = {name: [(f"{name}-{i}", run(f"mug/{i}", {"laplace"} if k % 2 else {"baseline", "gaussian"}))
+                      for i in range(2)] for k, name in enumerate(GRID)}
+    summary = scales_report(get_experiment("pub5_scales"), results, tmp_path)
+    png = tmp_path / "scales.png"
+    assert png.stat().st_size > 5000 and "scales.png" in (tmp_path / "summary.md").read_text()
+    assert np.asarray(Image.open(png)).std() > 10                           # drawn, not blank
+    assert {r["laplace"] for r in summary["grid"]} == {0.0, 1.0}

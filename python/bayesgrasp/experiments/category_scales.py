@@ -19,6 +19,7 @@ import numpy as np
 from ..planners.category import CategorySettings
 from . import report
 from .category import plan_and_execute, see
+from .category_plots import plot_scale_grid
 from .category_grasping import TASKS, prepare_task_grasps, view
 from .category_stats import grid_rows, nested_rows
 from .context import RunContext
@@ -59,8 +60,10 @@ def write_report(exp: Experiment, results: Dict[str, list], out: Path) -> dict:
     grid, nested = grid_rows(results, GRID, DENSITIES), nested_rows(results, MUGS, GRID, OURS)
     report.write_csv(grid, out / "grid.csv")
     report.write_csv(nested, out / "nested.csv")
+    png = plot_scale_grid(grid, DENSITIES, out / "scales.png", f"{exp.name}: success over Eq. 4.1's density scales")
     md += ["Success = lifted and the contacts on the task's parts, pooled over the three mug tasks. The same "
            "views at every grid point.", "", report.markdown(grid, tuple(grid[0])), "",
+           f"![success per density over the grid]({png.name})", "",
            "## The scales chosen without the held-out mug", "", report.markdown(nested, tuple(nested[0])), ""]
     summary.update({"grid": grid, "nested": nested})
     return report.finish(out, md, summary)

@@ -4,8 +4,9 @@ from __future__ import annotations
 
 import math
 import sys
+import time
 from dataclasses import dataclass, field, replace
-from typing import Callable, Optional, Union
+from typing import Callable, Optional, Sequence, Union
 
 from .. import DEFAULT_HAND
 from ..models import GraspModels, ModelSettings, get_models, parse_families
@@ -89,10 +90,38 @@ class RunContext:
         settings = settings or self.model_settings or ModelSettings(success=self.success)
         return get_models(obj, self.hand, settings, cache_dir=self.cache_dir, progress=self.progress)
 
+    def models_of(self, objs: Sequence[Union[str, ObjectModel]], settings=None) -> list:
+        """:meth:`models` of several objects, in order (``settings``: one ModelSettings for all, or
+        one per object). Those not cached are announced first (how many, and that a first build
+        takes minutes), and after each build the time left is estimated from the builds so far."""
+        from ..models import models_cached
+
+        default = self.model_settings or ModelSettings(success=self.success)
+        each = list(settings) if isinstance(settings, (list, tuple)) else [settings] * len(objs)
+        each = [s or default for s in each]
+        todo = [not models_cached(o, self.hand, s, cache_dir=self.cache_dir) for o, s in zip(objs, each)]
+        n = sum(todo)
+        if n:
+            self.say(f"models: {n} of {len(objs)} not cached; each is built once (minutes on 2 cores), "
+                     f"later calls load them in seconds")
+        out, built, spent = [], 0, 0.0
+        for o, s, build in zip(objs, each, todo):
+            t0 = time.perf_counter()
+            out.append(self.models(o, s))
+            if build:
+                built, spent = built + 1, spent + time.perf_counter() - t0
+                if built < n:
+                    self.say(f"models: {built} of {n} built in {spent / 60:.1f} min; about "
+                             f"{spent / built * (n - built) / 60:.0f} min left")
+        return out
+
     def family_models(self, obj: Union[str, ObjectModel], settings: Optional[ModelSettings] = None) -> dict:
         """{family: GraspModels} for every family of this context (the same settings otherwise)."""
         settings = settings or self.model_settings or ModelSettings(success=self.success)
-        return {f: self.models(obj, replace(settings, family=f)) for f in self.families}
+        if len(self.families) == 1:
+            return {self.families[0]: self.models(obj, replace(settings, family=self.families[0]))}
+        models = self.models_of([obj] * len(self.families), [replace(settings, family=f) for f in self.families])
+        return dict(zip(self.families, models))
 
     def planner_settings(self) -> PlannerSettings:
         """The planners' settings of this context (the defaults when none were given)."""

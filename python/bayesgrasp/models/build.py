@@ -195,6 +195,20 @@ def _as_reloaded(models: GraspModels, files: Optional[_CacheFiles], settings: Mo
 _MODELS: dict = {}
 
 
+def models_cached(obj: Union[str, ObjectModel], hand=DEFAULT_HAND, settings: Optional[ModelSettings] = None,
+                  cache_dir=None) -> bool:
+    """Whether ``obj``'s models are in this process's memo or in ``cache_dir`` (default
+    :func:`default_cache_dir`), i.e. whether :func:`get_models` will not build them. Reads no GP."""
+    settings = settings or ModelSettings()
+    cache_dir = default_cache_dir() if cache_dir is None else cache_dir
+    if (obj if isinstance(obj, str) else id(obj), hand, settings, str(cache_dir)) in _MODELS:
+        return True
+    obj = load_object(obj) if isinstance(obj, str) else obj
+    world = World.single(obj, pose=(0.0, 0.0, 0.0), hand=hand)
+    files = _CacheFiles(cache_dir, cache_key(world.object, world.hand.text or world.hand.name, settings))
+    return all(f.is_file() for f in (files.measurement, files.stability, files.info))
+
+
 def get_models(obj: Union[str, ObjectModel], hand: str = DEFAULT_HAND, settings: Optional[ModelSettings] = None,
                cache_dir=None, progress: Optional[Say] = None) -> GraspModels:
     """build_models with a per-process memo (a worker builds or loads each object's models once);
