@@ -135,7 +135,7 @@ def sweep_points(args) -> list:
 
 def run(args) -> int:
     from ..experiments import driver
-    from ..experiments.engines import check_address, make_engine
+    from ..experiments.engines import check_engine, make_engine
     from ..experiments.registry import EXPERIMENTS, experiment_names, get_experiment
     from ..objects import load_object
 
@@ -164,11 +164,10 @@ def run(args) -> int:
         load_object(o)  # a clear error for an unknown object
     exp = get_experiment(args.name)
     refuse_unread(args, exp.reads, f"experiment {exp.name}")    # not silently dropped
-    if args.address and args.engine == "ray":
-        try:                     # before the output directory or the cache is created
-            check_address(args.address)
-        except ValueError as e:
-            raise CliError(f"--{e}") from None
+    try:                         # before the output directory or the cache is created
+        check_engine(args.engine, args.workers, args.address)
+    except ValueError as e:      # its errors name the field: engine, workers or address
+        raise CliError(f"--{e}") from None
     out = out_dir(args.out or f"out/experiments/{args.name}")
     ctx = context(args)
     points = None

@@ -158,15 +158,24 @@ def check_address(address: str, timeout: float = ADDRESS_TIMEOUT) -> None:
                          f"start one there with `ray start --head --port {port}`") from None
 
 
-def make_engine(name: str = "local", workers: int = 1, address: Optional[str] = None):
-    """An engine by name: "local" (``workers`` processes) or "ray" (a local instance of
-    ``workers`` CPUs, or the cluster at ``address``)."""
+def check_engine(name: str = "local", workers: int = 1, address: Optional[str] = None, reach: bool = True) -> None:
+    """The engine's settings checked before anything starts: the name, ``address`` only for Ray
+    and not with ``workers``, then (``reach``) the address answering (:func:`check_address`).
+    ValueError "FIELD: ..." naming the field at fault."""
     if name not in ENGINES:
         raise ValueError(f"engine: one of {', '.join(ENGINES)}; got {name!r}")
     if address and name != "ray":
         raise ValueError("address: only for engine 'ray'")
     if address and workers != 1:
         raise ValueError(f"workers: the cluster at {address} has its own CPUs; workers {workers} would be ignored")
+    if address and reach:
+        check_address(address)
+
+
+def make_engine(name: str = "local", workers: int = 1, address: Optional[str] = None):
+    """An engine by name: "local" (``workers`` processes) or "ray" (a local instance of
+    ``workers`` CPUs, or the cluster at ``address``)."""
+    check_engine(name, workers, address, reach=False)          # RayEngine checks the address itself
     if name == "local":
         return LocalEngine(workers)
     return RayEngine(workers=None if address else workers, address=address)
