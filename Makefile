@@ -15,7 +15,7 @@ DEB_PACKAGES := build-essential cmake pkg-config python3-dev python3-venv \
 SOURCES := $(shell find cpp python tests/cpp bench -type f \( -name '*.cpp' -o -name '*.hpp' -o -name '*.h' -o -name '*.py' -o -name '*.json' \) 2>/dev/null) \
            CMakeLists.txt pyproject.toml
 
-.PHONY: all demo test bench deps clean distclean ctest pytest fuzz sanitize
+.PHONY: all demo test bench deps clean distclean ctest pytest fuzz sanitize readme
 all: $(VENV)/.installed
 
 # ---- system packages -------------------------------------------------------------------
@@ -56,6 +56,12 @@ pytest: $(VENV)/.installed
 	$(VENV)/bin/python -m pytest -q tests/python
 
 test: ctest pytest
+
+# Every README example, in order, on a clean copy of the clone, checked against its text
+# (experiments with --runs $(README_RUNS)); on a cold model cache the first run takes hours.
+README_RUNS ?= 2
+readme: $(VENV)/.installed
+	mkdir -p out && $(PY) tests/readme/run_readme.py --runs $(README_RUNS) --report out/readme.json
 
 # The long run of the bindings' property-based fuzzing (make test runs 25 cases per target).
 FUZZ_EXAMPLES ?= 1000
