@@ -77,8 +77,8 @@ def check(e: Example, cwd: Path, p: subprocess.CompletedProcess, seconds: float)
                 bad.append(f"{arg}: no {', '.join(missing)}")
         elif kind == "lifted":
             out = p.stdout
-            said = re.search(r"lift test: lifted|\"lifted\": true|-> lifted|success", out)
-            if not said or re.search(r"lift test: dropped|\"lifted\": false", out):
+            said = re.search(r"(?<!not )\blifted\b|\"lifted\": true", out)
+            if not said or re.search(r"\bdropped\b|not lifted|\"lifted\": false", out):
                 bad.append("its text says lifted; the output does not")
         elif kind == "prints":
             got = p.stdout.rstrip("\n").splitlines()
