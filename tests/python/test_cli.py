@@ -270,3 +270,31 @@ def test_grasp_needs_exactly_one_of_top_approach_pose(args, needle, capsys):
 def test_grasp_start_in_the_table_is_reported_not_an_error(capsys):
     d = grasp_json(capsys, "--object", "cube", "--approach", "1,0,0", "--at", "0,0,0.01")
     assert d["collision_at_start"] is True and d["contacts"] == [] and d["epsilon"] == 0.0
+
+
+def test_the_demo_hides_the_mug_where_its_first_grasp_misses(tmp_path):
+    """The demo shows the loop: of the poses its seed draws, it takes the first whose first planned
+    grasp is not lifted (the earlier ones lifted at once: checked here by running them), and its
+    loop then repeats that failed first attempt exactly."""
+    import argparse
+
+    import numpy as np
+
+    from bayesgrasp.cli.plan import DEMO_DRAWS, _demo_pose
+    from bayesgrasp.experiments import RunContext
+    from bayesgrasp.experiments.episode import EpisodeSettings, run_episode
+    from bayesgrasp.models import ModelSettings
+
+    tiny = ModelSettings(n_samples=200, n_inducing=30, max_iter=20, seed=5, n_lift_samples=60, n_calibration=0,
+                         n_pilot=20, spread=0.0)
+    ctx = RunContext(cache_dir=str(tmp_path), model_settings=tiny, seed=2)
+    args = argparse.Namespace(method="explore")
+    pose, skipped = _demo_pose(args, ctx, "mug")
+    assert skipped == 2                          # seed 2: the first two draws' first grasps lift
+    rng = np.random.default_rng(ctx.seed)
+    draws = [[rng.uniform(-0.08, 0.08), rng.uniform(-0.08, 0.08), rng.uniform(-np.pi, np.pi)] for _ in range(DEMO_DRAWS)]
+    assert pose == [float(v) for v in draws[skipped]]
+    first = lambda p, n: run_episode("mug", p, EpisodeSettings(method="explore", attempts=n), ctx, seed=ctx.seed)  # noqa: E731
+    assert all(first(draws[k], 1)["attempts"][0]["success"] for k in range(skipped))
+    full = first(pose, 4)
+    assert not full["attempts"][0]["success"] and len(full["attempts"]) >= 2

@@ -107,12 +107,14 @@ def demo(args) -> int:
     out = out_dir(args.out)
     obj = object_arg(args) if args.units or args.mass is not None else args.object   # a mesh in its unit, weighed
     ctx = context(args)
-    rng = np.random.default_rng(ctx.seed)
-    pose = [float(rng.uniform(-0.08, 0.08)), float(rng.uniform(-0.08, 0.08)), float(rng.uniform(-np.pi, np.pi))]
+    pose, skipped = _demo_pose(args, ctx, obj)
     s = ctx.planner_settings()
     print(f"{args.object} at a hidden pose ({100 * pose[0]:.1f} cm, {100 * pose[1]:.1f} cm, "
           f"{np.degrees(pose[2]):.0f} deg); belief: {s.n_particles} particles, +-{100 * s.half_width[0]:g} cm, "
           f"+-{np.degrees(s.half_width[2]):g} deg; method {args.method}")
+    if skipped:
+        print(f"  (the hidden pose is draw {skipped + 1} of seed {ctx.seed}: at the first {skipped}, the first grasp "
+              f"lifted and the belief would not have moved)")
     r = _loop(args, ctx, pose, obj=obj)
     f = r["final_belief"]
     print(f"{'success' if r['success'] else 'no successful grasp'} after {len(r['attempts'])} attempt(s); "
@@ -124,6 +126,28 @@ def demo(args) -> int:
     print(f"saved {png}, {out / 'demo.json'} (see it in 3D: bayesgrasp view {out / 'demo.json'}) and "
           f"{len(pictures)} picture(s) of the hand on the {args.object}: {', '.join(p.name for p in pictures)}")
     return 0
+
+
+#: hidden poses the demo draws at most, looking for one whose first grasp misses
+DEMO_DRAWS = 12
+
+
+def _demo_pose(args, ctx, obj) -> tuple:
+    """The demo's hidden pose, drawn from --seed (+-8 cm, any yaw), and the number of draws skipped:
+    a draw whose first planned grasp already lifts shows nothing of the belief (it never updates),
+    so the next is taken, up to DEMO_DRAWS (then the last). The check is the loop's own first
+    attempt (the same seed, so the demo repeats it exactly)."""
+    from ..experiments.episode import run_episode
+
+    rng = np.random.default_rng(ctx.seed)
+    models = ctx.family_models(obj)
+    for k in range(DEMO_DRAWS):
+        pose = [float(rng.uniform(-0.08, 0.08)), float(rng.uniform(-0.08, 0.08)), float(rng.uniform(-np.pi, np.pi))]
+        first = run_episode(obj, pose, EpisodeSettings(method=args.method, attempts=1), ctx, seed=ctx.seed,
+                            models=models)
+        if not first["attempts"][0]["success"]:
+            return pose, k
+    return pose, DEMO_DRAWS - 1
 
 
 def _attempt_pictures(doc: dict, out: Path) -> list:
