@@ -79,3 +79,23 @@ def test_no_grasp_results_name_the_reason():
 
 def test_psi_by_hand():
     np.testing.assert_allclose(psi([0.0, -0.1, 0.1, 0.2], 0.1, 0.01), [0.01, 0.01, 1 - np.exp(-1), 1 - np.exp(-2)])
+
+
+@pytest.mark.parametrize("method", ["laplace", "gaussian", "baseline"])
+def test_a_grasp_whose_target_maps_below_the_table_is_never_sent(method):
+    """A registration that puts a model's grasp under the table (target z = -5 cm): the plan takes
+    the other model's grasp, or, with no other, is empty with the reason; never a target z < 0
+    (the simulator refuses one: the defect seen on a real bottle mesh)."""
+    under, fine = rz(0.0, (0.0, 0.0, -0.35)), rz(0.0, (0.03, 0.0, 0.0))
+    assert (under @ TOP)[2, 3] == pytest.approx(-0.05)
+    gs = [grasp("a", TOP, eps=0.4), grasp("b", TOP, eps=0.2)]
+    regs = [RegistrationResult.known("a", under, phi=0.9), RegistrationResult.known("b", fine, phi=0.8)]
+    p = CategoryPlanner(HAND, gs, regs, settings=CategorySettings(method=method), seed=4).plan()
+    if method == "baseline":      # the best-fitting model's only grasp is under the table: no plan
+        assert not p.ok and "below the table" in p.reason
+    else:
+        assert p.ok and p.pose[2, 3] >= 0.0 and p.dominant_model == "b"
+    alone = CategoryPlanner(HAND, gs[:1], regs[:1], settings=CategorySettings(method=method), seed=4).plan()
+    assert not alone.ok and "below the table" in alone.reason
+    held = CategoryPlanner(HAND, gs[:1], regs[:1], settings=CategorySettings(method=method, table=False), seed=4).plan()
+    assert held.ok                 # no table (a tool held off it): z < 0 is just space

@@ -227,8 +227,15 @@ class CategoryPlanner:
     def _penalised(self, reference: np.ndarray, X: np.ndarray, spread: float, density) -> np.ndarray:
         s = self.settings
         J = self.mixture.evaluate_local(reference, X, density, s.threads)
-        d = self.intrusion(_task.poses_from_local(reference, X), spread)
-        return J * np.exp(-d / s.clearance_scale)
+        poses = _task.poses_from_local(reference, X)
+        d = self.intrusion(poses, spread)
+        return J * np.exp(-d / s.clearance_scale) * ~self.below_table(poses)
+
+    def below_table(self, poses: np.ndarray) -> np.ndarray:
+        """(N,) whether each hand pose's target (its position) lies under the table top, z < 0: such a
+        grasp cannot be executed (the simulator refuses it), so it is never chosen. All False without a table."""
+        P = np.asarray(poses, float)
+        return (P[:, 2, 3] < 0.0) if self.settings.table else np.zeros(len(P), bool)
 
     def intrusion(self, poses: np.ndarray, spread: float) -> np.ndarray:
         """Deepest intrusion (m) of the table or the cloud into the open hand at each pose (N, 4, 4)."""
@@ -273,11 +280,13 @@ class CategoryPlanner:
                           n_particles=s.pso_particles, max_iter=s.pso_iter, seed=int(rng.integers(2**31)), init=init)
             nfev += r.nfev
             optima.append(_task.poses_from_local(ref, r.x[None, :])[0])
-            if -r.fun > best_val:
+            if -r.fun > best_val and not self.below_table(optima[-1][None])[0]:
                 best_val, best_start = -r.fun, c
                 best = optima[-1]
         if s.method == "part-aware":
             return self._part_aware(optima, rng, nfev)
+        if best is None:
+            return self._empty("every start's optimum has its target below the table")
         return self._result(best, best_val, best_start, nfev)
 
     # ---- part-aware: Eq. 4.1's candidates re-ranked by where the fingers land ------------------------
@@ -304,6 +313,9 @@ class CategoryPlanner:
         on some model (P > 0), and J alone if none passes."""
         s = self.settings
         A = self.candidates(optima, rng)
+        A = A[~self.below_table(A)]            # a target under the table is never sent
+        if not len(A):
+            return self._empty("every candidate's target lies below the table")
         v = self.evaluate(A)
         comp = np.asarray(v.dominant, int)
         spreads = np.array([self.grasps[c].spread if c >= 0 else self.grasps[0].spread for c in comp], float)
@@ -331,6 +343,9 @@ class CategoryPlanner:
         idx = np.flatnonzero(self.model_of == i)
         if not len(idx):
             return self._empty(f"the best-fitting model {self.registrations[i].model} has no task grasp")
+        idx = idx[~self.below_table(self.mapped[idx])]
+        if not len(idx):
+            return self._empty(f"every task grasp of {self.registrations[i].model} maps below the table")
         c = int(idx[np.argmax(self.psi[idx])])
         return self._result(self.mapped[c], None, c, 0)
 
