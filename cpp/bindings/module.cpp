@@ -15,6 +15,7 @@ void bind_optim(py::module_& m);
 void bind_vision(py::module_& m);
 void bind_task(py::module_& m);
 void bind_touch(py::module_& m);
+void bind_deform(py::module_& m);
 }  // namespace bayesgrasp::bind
 
 namespace {
@@ -44,6 +45,7 @@ PYBIND11_MODULE(_core, m) {
       {"vision", "Simulated depth camera, table segmentation, FPFH + RANSAC + ICP registration.", bind_vision},
       {"task", "Task grasping (Eq. 4.1): pose densities, grasp mixtures, hand clearance.", bind_task},
       {"touch", "One touch (Pub. I): the executed grasp re-simulated against candidate object states.", bind_touch},
+      {"deform", "Non-rigid registration: Coherent Point Drift and its displacement field.", bind_deform},
   };
   for (const Submodule& s : submodules) {
     py::module_ sub = m.def_submodule(s.name, s.doc);

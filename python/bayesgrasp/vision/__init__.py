@@ -49,6 +49,7 @@ from bayesgrasp import _core
 
 from .camera import Camera, Intrinsics, NoiseModel, SegmentationOptions, SegmentationResult, Table, segment_table
 from .inputs import as_cloud, as_mesh
+from .deform import CpdOptions, MeshWarp, coherent_point_drift, warp_mesh
 from .registration import (FeatureEstimator, RegistrationOptions, RegistrationResult, RegistrationStatus,
                            RegistrationWarning, Registrar, model_samples, register, registration_options)
 
@@ -57,6 +58,7 @@ __all__ = [
     "model_samples", "rotation_error", "as_cloud", "as_mesh", "registration_options",
     "RegistrationOptions", "FeatureOptions", "CorrespondenceOptions", "RansacOptions", "IcpOptions", "UpPrior",
     "FeatureEstimator", "RegistrationStatus", "Intrinsics", "Table", "NoiseModel", "SegmentationOptions",
+    "CpdOptions", "MeshWarp", "coherent_point_drift", "warp_mesh",
 ]
 
 _v = _core.vision
