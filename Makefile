@@ -12,10 +12,11 @@ DEB_PACKAGES := build-essential cmake pkg-config python3-dev python3-venv \
   libeigen3-dev libfcl-dev libbullet-dev libqhull-dev nlohmann-json3-dev liblbfgspp-dev \
   libpcl-dev libgtest-dev libbenchmark-dev libopenblas-openmp-dev chromium chromium-driver
 
-SOURCES := $(shell find cpp python tests/cpp bench -type f \( -name '*.cpp' -o -name '*.hpp' -o -name '*.h' -o -name '*.py' -o -name '*.json' \) 2>/dev/null) \
-           CMakeLists.txt pyproject.toml
+# What the package's build reads: bench/'s C++ (its binaries share the build tree), not its scripts or results.
+SOURCES := $(shell find cpp python tests/cpp -type f \( -name '*.cpp' -o -name '*.hpp' -o -name '*.h' -o -name '*.py' -o -name '*.json' \) 2>/dev/null) \
+           $(wildcard bench/*.cpp bench/*.hpp) CMakeLists.txt pyproject.toml
 
-.PHONY: all demo test bench deps clean distclean ctest pytest fuzz sanitize readme
+.PHONY: all demo test bench bench-peers deps clean distclean ctest pytest fuzz sanitize readme
 all: $(VENV)/.installed
 
 # ---- system packages -------------------------------------------------------------------
@@ -78,6 +79,34 @@ $(BENCH_VENV)/.base: build/.deps-ok
 
 bench: $(VENV)/.installed $(BENCH_VENV)/.base
 	BENCH_PY=$(BENCH_VENV)/bin/python BAYESGRASP_PY=$(PY) BUILD_DIR=build/py bash bench/bench_all.sh
+
+# Peer planners (issue 52), each in its own virtual environment, driven by bench/peers/*_driver.py
+# (JSON request in, JSON result out; bench/peers/README.md). For now one smoke run on the mug.
+PEER_PBG := .venv-peer-pbg
+PEER_CGN := .venv-peer-cgn
+PEERS_OUT := bench/results/peers_smoke
+PEER_MESH := tests/data/ycb/025_mug.stl
+$(PEER_PBG)/.installed: bench/peers/requirements-pybullet-grasper.txt | build/.deps-ok
+	$(PYTHON) -m venv $(PEER_PBG)
+	$(PEER_PBG)/bin/pip install -q --upgrade pip
+	$(PEER_PBG)/bin/pip install -q -r bench/peers/requirements-pybullet-grasper.txt
+	@touch $@
+$(PEER_CGN)/.installed: bench/peers/requirements-cgn.txt bench/peers/requirements-cgn-nodeps.txt | build/.deps-ok
+	$(PYTHON) -m venv $(PEER_CGN)
+	$(PEER_CGN)/bin/pip install -q --upgrade pip
+	$(PEER_CGN)/bin/pip install -q -r bench/peers/requirements-cgn.txt
+	$(PEER_CGN)/bin/pip install -q --no-deps -r bench/peers/requirements-cgn-nodeps.txt
+	@touch $@
+
+bench-peers: $(PEER_PBG)/.installed $(PEER_CGN)/.installed
+	mkdir -p $(PEERS_OUT)
+	$(PEER_PBG)/bin/python bench/peers/make_partial_cloud.py $(PEER_MESH) $(PEERS_OUT)/mug_cloud.npy
+	for hand in barrett robotiq_2f85; do \
+	  echo '{"mesh": "$(PEER_MESH)", "pose": [0, 0, 0], "hand": "'$$hand'", "top_k": 5, "seed": 0}' > $(PEERS_OUT)/request_pbg_$$hand.json; \
+	  $(PEER_PBG)/bin/python bench/peers/pybullet_grasper_driver.py $(PEERS_OUT)/request_pbg_$$hand.json $(PEERS_OUT)/pybullet_grasper_$$hand.json || exit 1; \
+	done
+	echo '{"cloud": "$(PEERS_OUT)/mug_cloud.npy", "mesh": "$(PEER_MESH)", "pose": [0, 0, 0], "top_k": 5, "seed": 0}' > $(PEERS_OUT)/request_cgn.json
+	$(PEER_CGN)/bin/python bench/peers/cgn_driver.py $(PEERS_OUT)/request_cgn.json $(PEERS_OUT)/cgn.json
 
 clean:
 	rm -rf build/py out
