@@ -178,3 +178,65 @@ def test_epsilon_of_chosen_rows_is_the_batch_epsilon():
     rows = np.array([7, 0, 3, 11])
     np.testing.assert_allclose(w.epsilon_of(lazy, rows), full.epsilon[rows], rtol=1e-9, atol=1e-12)
 
+
+
+def _stretched(name=MUG, sx=1.3, lift=0.0):
+    """The model stretched along x (its handle further out) and raised by ``lift``: the same
+    triangles and labels, another shape, as an ObjectModel in the model's frame."""
+    from bayesgrasp.objects import ObjectModel, load_object
+
+    m = load_object(name)
+    V = m.vertices * [sx, 1.0, 1.0] + [0.0, 0.0, lift]
+    return ObjectModel(f"{m.name}~stretched", V, m.faces, density=m.density, parts=m.parts, part_names=m.part_names)
+
+
+@pytest.mark.parametrize("lift", [0.0, 0.01])
+def test_closing_on_a_given_shape_is_closing_on_that_shape_placed_by_the_registration(lift):
+    """check_candidates(shapes=[S]) gives, candidate by candidate, the parts that the hand touches
+    on S itself placed at the registration (S resting on the table: a shape whose bottom moved is
+    put back on it, and the candidates move with it, keeping their place on the shape)."""
+    from bayesgrasp.world import World
+
+    S = _stretched(lift=lift)
+    T = placed(0.7, (0.04, -0.02, 0.0))
+    rule = task_rule("mug", "handle")
+    A = np.array([T @ approach((-np.cos(a), -np.sin(a), 0.0), z) for a in (-0.4, 0.0, 0.5) for z in (0.03, 0.06)])
+    check = check_candidates(HAND, rule, A, 0.0, [RegistrationResult.known(MUG, T, phi=1.0)], [1.0],
+                             shapes=[S], resolve=False)
+    direct = World.single(S, pose=(0.04, -0.02, 0.7), hand=HAND, keep_origin=True)
+    down = np.eye(4)
+    down[2, 3] = -lift                                       # S put back on the table; the candidates move with it
+    A = np.array([T @ down @ np.linalg.inv(T) @ a for a in A])
+    rolls = np.array([Hand.approach_roll(a) for a in A])
+    b = direct.approach_batch(A[:, :3, 2], A[:, :3, 3], rolls, spread=0.0, frame="world")
+    for k in range(len(A)):
+        lo, hi = b.contacts.offsets[k], b.contacts.offsets[k + 1]
+        assert sorted(check.parts[k][0]) == sorted(p for p in b.contact_part[lo:hi] if p is not None)
+    if lift == 0.0:
+        assert check.p_rule.max() == 1.0                    # a handle grasp passes on the stretched shape
+    with pytest.raises(ValueError, match="shapes: one per registration"):
+        check_candidates(HAND, rule, A, 0.0, [RegistrationResult.known(MUG, T)], [1.0], shapes=[S, S])
+
+
+def test_the_warped_method_checks_its_candidates_on_the_models_warped_onto_the_cloud():
+    """A stretched mug seen as a cloud, mug/1 registered onto it: the warped method's shapes are
+    mug/1 warped to within millimetres of the stretched mug, and its plan passes the handle rule
+    there."""
+    from scipy.spatial import cKDTree
+
+    from bayesgrasp.vision import model_samples
+
+    S = _stretched()
+    T = placed(-0.5, (0.0, 0.03, 0.0))
+    P, _ = model_samples(S, samples=2500, seed=2)
+    cloud = P @ T[:3, :3].T + T[:3, 3]
+    regs = [RegistrationResult.known(MUG, T, phi=1.0)]
+    grasps = [TaskGrasp(model=MUG, task="handle", pose=HANDLE, spread=0.0, epsilon=0.2, lifted=True)]
+    planner = CategoryPlanner(HAND, grasps, regs, cloud=cloud, rule=task_rule("mug", "handle"),
+                              settings=CategorySettings(method="warped", part_candidates=16), seed=1)
+    (shape,) = planner.warped_models()
+    surface = cKDTree(model_samples(S, samples=30000, seed=3)[0])
+    assert np.median(surface.query(shape.vertices)[0]) < 0.002
+    assert shape.part_names == S.part_names and np.array_equal(shape.parts, S.parts)
+    plan = planner.plan()
+    assert plan.ok and plan.method == "warped" and plan.extra["p_rule"] == 1.0

@@ -50,7 +50,10 @@ from .protocol import as_reading
 
 _task = _core.task
 
-METHODS = ("laplace", "regularised", "gaussian", "baseline", "part-aware")
+METHODS = ("laplace", "regularised", "gaussian", "baseline", "part-aware", "warped")
+#: the methods that close their candidates on the models (part_check): on the models as registered,
+#: or on the models warped onto the cloud (vision.deform: Coherent Point Drift)
+PART_METHODS = ("part-aware", "warped")
 THESIS_METHODS = METHODS[:4]
 
 
@@ -87,6 +90,7 @@ class CategorySettings:
     part_rotation: float = float(np.radians(15.0))
     part_tiebreak: float = 0.1
     part_jitter_yaw: Sequence[float] = ()   # rad: the models also closed turned by these (see part_check)
+    warp_samples: int = 800                 # warped: surface points of each model warped onto the cloud (CPD)
 
     def __post_init__(self):
         if self.method not in METHODS:
@@ -111,7 +115,7 @@ class CategorySettings:
 
     def density(self):
         d = _task.PoseDensity()
-        kind = self.part_density if self.method == "part-aware" else self.method
+        kind = self.part_density if self.method in PART_METHODS else self.method
         d.kind = {"laplace": _task.DensityKind.laplace, "regularised": _task.DensityKind.regularised,
                   "gaussian": _task.DensityKind.gaussian, "baseline": _task.DensityKind.laplace}[kind]
         d.translation_scale, d.rotation_scale = self.translation_scale, self.rotation_scale
@@ -150,8 +154,8 @@ class CategoryPlanner:
         """``rule``: the task's rule, needed by the part-aware method (the part check)."""
         self.hand = hand if isinstance(hand, Hand) else Hand.load(hand)
         self.settings = settings or CategorySettings()
-        if self.settings.method == "part-aware" and rule is None:
-            raise ValueError("method part-aware: needs the task's rule (rule=task_rule(category, task))")
+        if self.settings.method in PART_METHODS and rule is None:
+            raise ValueError(f"method {self.settings.method}: needs the task's rule (rule=task_rule(category, task))")
         self.rule = rule
         self.registrations = list(registrations)
         if not self.registrations:
@@ -283,7 +287,7 @@ class CategoryPlanner:
             if -r.fun > best_val and not self.below_table(optima[-1][None])[0]:
                 best_val, best_start = -r.fun, c
                 best = optima[-1]
-        if s.method == "part-aware":
+        if s.method in PART_METHODS:
             return self._part_aware(optima, rng, nfev)
         if best is None:
             return self._empty("every start's optimum has its target below the table")
@@ -320,8 +324,9 @@ class CategoryPlanner:
         comp = np.asarray(v.dominant, int)
         spreads = np.array([self.grasps[c].spread if c >= 0 else self.grasps[0].spread for c in comp], float)
         J = np.asarray(v.value, float) * np.exp(-self._intrusions(A, spreads) / s.clearance_scale)
+        shapes = self.warped_models() if s.method == "warped" else None
         check = check_candidates(self.hand, self.rule, A, spreads, self.registrations, self.weights, s.threads,
-                                 resolve=False, jitter_yaw=tuple(s.part_jitter_yaw))
+                                 resolve=False, jitter_yaw=tuple(s.part_jitter_yaw), shapes=shapes)
         k = choose_lazily(check, J, s.part_tiebreak)
         plan = self._result(A[k], float(J[k]), None, nfev + len(A) * int(np.count_nonzero(self.weights > 0)))
         plan.extra.update({"p_rule": float(check.p_rule[k]), "p_success": float(check.p_success[k]),
@@ -330,6 +335,25 @@ class CategoryPlanner:
                            "contact_parts_on_models": {r.model: check.parts[k][i]
                                                        for i, r in enumerate(self.registrations) if self.weights[i] > 0}})
         return plan
+
+    def warped_models(self) -> list:
+        """Per registration: its training model warped onto the observed cloud (an ObjectModel in
+        the model's own frame, the same triangles and part labels: an estimate of the new object's
+        shape), or None (weight 0, not registered, or no cloud: the model as registered)."""
+        from ..objects import ObjectModel, load_object
+        from ..vision.deform import warp_mesh
+
+        out = []
+        for r, w in zip(self.registrations, self.weights):
+            if w <= 0 or not r.success or len(self.cloud) < 10:
+                out.append(None)
+                continue
+            m = load_object(r.model)
+            warp = warp_mesh(m, r.transform, self.cloud, samples=self.settings.warp_samples, seed=self.seed)
+            out.append(ObjectModel(f"{m.name}~warped", warp.vertices, m.faces, density=m.density,
+                                   source=f"{m.source} warped onto the cloud", parts=m.parts,
+                                   part_names=m.part_names))
+        return out
 
     def _intrusions(self, poses: np.ndarray, spreads: np.ndarray) -> np.ndarray:
         d = np.zeros(len(poses))

@@ -206,8 +206,21 @@ def _turned(yaw: float) -> np.ndarray:
     return T
 
 
+def shape_world(shape, hand: Hand, table: bool):
+    """(a world holding ``shape``, an ObjectModel in its model's frame, and the 4x4 shift from that
+    frame to the world's): the shape keeps its xy origin and rests on the table (its lowest point
+    at z = 0), as a warped model whose bottom moved would."""
+    from ..world import World
+
+    world = World.single(shape, pose=(0.0, 0.0, 0.0), hand=hand, table=table, keep_origin=True)
+    shift = np.eye(4)
+    shift[:3, 3] = world.scene.object_offset(0)
+    return world, shift
+
+
 def check_candidates(hand: Hand, rule: TaskRule, poses, spreads, registrations: Sequence, weights,
-                     threads: int = 1, resolve: bool = True, jitter_yaw: Sequence[float] = ()) -> PartCheck:
+                     threads: int = 1, resolve: bool = True, jitter_yaw: Sequence[float] = (),
+                     shapes: Sequence = None) -> PartCheck:
     """Every candidate ``poses`` (K, 4, 4, scene frame) closed on every registered model with
     weight > 0 (the others count 0): a :class:`PartCheck`; held computed for every candidate unless
     ``resolve`` is False (then :func:`choose_lazily` computes what it needs). Held is only computed
@@ -215,22 +228,31 @@ def check_candidates(hand: Hand, rule: TaskRule, poses, spreads, registrations: 
 
     ``jitter_yaw`` (rad): the model is also closed turned by each of these about its own vertical
     axis (T_i Rz(d)), as a registration that got the yaw slightly wrong would place it; rule_ok is
-    then the share of the placements on which the rule holds (held is read at T_i itself)."""
+    then the share of the placements on which the rule holds (held is read at T_i itself).
+
+    ``shapes``: per registration an ObjectModel (in that model's frame) to close on instead of the
+    model itself, e.g. the model warped onto the cloud (None entries: the model)."""
     A = np.asarray(poses, float).reshape(-1, 4, 4)
     S = np.broadcast_to(np.asarray(spreads, float), (len(A),))
     w = np.asarray(weights, float)
     if len(w) != len(registrations):
         raise ValueError(f"weights: one per registration ({len(registrations)}), got {len(w)}")
+    if shapes is not None and len(shapes) != len(registrations):
+        raise ValueError(f"shapes: one per registration ({len(registrations)}) or None, got {len(shapes)}")
     per_model = {}
     for i, reg in enumerate(registrations):
         if w[i] <= 0 or not reg.success or not len(A):
             continue
-        world = model_world(reg.model, hand, bool(rule.table))
+        shape = None if shapes is None else shapes[i]
+        if shape is None:
+            world, shift = model_world(reg.model, hand, bool(rule.table)), np.eye(4)
+        else:
+            world, shift = shape_world(shape, hand, bool(rule.table))
         T = np.asarray(reg.transform, float)
-        r, parts, closings = close_on_model(world, rule, np.linalg.inv(T) @ A, S, threads)
+        r, parts, closings = close_on_model(world, rule, shift @ np.linalg.inv(T) @ A, S, threads)
         r = r.astype(float)
         for d in jitter_yaw:
-            r += close_on_model(world, rule, np.linalg.inv(T @ _turned(float(d))) @ A, S, threads)[0]
+            r += close_on_model(world, rule, shift @ np.linalg.inv(T @ _turned(float(d))) @ A, S, threads)[0]
         per_model[i] = (r / (1 + len(jitter_yaw)), parts, closings)
     return _combine(len(A), len(registrations), w, per_model, threads, resolve)
 
