@@ -32,7 +32,7 @@ equal to our table frame, z up, table top at z = 0):
   hand 0.1 m along +z. `pose` in our result is therefore `pose_peer @ Trans(0, 0, 0.1)`: the hand's
   base link at the moment of closing (nominal; a collision on the way may stop it short).
 * Barrett hand (base link `bh_base_link`): origin at the wrist side of the palm housing, centre of
-  the palm; the palm face is at z = +0.090 m. Finger 3 (the thumb, joints bh_j32/bh_j33) is at
+  the palm; the palm face is at z = +0.079 m (palm_280.obj within 30 mm of the centre; 0.090 m is the top of finger 3's housing). Finger 3 (the thumb, joints bh_j32/bh_j33) is at
   y = -0.05 m, fingers 1 and 2 (bh_j12/bh_j13, bh_j22/bh_j23) at x = +/-0.025 m, y = +0.05 m; at zero
   joint angles the fingers lie flat along -y and +y and curl towards +z as their joints grow
   (0 to 2.44 rad, distal joint coupled at 0.344 of the proximal one). The spread bh_j11 (coupled
