@@ -73,7 +73,7 @@ PBG_TIP = (-0.0477, 0.0349, 0.0)
 PBG_SPREAD = 0.01   # rad, bh_j11 (and bh_j21 by mimic) held there by the peer (driver docstring)
 # The palm face in bh_base_link: z = 0.079 m at the centre of the palm (visual/palm_280.obj, every
 # vertex within 30 mm of the z axis is at z <= 0.0793; the collision hull palm_280_vhacd.obj
-# reaches 0.0797 there). The driver docstring's 0.090 m is the top of finger 3's housing
+# reaches 0.0797 there). 0.090 m, the highest point near the centre, is the top of finger 3's housing
 # (x within +/-12.5 mm, y from -0.060 to -0.038 m), not the palm face under the object.
 PBG_PALM_FACE_Z = 0.079
 
