@@ -28,6 +28,7 @@ void bind_deform(py::module_& m) {
       .field("max_iterations", &CpdOptions::max_iterations, "int", "EM iterations at most")
       .field("tolerance", &CpdOptions::tolerance, "float", "stop when the variance changes by less than this fraction")
       .field("rank", &CpdOptions::rank, "int", "Nystrom landmarks (0 or >= the model's points: exact)")
+      .field("cutoff", &CpdOptions::cutoff, "float", "pairs farther apart than this many sigma are left out of the E-step (0: every pair)")
       .field("threads", &CpdOptions::threads, "int", "threads of the E-step (0 = all cores)")
       .validator([](const CpdOptions& o) { deform::validate(o); })
       .finish();

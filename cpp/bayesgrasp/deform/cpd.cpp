@@ -5,6 +5,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
+#include <utility>
 #include <stdexcept>
 #include <vector>
 
@@ -21,6 +23,7 @@ void validate(const CpdOptions& o, const std::string& prefix) {
   require_at_least(o.max_iterations, 1, prefix + "max_iterations");
   require_non_negative(o.tolerance, prefix + "tolerance");
   require_at_least(o.rank, 0, prefix + "rank");
+  require_non_negative(o.cutoff, prefix + "cutoff");
   thread_count(o.threads, (prefix + "threads").c_str());
 }
 
@@ -67,12 +70,58 @@ struct Posterior {
   double NP = 0.0;     // 1^T P 1
 };
 
+/// The moved model's points binned in cubes of side `cell` (their neighbours within `cell` of a
+/// query lie in the 27 cubes around it); empty when the cubes would be too few to save anything.
+struct Grid {
+  double cell = 0.0;
+  Eigen::RowVector3d lo;
+  std::vector<std::pair<std::int64_t, int>> keyed;  // (cube key, point), sorted by key
+
+  static std::int64_t key(long i, long j, long k) { return (i * 4096 + j) * 4096 + k; }
+  Eigen::Array3i cube(const Eigen::RowVector3d& p) const {
+    return ((p - lo).array() / cell).floor().cast<int>().transpose();
+  }
+
+  Grid(const Points& T, double cutoff_distance) {
+    const Eigen::RowVector3d hi = T.colwise().maxCoeff();
+    lo = T.colwise().minCoeff();
+    if (!(cutoff_distance > 0.0) || cutoff_distance * 3.0 > (hi - lo).maxCoeff()) return;  // too coarse: every pair
+    // cubes no smaller than 1/2000 of the extent keep the keys apart (4096 per axis); a larger
+    // cube still holds every neighbour within the cutoff in the 27 around a point, and a key
+    // shared by a far point costs a distance, never a wrong term (each pair's distance is checked)
+    cell = std::max(cutoff_distance, (hi - lo).maxCoeff() / 2000.0);
+    keyed.reserve(T.rows());
+    for (Eigen::Index m = 0; m < T.rows(); ++m) {
+      const Eigen::Array3i c = cube(T.row(m));
+      keyed.emplace_back(key(c(0), c(1), c(2)), int(m));
+    }
+    std::sort(keyed.begin(), keyed.end());
+  }
+  bool used() const { return cell > 0.0; }
+
+  /// Calls f(m) for every point in the 27 cubes around p.
+  template <class F>
+  void near(const Eigen::RowVector3d& p, F&& f) const {
+    const Eigen::Array3i c = cube(p);
+    for (int i = -1; i <= 1; ++i)
+      for (int j = -1; j <= 1; ++j)
+        for (int k = -1; k <= 1; ++k) {
+          const std::int64_t q = key(c(0) + i, c(1) + j, c(2) + k);
+          auto it = std::lower_bound(keyed.begin(), keyed.end(), std::make_pair(q, -1));
+          for (; it != keyed.end() && it->first == q; ++it) f(it->second);
+        }
+  }
+};
+
 /// E-step: posteriors of the moved model's components for every observed point, with the
-/// uniform outlier term c, accumulated per thread over the observed points.
-Posterior e_step(const Points& X, const Points& T, double sigma2, double w, int threads) {
+/// uniform outlier term c, accumulated per thread over the observed points. With a cutoff, only
+/// the components within cutoff * sigma of a point are summed (found through a Grid).
+Posterior e_step(const Points& X, const Points& T, double sigma2, double w, double cutoff, int threads) {
   const long N = X.rows(), M = T.rows();
   const double c = std::pow(2.0 * M_PI * sigma2, 1.5) * w / (1.0 - w) * double(M) / double(N);
   const double g = -0.5 / sigma2;
+  const double r2 = cutoff * cutoff * sigma2;
+  const Grid grid(T, cutoff * std::sqrt(sigma2));
   const int nt = thread_count_for(threads, N);
   std::vector<Eigen::VectorXd> P1s(nt, Eigen::VectorXd::Zero(M));
   std::vector<Disp> PXs(nt, Disp::Zero(M, 3));
@@ -82,16 +131,38 @@ Posterior e_step(const Points& X, const Points& T, double sigma2, double w, int 
   {
     const int t = omp_get_thread_num();
     Eigen::VectorXd k(M);
+    std::vector<std::pair<int, double>> terms;
 #pragma omp for schedule(static)
     for (long n = 0; n < N; ++n) {
       const Eigen::RowVector3d x = X.row(n);
-      for (long m = 0; m < M; ++m) k(m) = std::exp(g * (x - T.row(m)).squaredNorm());
-      const double den = k.sum() + c;
+      if (!grid.used()) {
+        for (long m = 0; m < M; ++m) k(m) = std::exp(g * (x - T.row(m)).squaredNorm());
+        const double den = k.sum() + c;
+        if (!(den > 0.0)) continue;
+        k /= den;
+        P1s[t] += k;
+        PXs[t].noalias() += k * x;
+        out.Pt1(n) = k.sum();
+        continue;
+      }
+      terms.clear();
+      double sum = 0.0;
+      grid.near(x, [&](int m) {
+        const double d2 = (x - T.row(m)).squaredNorm();
+        if (d2 <= r2) {
+          const double e = std::exp(g * d2);
+          terms.emplace_back(m, e);
+          sum += e;
+        }
+      });
+      const double den = sum + c;
       if (!(den > 0.0)) continue;
-      k /= den;
-      P1s[t] += k;
-      PXs[t].noalias() += k * x;
-      out.Pt1(n) = k.sum();
+      for (const auto& [m, e] : terms) {
+        const double p = e / den;
+        P1s[t](m) += p;
+        PXs[t].row(m) += p * x;
+      }
+      out.Pt1(n) = sum / den;
     }
   }
   out.P1 = Eigen::VectorXd::Zero(M);
@@ -163,7 +234,7 @@ CpdResult coherent_point_drift(const Points& model, const Points& observed, cons
   Disp a = Disp::Zero(landmarks.rows(), 3);
   double sigma2 = initial_variance(X, Y);
   for (r.iterations = 1; r.iterations <= options.max_iterations; ++r.iterations) {
-    const Posterior post = e_step(X, T, sigma2, options.outlier_weight, options.threads);
+    const Posterior post = e_step(X, T, sigma2, options.outlier_weight, options.cutoff, options.threads);
     if (!(post.NP > 1e-12)) break;  // nothing observed is explained by the model any more
     a = field_coefficients(C, L, post, Y, options.lambda * sigma2);
     T = Y + C * a;

@@ -37,6 +37,9 @@ struct CpdOptions {
   int max_iterations = 100;
   double tolerance = 1e-3;    // stop when the variance changes by less than this fraction (1e-5: same fit, 2-3x the iterations)
   int rank = 120;             // Nystrom landmarks K; 0 or >= M: every model point (exact)
+  double cutoff = 3.5;        // x sigma: pairs farther apart are left out of the E-step (a grid
+                              // finds the rest; exp(-3.5^2 / 2) = 0.2% of a coincident pair's
+                              // term); 0: every pair
   int threads = 0;            // E-step over the observed points; 0 = all cores (thread_count)
 };
 
