@@ -240,3 +240,11 @@ def test_the_warped_method_checks_its_candidates_on_the_models_warped_onto_the_c
     assert shape.part_names == S.part_names and np.array_equal(shape.parts, S.parts)
     plan = planner.plan()
     assert plan.ok and plan.method == "warped" and plan.extra["p_rule"] == 1.0
+    # another task on the same view reuses the warped models: the same plan, no warp recomputed
+    again = CategoryPlanner(HAND, grasps, regs, cloud=cloud, rule=task_rule("mug", "handle"), warped=[shape],
+                            settings=CategorySettings(method="warped", part_candidates=16), seed=1)
+    assert again.warped_models()[0] is shape
+    np.testing.assert_array_equal(again.plan().pose, plan.pose)
+    with pytest.raises(ValueError, match="warped: one per registration"):
+        CategoryPlanner(HAND, grasps, regs, cloud=cloud, rule=task_rule("mug", "handle"), warped=[shape, shape],
+                        settings=CategorySettings(method="warped"))

@@ -161,6 +161,8 @@ class CategoryEpisode:
     observation: Observation
     registrations: List[RegistrationResult]
     extra: Dict = field(default_factory=dict)
+    #: the training models warped onto this view, per (samples, seed): computed once for every task
+    warps: Dict = field(default_factory=dict, repr=False)
 
 
 def see(obj: Optional[str], pose, category_name: str, exclude: Sequence[str] = (), eye_offset=DEFAULT_EYE_OFFSET,
@@ -186,8 +188,11 @@ def plan_and_execute(ep: CategoryEpisode, category_name: str, task: str, method:
     grasps = demonstrated(ep.models, rule, ctx) if grasps is None else grasps
     grasps = [g for g in grasps if g.task == task]
     s = replace(settings or CategorySettings(method=method), table=rule.table)
+    key = (s.warp_samples, s.clearance_voxel, seed)
     planner = CategoryPlanner(ctx.hand, grasps, ep.registrations, cloud=ep.observation.cloud, settings=s, seed=seed,
-                              rule=rule)
+                              rule=rule, warped=ep.warps.get(key))
     plan = planner.plan()
+    if s.method == "warped":
+        ep.warps[key] = planner.warped_models()        # the same view's other tasks reuse them
     outcome = execute(ep.obj, ep.pose, plan, rule, ctx) if ep.obj is not None else not_executed(plan)
     return {**outcome.to_dict(), **plan.to_dict(), "method": method, "task": task, "task_grasps": len(grasps)}

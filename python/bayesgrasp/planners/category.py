@@ -150,8 +150,10 @@ class CategoryPlanner:
 
     def __init__(self, hand: Hand, task_grasps: Sequence[TaskGrasp], registrations: Sequence[RegistrationResult],
                  cloud=None, settings: Optional[CategorySettings] = None, seed: int = 0,
-                 rule: Optional[TaskRule] = None):
-        """``rule``: the task's rule, needed by the part-aware method (the part check)."""
+                 rule: Optional[TaskRule] = None, warped: Optional[Sequence] = None):
+        """``rule``: the task's rule, needed by the part-aware methods (the part check);
+        ``warped``: :meth:`warped_models` computed before for the same registrations, cloud and
+        seed (another task on the same view), else they are computed when needed."""
         self.hand = hand if isinstance(hand, Hand) else Hand.load(hand)
         self.settings = settings or CategorySettings()
         if self.settings.method in PART_METHODS and rule is None:
@@ -169,6 +171,9 @@ class CategoryPlanner:
         self.seed = int(seed)
         self.weights = normalised_weights(self.registrations)
         self.failed: List[np.ndarray] = []
+        if warped is not None and len(warped) != len(self.registrations):
+            raise ValueError(f"warped: one per registration ({len(self.registrations)}), got {len(warped)}")
+        self._warped = None if warped is None else list(warped)
         self._build_mixture()
 
     @property
@@ -340,6 +345,8 @@ class CategoryPlanner:
         """Per registration: its training model warped onto the observed cloud (an ObjectModel in
         the model's own frame, the same triangles and part labels: an estimate of the new object's
         shape), or None (weight 0, not registered, or no cloud: the model as registered)."""
+        if self._warped is not None:
+            return self._warped
         from ..objects import ObjectModel, load_object
         from ..vision.deform import warp_mesh
 
@@ -353,6 +360,7 @@ class CategoryPlanner:
             out.append(ObjectModel(f"{m.name}~warped", warp.vertices, m.faces, density=m.density,
                                    source=f"{m.source} warped onto the cloud", parts=m.parts,
                                    part_names=m.part_names))
+        self._warped = out
         return out
 
     def _intrusions(self, poses: np.ndarray, spreads: np.ndarray) -> np.ndarray:
