@@ -235,3 +235,20 @@ def test_bad_convex_shape_refused(edit, message):
     edit(shape)
     with pytest.raises(ValueError, match=r"palm\.shapes\[0\]: .*" + message):
         Hand.from_json(json.dumps(spec))
+
+
+@pytest.mark.parametrize("tilt, ok", [(3.67e-6, True), (5e-5, True), (1e-3, False)])
+def test_an_axis_rounded_in_the_urdf_is_taken_within_1e_4_rad(tmp_path, tilt, ok):
+    """A URDF that writes its numbers rounded (1.5708 for pi/2 tilts an axis by 3.7e-6 rad) loads,
+    and grasps as the exact one does; an axis 1e-3 rad out of the palm plane is refused, the
+    tolerance named."""
+    axis = f'<axis xyz="0 -1 {np.tan(tilt):.12g}"/>'
+    path = _copy_bh8(tmp_path, lambda u: u.replace('<axis xyz="0 -1 0"/>', axis, 2))   # bh_j12 and bh_j13
+    if not ok:
+        with pytest.raises(HandFileError, match=r"joint 'bh_j12' axis is not in the palm plane .*up to 0\.0001"):
+            Hand.load(path)
+        return
+    (tmp_path / "exact").mkdir()
+    tilted, exact = Hand.load(path), Hand.load(_copy_bh8(tmp_path / "exact"))
+    q = np.array([0.5, 1.2, 1.0, 1.1, 0.9, 1.3, 1.0])
+    np.testing.assert_allclose(tilted.fingertips(q), exact.fingertips(q), atol=1e-5)

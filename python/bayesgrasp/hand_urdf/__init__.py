@@ -32,7 +32,7 @@ from typing import Optional
 
 import numpy as np
 
-from .urdf import _TOL, HandFileError, _mesh_points, _origin, _pose, _rpy, _shapes_of, _transform, _Tree, _unit
+from .urdf import _AXIS_TOL, _TOL, HandFileError, _mesh_points, _origin, _pose, _rpy, _shapes_of, _transform, _Tree, _unit
 
 __all__ = ["HandFileError", "hand_json_from_urdf", "sidecar_path"]
 
@@ -170,10 +170,13 @@ class _Converter:
         axes = [_unit(T[:3, :3] @ np.asarray(j.axis if j.axis is not None else (1, 0, 0), dtype=float))
                 for T, j in zip(T0, joints)]
         a = axes[0]
-        if abs(a @ z) > _TOL:
-            self._fail(f"{w}: joint '{joints[0].name}' axis is not in the palm plane (its z in the hand frame is {a @ z:.3g})")
+        if abs(a @ z) > _AXIS_TOL:
+            self._fail(f"{w}: joint '{joints[0].name}' axis is not in the palm plane (its z in the hand frame is "
+                       f"{a @ z:.3g}; up to {_AXIS_TOL:g} is taken as in it)")
+        if abs(a @ z) > _TOL:                # within the tolerance: put in the plane
+            a = _unit(a - (a @ z) * z)
         for k, ak in enumerate(axes[1:], 1):
-            if ak @ a < 1.0 - _TOL:
+            if ak @ a < 1.0 - _AXIS_TOL:
                 self._fail(f"{w}: joint '{joints[k].name}' axis is not parallel to '{joints[0].name}''s "
                            "(a finger is a planar chain; a positive angle closes every joint)")
         d = np.cross(z, a)  # outward direction: a positive angle turns d towards +z (a = d x z)
@@ -182,7 +185,7 @@ class _Converter:
             sj = spread_here[0]
             Ts = self._in_hand(self.tree.zero_pose(sj.child))
             saxis = Ts[:3, :3] @ _unit(sj.axis if sj.axis is not None else (1, 0, 0))
-            if abs(abs(saxis @ z) - 1.0) > _TOL:
+            if abs(abs(saxis @ z) - 1.0) > _AXIS_TOL:
                 self._fail(f"{w}: joint '{sj.name}' moves the finger's base but does not turn about the approach axis")
             if spread_joint is None:
                 self._fail(f"{w}: joint '{sj.name}' moves the finger's base but the sidecar's spread is null")
@@ -216,8 +219,10 @@ class _Converter:
             if length < 1e-9:
                 self._fail(f"{w}.phalanges[{k}]: joint '{j.name}' has zero length to the next joint or fingertip")
             x = v / length
-            if abs(x @ a) > _TOL:
+            if abs(x @ a) > _AXIS_TOL:
                 self._fail(f"{w}.phalanges[{k}]: link '{j.child}' does not lie in the finger's plane")
+            if abs(x @ a) > _TOL:
+                x = _unit(x - (x @ a) * a)
             theta = math.atan2(x @ z, x @ d)
             phi = theta - theta_prev  # our relative angle at the URDF's zero
             theta_prev = theta
@@ -259,8 +264,11 @@ class _Converter:
         z = np.array([0.0, 0.0, 1.0])
         T0 = self._in_hand(self.tree.zero_pose(j.child))
         d = _unit(T0[:3, :3] @ np.asarray(j.axis if j.axis is not None else (1, 0, 0), dtype=float))
+        if abs(d @ z) > _AXIS_TOL:
+            self._fail(f"{w}: joint '{j.name}' does not slide in the palm plane (its axis's z in the hand frame is "
+                       f"{d @ z:.3g}; up to {_AXIS_TOL:g} is taken as in it)")
         if abs(d @ z) > _TOL:
-            self._fail(f"{w}: joint '{j.name}' does not slide in the palm plane (its axis's z in the hand frame is {d @ z:.3g})")
+            d = _unit(d - (d @ z) * z)
         for above in self.tree.chain(j.parent):
             if above.type != "fixed" and above not in self.tree.chain(self.side["palm"]["link"]):
                 self._fail(f"{w}: joint '{above.name}' moves the jaw's base; a jaw hangs from the palm by fixed joints")

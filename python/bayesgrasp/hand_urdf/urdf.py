@@ -9,6 +9,10 @@ from pathlib import Path
 import numpy as np
 
 _TOL = 1e-6           # geometric checks (m, or cosine of an angle)
+# Directions (cosines of angles) a URDF writes with rounded numbers: an axis within 1e-4 rad of the
+# palm plane or of another axis is taken as in it or parallel to it, and used projected (1.5708
+# written for pi/2 tilts an axis by 3.7e-6 rad; 1e-4 rad moves a point 5 cm away by 5 micrometres).
+_AXIS_TOL = 1e-4
 _PRISM_SIDES = 32     # a lone cylinder's convex prism
 
 
