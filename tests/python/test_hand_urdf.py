@@ -252,3 +252,19 @@ def test_an_axis_rounded_in_the_urdf_is_taken_within_1e_4_rad(tmp_path, tilt, ok
     tilted, exact = Hand.load(path), Hand.load(_copy_bh8(tmp_path / "exact"))
     q = np.array([0.5, 1.2, 1.0, 1.1, 0.9, 1.3, 1.0])
     np.testing.assert_allclose(tilted.fingertips(q), exact.fingertips(q), atol=1e-5)
+
+
+def test_a_simulator_s_namespaced_extension_is_skipped(tmp_path):
+    """<drake:...> elements (declared or not, as URDFs from simulators carry them) do not stop the
+    hand from loading; broken XML still does."""
+    ext = '<drake:collision_filter_group name="g"><drake:member link="bh_base_link"/></drake:collision_filter_group>'
+    undeclared = _copy_bh8(tmp_path, lambda u: u.replace("</robot>", ext + "</robot>"))
+    assert Hand.load(undeclared).num_joints == 7
+    (tmp_path / "b").mkdir()
+    declared = _copy_bh8(tmp_path / "b", lambda u: u.replace("<robot ", '<robot xmlns:drake="http://drake.mit.edu" ', 1)
+                         .replace("</robot>", ext + "</robot>"))
+    assert Hand.load(declared).text == Hand.load(undeclared).text
+    (tmp_path / "c").mkdir()
+    broken = _copy_bh8(tmp_path / "c", lambda u: u.replace("</robot>", "<drake:open></robot>"))
+    with pytest.raises(HandFileError, match=r"hand\.urdf: not a readable URDF \(XML: "):
+        Hand.load(broken)

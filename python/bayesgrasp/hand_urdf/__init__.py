@@ -67,20 +67,39 @@ def _load_sidecar(path: Path) -> dict:
     return data
 
 
+def _declare_prefixes(text: bytes) -> bytes:
+    """``text`` with every namespace prefix it uses but does not declare (a simulator's
+    extension such as ``<drake:...>``, which URDF readers skip) declared on its root element, so
+    that a strict XML parser reads it; other text is left as it is."""
+    import re
+
+    used = set(re.findall(rb"</?([A-Za-z_][\w.-]*):[A-Za-z_]", text)) | set(re.findall(rb"\s([A-Za-z_][\w.-]*):[\w.-]+\s*=", text))
+    declared = set(re.findall(rb"xmlns:([A-Za-z_][\w.-]*)\s*=", text))
+    missing = sorted(used - declared - {b"xml", b"xmlns"})
+    if not missing:
+        return text
+    decl = b"".join(b' xmlns:%s="urn:undeclared:%s"' % (p, p) for p in missing)
+    return re.sub(rb"<robot\b", b"<robot" + decl, text, count=1)
+
+
 def _load_urdf(path: Path):
+    import io
+
     import yourdfpy
     from lxml import etree
 
-    try:  # strict XML first: yourdfpy recovers from broken XML with a guess
-        root = etree.parse(str(path)).getroot()
+    try:
+        text = _declare_prefixes(path.read_bytes())
     except OSError as e:
         raise HandFileError(f"{path}: cannot read the URDF ({e})") from None
+    try:  # strict XML first: yourdfpy recovers from broken XML with a guess
+        root = etree.fromstring(text)
     except etree.XMLSyntaxError as e:
         raise HandFileError(f"{path}: not a readable URDF (XML: {e})") from None
     if root.tag != "robot":
         raise HandFileError(f"{path}: not a readable URDF (its root element is <{root.tag}>, not <robot>)")
     try:
-        robot = yourdfpy.URDF.load(str(path), build_scene_graph=False, load_meshes=False,
+        robot = yourdfpy.URDF.load(io.BytesIO(text), build_scene_graph=False, load_meshes=False,
                                    build_collision_scene_graph=False, load_collision_meshes=False)
     except OSError as e:
         raise HandFileError(f"{path}: cannot read the URDF ({e.strerror or e})") from None
