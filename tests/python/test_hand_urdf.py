@@ -268,3 +268,28 @@ def test_a_simulator_s_namespaced_extension_is_skipped(tmp_path):
     broken = _copy_bh8(tmp_path / "c", lambda u: u.replace("</robot>", "<drake:open></robot>"))
     with pytest.raises(HandFileError, match=r"hand\.urdf: not a readable URDF \(XML: "):
         Hand.load(broken)
+
+
+def test_a_hand_inside_an_arm_urdf_is_read_from_its_root_link(tmp_path):
+    """The BH8 mounted on a two-joint arm in one URDF: refused while the arm's joints are unnamed;
+    with the sidecar's root naming the hand's base link everything above it is ignored and the hand
+    is the BH8 (the same fingertips at the same joints)."""
+    arm = ('<link name="world"/><link name="arm_1"/><link name="arm_2"/>'
+           '<joint name="arm_j1" type="revolute"><parent link="world"/><child link="arm_1"/><origin xyz="0 0 0.3"/>'
+           '<axis xyz="0 0 1"/><limit lower="-3" upper="3" effort="10" velocity="1"/></joint>'
+           '<joint name="arm_j2" type="revolute"><parent link="arm_1"/><child link="arm_2"/><origin xyz="0 0 0.4"/>'
+           '<axis xyz="0 1 0"/><limit lower="-2" upper="2" effort="10" velocity="1"/></joint>'
+           '<joint name="arm_to_hand" type="fixed"><parent link="arm_2"/><child link="bh_base_link"/>'
+           '<origin xyz="0.1 0 0.05" rpy="0.3 -0.2 1.0"/></joint></robot>')
+    mounted = _copy_bh8(tmp_path, lambda u: u.replace("</robot>", arm))
+    with pytest.raises(HandFileError, match=r"joint 'arm_j\d' moves link '\w+', but the sidecar names it nowhere"):
+        Hand.load(mounted)
+    (tmp_path / "r").mkdir()
+    rooted = _copy_bh8(tmp_path / "r", lambda u: u.replace("</robot>", arm), lambda s: s.update(root="bh_base_link"))
+    (tmp_path / "e").mkdir()
+    hand, exact = Hand.load(rooted), Hand.load(_copy_bh8(tmp_path / "e"))
+    q = np.array([0.4, 1.0, 1.1, 0.8, 1.0, 1.2, 0.9])
+    np.testing.assert_allclose(hand.fingertips(q), exact.fingertips(q), atol=1e-12)
+    (tmp_path / "x").mkdir()
+    with pytest.raises(HandFileError, match=r"root names link 'bh_wrist', which the URDF does not have"):
+        Hand.load(_copy_bh8(tmp_path / "x", lambda u: u.replace("</robot>", arm), lambda s: s.update(root="bh_wrist")))

@@ -125,6 +125,8 @@ def hand_json_from_urdf(urdf: str | Path, sidecar: Optional[str | Path] = None) 
     if named != urdf.resolve():
         raise HandFileError(f"{side_path}: urdf: names {side['urdf']}, but it was loaded with {urdf}")
     tree = _Tree(_load_urdf(urdf), str(urdf))
+    if side.get("root") is not None:
+        tree = tree.below(side["root"], f"{side_path}: root")
     return json.dumps(_Converter(tree, side, str(side_path), urdf.parent).hand(), indent=1)
 
 

@@ -71,6 +71,25 @@ class _Tree:
                     raise HandFileError(f"{where}: kinematic loop through link '{n}'")
                 seen.add(n)
 
+    def below(self, root: str, what: str = "root") -> "_Tree":
+        """Only link ``root`` and the links under it, with the joints between them: a hand read out
+        of a larger URDF (an arm, a simulator's drive joints above the palm). Poses are then
+        relative to ``root``."""
+        if root not in self.links:
+            raise HandFileError(f"{self.where}: {what} names link '{root}', which the URDF does not have")
+        keep = {root}
+        grew = True
+        while grew:
+            grew = False
+            for j in self.joints.values():
+                if j.parent in keep and j.child not in keep:
+                    keep.add(j.child)
+                    grew = True
+        self.links = {n: l for n, l in self.links.items() if n in keep}
+        self.joints = {n: j for n, j in self.joints.items() if j.parent in keep and j.child in keep}
+        self.parent_joint = {c: j for c, j in self.parent_joint.items() if c in keep and c != root}
+        return self
+
     def joint(self, name: str, what: str):
         if name not in self.joints:
             raise HandFileError(f"{self.where}: {what} names joint '{name}', which the URDF does not have")
