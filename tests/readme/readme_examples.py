@@ -6,7 +6,8 @@ blocks hold commands, comments and, in a transcript, ``$ COMMAND`` lines followe
 command prints. Each example keeps the claims its text makes that a run can check:
 
 * ``--png F``, ``--snapshot F``, ``--out D``: the file or directory is written;
-* an ``experiment NAME`` line: its directory gets ``summary.md``, ``results.sqlite`` and a PNG;
+* an ``experiment NAME`` line: its directory gets ``summary.md``, ``results.sqlite`` and a PNG
+  (a sweep: ``sweep.md``, ``sweep.csv``, ``sweep.png`` and ``results.sqlite``);
 * a comment saying ``lifted`` (and not ``not lifted``): the command reports a lift;
 * a transcript: the command prints exactly the lines shown.
 
@@ -166,7 +167,8 @@ def claims(e: Example) -> List[str]:
         if f:
             out.append(f"file:{f}")
     if argv[:1] == ["experiment"] and not _option(argv, "--config") and experiment_out(argv):
-        out.append(f"experiment:{experiment_out(argv)}")
+        kind = "sweep" if "--sweep" in argv else "experiment"     # a sweep writes sweep.md/.csv/.png
+        out.append(f"{kind}:{experiment_out(argv)}")
     elif _option(argv, "--out") and argv[:1] != ["experiment"]:
         out.append(f"dir:{_option(argv, '--out')}")
     if e.kind == "sh" and argv[:1] != ["experiment"] and e.argv[:1] == [".venv/bin/python"]:

@@ -75,6 +75,10 @@ def check(e: Example, cwd: Path, p: subprocess.CompletedProcess, seconds: float)
                 missing.append("a PNG")
             if missing:
                 bad.append(f"{arg}: no {', '.join(missing)}")
+        elif kind == "sweep":
+            missing = [f for f in ("sweep.md", "sweep.csv", "sweep.png", "results.sqlite") if not (cwd / arg / f).is_file()]
+            if missing:
+                bad.append(f"{arg}: no {', '.join(missing)}")
         elif kind == "lifted":
             out = p.stdout
             said = re.search(r"(?<!not )\blifted\b|\"lifted\": true", out)
