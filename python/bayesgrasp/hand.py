@@ -17,7 +17,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Optional
+from typing import List, Optional, Tuple
 
 import numpy as np
 
@@ -90,6 +90,8 @@ class Hand:
         self.core = core
         self.source = source
         self._text = text
+        #: a URDF hand's joints as functions of ours (hand_urdf's joint map), else None
+        self.urdf_joint_map: Optional[list] = None
 
     @classmethod
     def load(cls, name_or_path: str | Path = DEFAULT_HAND) -> "Hand":
@@ -110,8 +112,24 @@ class Hand:
         converted to a hand file's model (:func:`bayesgrasp.hand_urdf.hand_json_from_urdf`)."""
         from .hand_urdf import hand_json_from_urdf
 
-        text = hand_json_from_urdf(urdf, sidecar)
-        return cls(_core.hand.Hand.from_json(text), str(urdf), text)
+        text, joint_map = hand_json_from_urdf(urdf, sidecar, with_joint_map=True)
+        hand = cls(_core.hand.Hand.from_json(text), str(urdf), text)
+        hand.urdf_joint_map = joint_map
+        return hand
+
+    def urdf_joints(self, q) -> Optional[Tuple[List[str], np.ndarray]]:
+        """A URDF hand's joint vector ``q`` (ours: ``joint_names``' order) in the URDF's own terms:
+        (the URDF's moving joint names, in the URDF's order, mimic joints included; their values
+        in the URDF's units and zero), or None for a hand file. Each value is
+        scale * q[index] + offset from the conversion: a revolute phalanx is the URDF's angle plus
+        its angle at the URDF's zero, a jaw is the URDF's upper limit minus its value."""
+        if self.urdf_joint_map is None:
+            return None
+        q = np.asarray(q, dtype=float).ravel()
+        if q.size != self.num_joints:
+            raise ValueError(f"q: {q.size} values for a hand of {self.num_joints} joints")
+        return ([m["name"] for m in self.urdf_joint_map],
+                np.array([m["scale"] * q[m["index"]] + m["offset"] for m in self.urdf_joint_map]))
 
     @classmethod
     def from_json(cls, text: str) -> "Hand":

@@ -293,3 +293,87 @@ def test_a_hand_inside_an_arm_urdf_is_read_from_its_root_link(tmp_path):
     (tmp_path / "x").mkdir()
     with pytest.raises(HandFileError, match=r"root names link 'bh_wrist', which the URDF does not have"):
         Hand.load(_copy_bh8(tmp_path / "x", lambda u: u.replace("</robot>", arm), lambda s: s.update(root="bh_wrist")))
+
+
+def _urdf_fk(urdf: str, values: dict) -> dict:
+    """Every link's pose in the URDF's root frame with the joints at ``values`` (name -> rad or m):
+    the URDF's own chain (origin, then the joint's motion about or along its axis), read with
+    yourdfpy; independent of our conversion."""
+    import yourdfpy
+    from scipy.spatial.transform import Rotation
+
+    robot = yourdfpy.URDF.load(urdf, build_scene_graph=False, load_meshes=False).robot
+    parent = {j.child: j for j in robot.joints}
+
+    def pose(link):
+        if link not in parent:
+            return np.eye(4)
+        j = parent[link]
+        T = pose(j.parent) @ (np.eye(4) if j.origin is None else np.asarray(j.origin, float))
+        M = np.eye(4)
+        if j.type in ("revolute", "continuous"):
+            M[:3, :3] = Rotation.from_rotvec(np.asarray(j.axis, float) * values.get(j.name, 0.0)).as_matrix()
+        elif j.type == "prismatic":
+            M[:3, 3] = np.asarray(j.axis, float) * values.get(j.name, 0.0)
+        return T @ M
+    return {l.name: pose(l.name) for l in robot.links}
+
+
+@pytest.mark.parametrize("name", ["barrett_bh8.urdf", "robotiq_3f.urdf", "parallel_jaw.urdf"])
+def test_the_joint_values_out_drive_the_urdf_to_the_simulator_s_fingertips(name):
+    """Our joint vector in the URDF's own terms (Hand.urdf_joints): every moving URDF joint,
+    mimic joints included, put into the URDF's own kinematic chain, brings each finger's tip (the
+    sidecar's point on its last link; a jaw's on its sliding line) to where our model puts it,
+    within 1 mm, at the open hand and at grasps the simulator closed."""
+    from bayesgrasp.world import World
+
+    hand = Hand.load(name)
+    urdf, side = HANDS_DIR / name, json.loads((HANDS_DIR / name.replace(".urdf", ".hand.json")).read_text())
+    world = World.single("cube", hand=hand)
+    closed = [world.grasp(x, 0.0, yaw).joint_angles for x, yaw in ((0.0, 0.0), (0.01, 0.6))]
+    for q in [hand.open_joints()] + closed:
+        names, values = hand.urdf_joints(q)
+        assert len(names) == len(set(names)) and len(names) >= hand.num_joints - 1
+        links = _urdf_fk(str(urdf), dict(zip(names, values)))
+        palm = side["palm"]
+        from scipy.spatial.transform import Rotation
+
+        H = np.eye(4)
+        H[:3, :3] = Rotation.from_euler("xyz", palm["rpy"]).as_matrix()
+        H[:3, 3] = palm["xyz"]
+        H = links[palm["link"]] @ H                              # the hand frame in the URDF's root
+        robot = __import__("yourdfpy").URDF.load(str(urdf), build_scene_graph=False, load_meshes=False).robot
+        joints = {j.name: j for j in robot.joints}
+        tips = []
+        for f in side["fingers"]:
+            j = joints[f["phalanges"][-1]["joint"]]
+            tip = np.asarray(f["fingertip"], float)
+            if j.type == "prismatic":       # our jaw's tip lies on its sliding line (the pad offset is its shapes')
+                axis = np.asarray(j.axis, float) / np.linalg.norm(j.axis)
+                tip = tip - (tip @ axis) * axis
+            tips.append((np.linalg.inv(H) @ links[j.child] @ np.append(tip, 1.0))[:3])
+        np.testing.assert_allclose(np.array(tips), hand.fingertips(q), atol=1e-3)
+    file_hand = Hand.load("barrett_bh8")
+    assert file_hand.urdf_joints(file_hand.open_joints()) is None          # a hand file has no URDF
+
+
+def test_outputs_give_a_urdf_hand_s_joints_in_the_urdf_s_terms(capsys):
+    """grasp --json and --format ros with a URDF hand: the record's urdf block and the ROS
+    postures name the URDF's joints with the URDF's values (a jaw's position, not its travel)."""
+    from bayesgrasp.cli import main
+    from bayesgrasp.io.grasp_schema import validate
+
+    assert main(["grasp", "--object", "cube", "--top", "0,0,0", "--hand", "parallel_jaw.urdf", "--no-lift", "--json"]) == 0
+    g = json.loads(capsys.readouterr().out)["grasp"]
+    validate(g)
+    travel = dict(zip(g["joint_names"], g["joint_positions"]))
+    assert g["urdf"]["joint_names"] == ["pj_finger_joint1", "pj_finger_joint2"]
+    np.testing.assert_allclose(g["urdf"]["joint_positions"], [0.04 - travel["left/jaw"], 0.04 - travel["right/jaw"]])
+    np.testing.assert_allclose(g["urdf"]["pregrasp_joint_positions"], [0.04, 0.04])       # open: the URDF's upper limit
+    assert main(["grasp", "--object", "cube", "--top", "0,0,0", "--hand", "parallel_jaw.urdf", "--no-lift",
+                 "--format", "ros"]) == 0
+    ros = json.loads(capsys.readouterr().out)
+    assert ros["grasp_posture"]["joint_names"] == g["urdf"]["joint_names"]
+    assert ros["joint_state"]["position"] == g["urdf"]["joint_positions"]
+    assert main(["grasp", "--object", "cube", "--top", "0,0,0", "--no-lift", "--json"]) == 0
+    assert "urdf" not in json.loads(capsys.readouterr().out)["grasp"]                    # a hand file's record has none

@@ -110,9 +110,10 @@ def _load_urdf(path: Path):
 
 # ---------------------------------------------------------------- the conversion ----
 
-def hand_json_from_urdf(urdf: str | Path, sidecar: Optional[str | Path] = None) -> str:
+def hand_json_from_urdf(urdf: str | Path, sidecar: Optional[str | Path] = None, with_joint_map: bool = False):
     """The hand-file text (JSON) of a URDF hand and its sidecar (default: ``NAME.hand.json``
-    beside ``NAME.urdf``). Raises :class:`HandFileError` naming the file and what is wrong."""
+    beside ``NAME.urdf``); with ``with_joint_map`` also the URDF's joints as functions of ours
+    (see ``_Converter._joint_map``). Raises :class:`HandFileError` naming the file and what is wrong."""
     urdf = Path(urdf)
     side_path = Path(sidecar) if sidecar is not None else sidecar_path(urdf)
     if not urdf.is_file():
@@ -127,7 +128,9 @@ def hand_json_from_urdf(urdf: str | Path, sidecar: Optional[str | Path] = None) 
     tree = _Tree(_load_urdf(urdf), str(urdf))
     if side.get("root") is not None:
         tree = tree.below(side["root"], f"{side_path}: root")
-    return json.dumps(_Converter(tree, side, str(side_path), urdf.parent).hand(), indent=1)
+    conv = _Converter(tree, side, str(side_path), urdf.parent)
+    text = json.dumps(conv.hand(), indent=1)
+    return text if not with_joint_map else (text, conv.joint_map)
 
 
 class _Converter:
@@ -220,8 +223,10 @@ class _Converter:
             sign = float(np.sign(saxis @ z))
             base = Ts[:3, 3] + (pos[0][2] - Ts[2, 3]) * z
             spread_sign, yaw_offset = sign * mult, sign * off
+            urdf_map = [(sj.name, 0, mult, off)]     # the URDF's value of this spread joint from our spread
         else:
             base, spread_sign, yaw_offset = pos[0].copy(), 0.0, 0.0
+            urdf_map = []
         knuckle = float((pos[0] - base) @ d)
         if np.linalg.norm(pos[0] - base - knuckle * d) > _TOL or knuckle < -_TOL:
             self._fail(f"{w}: joint '{joints[0].name}' is not on the finger's outward line from its base "
@@ -262,6 +267,7 @@ class _Converter:
             frame = np.eye(4)
             frame[:3, 0], frame[:3, 1], frame[:3, 2], frame[:3, 3] = x, a, np.cross(x, a), pos[k]
             frames.append(frame)
+            urdf_map.append((j.name, joint0 + k, 1.0, -phi))   # ours = the URDF's angle + phi
             phalanges.append({"name": p["name"], "joint": "revolute", "length": length, "lower_deg": math.degrees(lo),
                               "upper_deg": math.degrees(hi), "offset_deg": math.degrees(offset), "ratio": ratio,
                               "torque_nm": float(p["torque_nm"]), "link": j.child})
@@ -269,7 +275,7 @@ class _Converter:
         knuckle_frame[:3, 0], knuckle_frame[:3, 1], knuckle_frame[:3, 2], knuckle_frame[:3, 3] = d, a, np.cross(d, a), base
         return {"spec": spec, "joints": joints, "base": base, "base_yaw": base_yaw, "spread_sign": spread_sign,
                 "knuckle": max(knuckle, 0.0), "knuckle_frame": knuckle_frame, "phalanges": phalanges, "frames": frames,
-                "spread_joint": spread_here[0] if spread_here else None, "first_q": joint0}
+                "spread_joint": spread_here[0] if spread_here else None, "first_q": joint0, "urdf_map": urdf_map}
 
     def _jaw(self, fi: int, spec: dict, joints: list, joint0: int) -> dict:
         """A parallel jaw: one prismatic joint whose positive direction opens the finger (the URDF
@@ -307,7 +313,18 @@ class _Converter:
                    "offset_m": 0.0, "ratio": 1.0, "force_n": float(p["force_n"]), "link": j.child}
         return {"spec": spec, "joints": joints, "base": pos, "base_yaw": math.degrees(math.atan2(d[1], d[0])),
                 "spread_sign": 0.0, "knuckle": hi, "knuckle_frame": None, "phalanges": [phalanx], "frames": [frame],
-                "spread_joint": None, "first_q": joint0}
+                "spread_joint": None, "first_q": joint0, "urdf_map": [(j.name, joint0, -1.0, hi)]}   # ours = hi - URDF
+
+    def _joint_map(self, fingers: list, spread_joint) -> list:
+        """Every moving URDF joint of the hand as an affine function of one of our joints, in URDF
+        order: {"name", "index" (into our joint vector), "scale", "offset"} with
+        URDF value = scale * ours[index] + offset (rad or m)."""
+        entries = {} if spread_joint is None else {spread_joint.name: (0, 1.0, 0.0)}
+        for f in fingers:
+            for name, index, scale, offset in f["urdf_map"]:
+                entries.setdefault(name, (index, scale, offset))
+        return [{"name": j.name, "index": entries[j.name][0], "scale": entries[j.name][1], "offset": entries[j.name][2]}
+                for j in self.tree.joints.values() if j.name in entries]
 
     # -- which URDF links make each of our links --
     def _bodies(self, fingers: list) -> dict:
@@ -367,6 +384,7 @@ class _Converter:
                 if j.name in joint_names:
                     self._fail(f"joint '{j.name}' closes two phalanges ({joint_names[j.name]} and {f['spec']['name']}/{p['name']})")
                 joint_names[j.name] = f"{f['spec']['name']}/{p['name']}"
+        self.joint_map = self._joint_map(fingers, spread_joint)
         bodies = self._bodies(fingers)
         measured = []
         for k, n in enumerate(self.side["measured_joints"]):

@@ -69,10 +69,16 @@ def grasp_record(pose, hand: str, joint_names: Sequence[str], joint_positions, s
 
 
 def hand_grasp_record(hand, pose, joint_positions, spread: Optional[float], frame: str = "world") -> dict:
-    """:func:`grasp_record` for a :class:`bayesgrasp.hand.Hand`: its name, joint names and open preshape."""
+    """:func:`grasp_record` for a :class:`bayesgrasp.hand.Hand`: its name, joint names and open
+    preshape; a URDF hand's record also gives them in the URDF's terms (``urdf``)."""
     s = float(hand.core.spread_default if spread is None else spread)
-    return grasp_record(pose, hand.name, hand.joint_names, joint_positions, s, frame=frame,
-                        open_positions=hand.open_joints(s))
+    q_open = hand.open_joints(s)
+    rec = grasp_record(pose, hand.name, hand.joint_names, joint_positions, s, frame=frame, open_positions=q_open)
+    closed = hand.urdf_joints(rec["joint_positions"])
+    if closed is not None:
+        rec["urdf"] = {"joint_names": closed[0], "joint_positions": closed[1].tolist(),
+                       "pregrasp_joint_positions": hand.urdf_joints(q_open)[1].tolist()}
+    return rec
 
 
 @lru_cache(maxsize=1)
@@ -116,11 +122,14 @@ def to_ros(record: dict, grasp_id: str = "grasp", quality: Optional[float] = Non
     (its +z, as MoveIt expects it in the end effector's frame), the retreat is the lift: +z of
     the record's frame. The frame_id is the record's frame ("world" or "object")."""
     frame_id = record["frame"]
-    names = record["joint_names"]
     pre = record["pregrasp"]
+    if "urdf" in record:        # a URDF hand: the joints the robot's driver knows, in its terms
+        names, closed, opened = (record["urdf"][k] for k in ("joint_names", "joint_positions", "pregrasp_joint_positions"))
+    else:
+        names, closed, opened = record["joint_names"], record["joint_positions"], pre["joint_positions"]
     return {"id": grasp_id,
-            "pre_grasp_posture": _trajectory(names, pre["joint_positions"], 0.0, frame_id),
-            "grasp_posture": _trajectory(names, record["joint_positions"], 1.0, frame_id),
+            "pre_grasp_posture": _trajectory(names, opened, 0.0, frame_id),
+            "grasp_posture": _trajectory(names, closed, 1.0, frame_id),
             "grasp_pose": {"header": {"frame_id": frame_id},
                            "pose": _pose_msg(record["position"], record["quaternion_xyzw"])},
             "grasp_quality": 0.0 if quality is None else float(quality),
@@ -129,4 +138,4 @@ def to_ros(record: dict, grasp_id: str = "grasp", quality: Optional[float] = Non
             "post_place_retreat": _translation(frame_id, (0.0, 0.0, 0.0), 0.0),
             "max_contact_force": 0.0, "allowed_touch_objects": [],
             "joint_state": {"header": {"frame_id": frame_id}, "name": list(names),
-                            "position": list(record["joint_positions"]), "velocity": [], "effort": []}}
+                            "position": list(closed), "velocity": [], "effort": []}}
