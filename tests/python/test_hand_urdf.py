@@ -377,3 +377,20 @@ def test_outputs_give_a_urdf_hand_s_joints_in_the_urdf_s_terms(capsys):
     assert ros["joint_state"]["position"] == g["urdf"]["joint_positions"]
     assert main(["grasp", "--object", "cube", "--top", "0,0,0", "--no-lift", "--json"]) == 0
     assert "urdf" not in json.loads(capsys.readouterr().out)["grasp"]                    # a hand file's record has none
+
+
+def test_a_multi_piece_collision_mesh_keeps_its_pieces(tmp_path):
+    """A palm mesh of two separate blocks becomes two convex shapes, each a block's 8 corners, not
+    one hull over both (which would fill the 4 cm gap between them)."""
+    import trimesh
+
+    (tmp_path / "meshes").mkdir()
+    a, b = trimesh.creation.box(extents=[0.09, 0.025, 0.06]), trimesh.creation.box(extents=[0.09, 0.025, 0.06])
+    a.apply_translation([0, -0.0325, 0])
+    b.apply_translation([0, 0.0325, 0])
+    trimesh.util.concatenate([a, b]).export(tmp_path / "meshes" / "palm.stl")
+    path = _bh8_with(tmp_path, r'<box size="0\.09 0\.09 0\.06"/>', '<mesh filename="package://bh8/meshes/palm.stl"/>')
+    palm = [s for s in Hand.load(path).link_shapes()[0]]
+    assert [s.type for s in palm] == ["convex", "convex"]
+    assert sorted(round(float(s.vertices[:, 1].mean()), 4) for s in palm) == [-0.0325, 0.0325]
+    assert all(s.vertices.shape == (8, 3) for s in palm)

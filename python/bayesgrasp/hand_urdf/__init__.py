@@ -366,7 +366,7 @@ class _Converter:
                 elif g.cylinder is not None:
                     items.append(("cylinder", T, g.cylinder))
                 elif g.mesh is not None:
-                    items.append(("mesh", T, _transform(T, _mesh_points(g.mesh, self.urdf_dir, self.where, name))))
+                    items += [("mesh", T, _transform(T, P)) for P in _mesh_points(g.mesh, self.urdf_dir, self.where, name)]
         return _shapes_of(items, self.where)
 
     def hand(self) -> dict:

@@ -114,7 +114,8 @@ class _Tree:
 
 # ---------------------------------------------------------------- collision shapes ----
 
-def _mesh_points(geom_mesh, urdf_dir: Path, where: str, link: str) -> np.ndarray:
+def _mesh_points(geom_mesh, urdf_dir: Path, where: str, link: str) -> list:
+    """The vertices (in the link's frame, scaled) of each connected piece of a collision mesh."""
     import trimesh
 
     name = geom_mesh.filename
@@ -133,8 +134,12 @@ def _mesh_points(geom_mesh, urdf_dir: Path, where: str, link: str) -> np.ndarray
     V = np.asarray(m.vertices, dtype=float)
     if len(V) < 4:
         raise HandFileError(f"{where}: link '{link}': mesh '{path}' has fewer than 4 vertices")
-    scale = geom_mesh.scale
-    return V * (1.0 if scale is None else np.asarray(scale, dtype=float))
+    scale = 1.0 if geom_mesh.scale is None else np.asarray(geom_mesh.scale, dtype=float)
+    # each connected piece its own convex hull (one hull over a multi-piece mesh would fill the
+    # space between the pieces); pieces with fewer than 4 vertices bound no volume and are left out
+    pieces = [np.asarray(p.vertices, dtype=float) * scale for p in m.split(only_watertight=False)] if len(m.faces) else []
+    pieces = [P for P in pieces if len(P) >= 4 and np.linalg.matrix_rank(P - P.mean(axis=0), tol=1e-9) == 3]
+    return pieces or [V * scale]
 
 
 def _transform(T: np.ndarray, P: np.ndarray) -> np.ndarray:
