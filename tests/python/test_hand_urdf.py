@@ -394,3 +394,24 @@ def test_a_multi_piece_collision_mesh_keeps_its_pieces(tmp_path):
     assert [s.type for s in palm] == ["convex", "convex"]
     assert sorted(round(float(s.vertices[:, 1].mean()), 4) for s in palm) == [-0.0325, 0.0325]
     assert all(s.vertices.shape == (8, 3) for s in palm)
+
+
+def test_a_mimic_of_an_equivalent_joint_is_the_same_coupling(tmp_path):
+    """Finger 2's distal written as a mimic of finger 1's proximal, which finger 2's proximal mimics
+    one to one: the URDF makes it the same coupling, and the hand converts to the same text; a mimic
+    of another finger's independent joint is still refused."""
+    def via_finger1(u):
+        u = u.replace('<mimic joint="bh_j22" multiplier="0.3333333333333333"',
+                      '<mimic joint="bh_j12" multiplier="0.3333333333333333"')
+        return u.replace('<axis xyz="0 -1 0"/><limit lower="0" upper="2.443460952792061" effort="1.467" velocity="1"/></joint>\n'
+                         '  <link name="bh_finger2_proximal">',
+                         '<axis xyz="0 -1 0"/><limit lower="0" upper="2.443460952792061" effort="1.467" velocity="1"/>'
+                         '<mimic joint="bh_j12" multiplier="1" offset="0"/></joint>\n  <link name="bh_finger2_proximal">')
+    urdf = (HANDS_DIR / "barrett_bh8.urdf").read_text()
+    assert via_finger1(urdf).count('<mimic joint="bh_j12"') == 3        # the edit took: j13, j22 and j23
+    (tmp_path / "exact").mkdir()
+    assert Hand.load(_copy_bh8(tmp_path, via_finger1)).text == Hand.load(_copy_bh8(tmp_path / "exact")).text
+    (tmp_path / "other").mkdir()
+    other = _copy_bh8(tmp_path / "other", lambda u: u.replace('<mimic joint="bh_j22" multiplier', '<mimic joint="bh_j32" multiplier'))
+    with pytest.raises(HandFileError, match=r"joint 'bh_j23' is neither the finger's first joint nor a mimic of 'bh_j22'"):
+        Hand.load(other)

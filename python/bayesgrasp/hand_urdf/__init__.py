@@ -258,8 +258,8 @@ class _Converter:
             # coupling while free: the driver runs from its lower limit at t = 0 with ratio 1
             if k == 0:
                 ratio, offset = 1.0, lo
-            elif j.mimic is not None and j.mimic.joint == driver.name:
-                m, o = float(j.mimic.multiplier or 1.0), float(j.mimic.offset or 0.0)
+            elif self._coupling(j, driver) is not None:
+                m, o = self._coupling(j, driver)
                 ratio, offset = m, phi + m * lower0 + o
             else:
                 self._fail(f"{w}.phalanges[{k}]: joint '{j.name}' is neither the finger's first joint nor a mimic "
@@ -314,6 +314,28 @@ class _Converter:
         return {"spec": spec, "joints": joints, "base": pos, "base_yaw": math.degrees(math.atan2(d[1], d[0])),
                 "spread_sign": 0.0, "knuckle": hi, "knuckle_frame": None, "phalanges": [phalanx], "frames": [frame],
                 "spread_joint": None, "first_q": joint0, "urdf_map": [(j.name, joint0, -1.0, hi)]}   # ours = hi - URDF
+
+    def _as_root(self, j) -> tuple:
+        """(root joint, m, o): j's value = m * root's + o, following its <mimic> chain to a joint
+        that mimics nothing (a loop of mimics is refused)."""
+        m, o, seen = 1.0, 0.0, {j.name}
+        while j.mimic is not None:
+            mm, oo = float(j.mimic.multiplier if j.mimic.multiplier is not None else 1.0), float(j.mimic.offset or 0.0)
+            m, o = m * mm, m * oo + o
+            j = self.tree.joint(j.mimic.joint, f"joint '{j.name}'s mimic")
+            if j.name in seen:
+                self._fail(f"joint '{j.name}': its <mimic> chain loops")
+            seen.add(j.name)
+        return j, m, o
+
+    def _coupling(self, j, driver) -> Optional[tuple]:
+        """(m, o) with j's value = m * driver's + o when the URDF makes them so, directly or through
+        any chain of <mimic>s to a common joint (another finger's driver, say); else None."""
+        rj, mj, oj = self._as_root(j)
+        rd, md, od = self._as_root(driver)
+        if rj.name != rd.name or md == 0.0:
+            return None
+        return mj / md, oj - mj / md * od
 
     def _joint_map(self, fingers: list, spread_joint) -> list:
         """Every moving URDF joint of the hand as an affine function of one of our joints, in URDF
