@@ -110,6 +110,8 @@ def test_copied_urdf_hand_loads(tmp_path):
     (None, lambda u: u.replace('<mimic joint="bh_j12" multiplier="0.3333333333333333" offset="0.7330382858376184"/>', ""),
      r"joint 'bh_j13' is neither the finger's first joint nor a mimic of 'bh_j12'"),
     (None, lambda u: u.replace("<robot", "<robt", 1), r"hand\.urdf: not a readable URDF"),
+    (None, lambda u: u.replace('<mimic joint="bh_j12" multiplier="0.3333333333333333"', '<mimic joint="bh_j12" multiplier="-1"'),
+     r"hand\.hand\.json: fingers\[0\]\.phalanges\[1\]: joint 'bh_j13' turns against 'bh_j12' \(mimic multiplier -1\)"),
 ])
 def test_bad_urdf_hand_refused_in_one_line(tmp_path, side_edit, urdf_edit, message):
     path = _copy_bh8(tmp_path, urdf_edit, side_edit)

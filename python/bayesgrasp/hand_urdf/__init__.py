@@ -260,6 +260,10 @@ class _Converter:
                 ratio, offset = 1.0, lo
             elif self._coupling(j, driver) is not None:
                 m, o = self._coupling(j, driver)
+                if m < 0:
+                    self._fail(f"{w}.phalanges[{k}]: joint '{j.name}' turns against '{driver.name}' (mimic multiplier "
+                               f"{m:g}): a linkage that keeps a pad parallel; a closing scheme with negative "
+                               "couplings is not supported yet (each phalanx must close with its finger's driver)")
                 ratio, offset = m, phi + m * lower0 + o
             else:
                 self._fail(f"{w}.phalanges[{k}]: joint '{j.name}' is neither the finger's first joint nor a mimic "
