@@ -298,3 +298,17 @@ def test_the_demo_hides_the_mug_where_its_first_grasp_misses(tmp_path):
     assert all(first(draws[k], 1)["attempts"][0]["success"] for k in range(skipped))
     full = first(pose, 4)
     assert not full["attempts"][0]["success"] and len(full["attempts"]) >= 2
+
+
+def test_episode_new_offers_only_the_methods_an_episode_runs(capsys):
+    """The parser's --method choices come from the episodes' own lists: part-aware (which no
+    episode runs) is refused by the parser, not accepted and refused later."""
+    from bayesgrasp.experiments.outside_loop import METHODS
+    from bayesgrasp.experiments.outside_loop_category import CATEGORY_METHODS
+
+    with pytest.raises(SystemExit):
+        main(["episode", "new", "--category", "mug", "--task", "side", "--method", "part-aware", "--dir", "x"])
+    err = capsys.readouterr().err
+    assert "invalid choice: 'part-aware'" in err
+    for m in METHODS + CATEGORY_METHODS + ("fusion",):
+        assert f"'{m}'" in err

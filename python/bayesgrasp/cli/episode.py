@@ -14,12 +14,13 @@ import json
 import numpy as np
 
 from ..experiments.episode import EpisodeSettings
+from ..experiments.outside_loop import METHODS as POSE_METHODS          # the episodes' own lists
+from ..experiments.outside_loop_category import CATEGORY_METHODS as _PLANNED_ONCE
 from . import camera_input
 from .args import (CliError, add_context_options, add_format_options, bounded_int, context, floats, output_format,
                    task_grasps_arg)
 
-POSE_METHODS = ("stability", "explore")
-CATEGORY_METHODS = ("laplace", "regularised", "gaussian", "baseline", "part-aware", "fusion")
+CATEGORY_METHODS = _PLANNED_ONCE + ("fusion",)
 
 
 def add(sub) -> None:
