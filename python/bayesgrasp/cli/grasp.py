@@ -69,7 +69,7 @@ def run(args) -> int:
     grasp = _grasp(world, args, request)
     g = grasp.to_dict()
     out = {
-        "object": args.object, "units": args.units, "object_pose": pose, "top": request.get("top"), "hand": world.hand.name,
+        "object": args.object, "object_pose": pose, "top": request.get("top"), "hand": world.hand.name,
         "joint_angles": [float(v) for v in g["joint_angles"]],
         "joint_names": list(world.hand.core.joint_names),
         "contacts": g["contacts"], "epsilon": g["epsilon"], "volume": g["volume"],
@@ -78,7 +78,7 @@ def run(args) -> int:
         "hand_pose": np.asarray(g["hand_pose"]).tolist(),
         "mode": request["mode"], "input_frame": args.frame, "approach": request.get("approach"), "pose": request.get("pose"),
         "stopped_by_table": g["stopped_by_table"], "hand_pose_object": np.asarray(g["hand_pose_object"]).tolist(),
-        "mass": _mass_used(world.object),
+        "mass": _mass_used(world.object), "units": args.units,
     }
     out["grasp"] = hand_grasp_record(world.hand, g["hand_pose"], g["joint_angles"], world.spread if args.spread is None else args.spread)
     if args.lift_trace:
