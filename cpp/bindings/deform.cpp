@@ -23,7 +23,7 @@ void bind_deform(py::module_& m) {
   using deform::DisplacementField;
   OptionClass<CpdOptions>(m, "CpdOptions", "Coherent Point Drift (non-rigid) settings.")
       .field("beta", &CpdOptions::beta, "float", "kernel width in the model's RMS radii (larger: smoother)")
-      .field("lambda_", &CpdOptions::lambda, "float", "weight of the field's smoothness term (larger: less motion)")
+      .field("lam", &CpdOptions::lam, "float", "lambda, the weight of the field's smoothness term (larger: less motion)")
       .field("outlier_weight", &CpdOptions::outlier_weight, "float", "w in [0, 1): the uniform outlier component's share")
       .field("max_iterations", &CpdOptions::max_iterations, "int", "EM iterations at most")
       .field("tolerance", &CpdOptions::tolerance, "float", "stop when the variance changes by less than this fraction")

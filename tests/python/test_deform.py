@@ -76,7 +76,7 @@ def test_points_warp_like_the_mesh_and_a_partial_view_moves_the_hidden_side():
 
 
 def test_options_and_bad_input_are_named():
-    assert cpd_options(lam=3.0).lambda_ == 3.0 and cpd_options(beta=1.5).beta == 1.5
+    assert cpd_options(lam=3.0).lam == 3.0 and cpd_options(beta=1.5).beta == 1.5
     o = CpdOptions()
     cpd_options(o, rank=10)
     assert o.rank == 120                                        # the options given are not changed

@@ -17,7 +17,7 @@ namespace bayesgrasp::deform {
 
 void validate(const CpdOptions& o, const std::string& prefix) {
   require_positive(o.beta, prefix + "beta");
-  require_positive(o.lambda, prefix + "lambda");
+  require_positive(o.lam, prefix + "lam");
   if (!(o.outlier_weight >= 0.0 && o.outlier_weight < 1.0))
     bad_field(prefix + "outlier_weight", "in [0, 1)", number_str(o.outlier_weight));
   require_at_least(o.max_iterations, 1, prefix + "max_iterations");
@@ -236,7 +236,7 @@ CpdResult coherent_point_drift(const Points& model, const Points& observed, cons
   for (r.iterations = 1; r.iterations <= options.max_iterations; ++r.iterations) {
     const Posterior post = e_step(X, T, sigma2, options.outlier_weight, options.cutoff, options.threads);
     if (!(post.NP > 1e-12)) break;  // nothing observed is explained by the model any more
-    a = field_coefficients(C, L, post, Y, options.lambda * sigma2);
+    a = field_coefficients(C, L, post, Y, options.lam * sigma2);
     T = Y + C * a;
     const double next = variance(X, T, post);
     const bool settled = std::abs(next - sigma2) <= options.tolerance * sigma2;

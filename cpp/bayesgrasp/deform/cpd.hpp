@@ -32,7 +32,7 @@ using Points = Eigen::Matrix<double, Eigen::Dynamic, 3, Eigen::RowMajor>;
 
 struct CpdOptions {
   double beta = 2.0;          // kernel width, in the model's RMS radii (larger: stiffer, smoother field)
-  double lambda = 2.0;        // regularisation weight of the field's RKHS norm (larger: smaller motion)
+  double lam = 2.0;           // lambda: regularisation weight of the field's RKHS norm (larger: smaller motion)
   double outlier_weight = 0.1;  // w in [0, 1): the uniform component's share (clutter, noise)
   int max_iterations = 100;
   double tolerance = 1e-3;    // stop when the variance changes by less than this fraction (1e-5: same fit, 2-3x the iterations)

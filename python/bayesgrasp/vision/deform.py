@@ -35,10 +35,9 @@ __all__ = ["CpdOptions", "CpdResult", "DisplacementField", "MeshWarp", "coherent
 
 def cpd_options(options: Optional[CpdOptions] = None, **keywords) -> CpdOptions:
     """A validated copy of ``options`` (default ``CpdOptions()``) with ``keywords`` set (``beta``,
-    ``lambda_`` or ``lam``, ``outlier_weight``, ``max_iterations``, ``tolerance``, ``rank``,
-    ``threads``). ValueError naming an unknown keyword or a bad value; ``options`` is not changed."""
-    if "lam" in keywords:
-        keywords["lambda_"] = keywords.pop("lam")
+    ``lam`` (CPD's lambda; ``lambda`` is Python's), ``outlier_weight``, ``max_iterations``,
+    ``tolerance``, ``rank``, ``cutoff``, ``threads``). ValueError naming an unknown keyword or a bad
+    value; ``options`` is not changed."""
     out = with_fields(CpdOptions, options, keywords, validate=False)
     out.validate()
     return out
