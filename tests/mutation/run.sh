@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Mutation check (issue 32): mutmut over belief.py, planners/base.py and models/tasks.py, run
+# Mutation check (issue 32): mutmut over the belief package, planners/base.py and models/tasks.py, run
 # against their unit tests. A measurement, not a CI step:
 #   bash tests/mutation/run.sh [WORKDIR]        (default /tmp/bayesgrasp-mutation)
 #   then: cd WORKDIR && ../path/.venv/bin/mutmut results
@@ -20,7 +20,7 @@ cp -r "$ROOT/tests/python" "$W/tests/python"
 cat > "$W/pyproject.toml" <<'EOF'
 [tool.mutmut]
 source_paths = ["src/bayesgrasp"]
-only_mutate = ["src/bayesgrasp/belief.py", "src/bayesgrasp/planners/base.py", "src/bayesgrasp/models/tasks.py"]
+only_mutate = ["src/bayesgrasp/belief/*.py", "src/bayesgrasp/planners/base.py", "src/bayesgrasp/models/tasks.py"]
 pytest_add_cli_args_test_selection = ["tests/python/test_belief.py", "tests/python/test_planners.py",
                                       "tests/python/test_tasks.py", "tests/python/test_bad_input.py"]
 pytest_add_cli_args = ["-p", "no:cacheprovider", "-x", "-q", "--deselect",
@@ -33,6 +33,10 @@ testpaths = ["tests/python"]
 addopts = "-p no:dash"
 EOF
 cd "$W"
+# every pattern must name files that exist (a renamed module was once skipped without a word)
+for pattern in "src/bayesgrasp/belief/*.py" src/bayesgrasp/planners/base.py src/bayesgrasp/models/tasks.py; do
+  compgen -G "$pattern" > /dev/null || { echo "mutation: nothing matches $pattern" >&2; exit 2; }
+done
 OMP_NUM_THREADS=1 OPENBLAS_NUM_THREADS=1 "$ROOT/.venv/bin/mutmut" run --max-children "${JOBS:-2}"
 "$ROOT/.venv/bin/mutmut" results > results.txt || true
 "$PY" "$ROOT/tests/mutation/score.py" "$W"
