@@ -2,7 +2,8 @@
 
 Decision (Eq. 4.1): a held-out mug's view registered against the 6 other mugs (prepared once, as
 a robot would) and the plan for the task, per method: laplace (the thesis's) and part-aware (Eq.
-4.1's candidates closed on the 6 registered models and re-ranked, the part check included). Round
+4.1's candidates closed on the 6 registered models and re-ranked, the part check included) and warped
+(the same check on the 6 models warped onto the view by CPD, the warps included). Round
 (Eqs. 4.4-4.6): the update of the 6 models' poses and weights from one grasp's joint angles and the
 next grasp's optimisation, with the thesis's task term and with the part-aware one.
 Models and task grasps come from the cache (built by `bayesgrasp experiment pub5` / `pub6`, or
@@ -24,7 +25,7 @@ from bayesgrasp.models.tasks import task_rule
 from bayesgrasp.planners.category import CategoryPlanner, CategorySettings
 from bayesgrasp.planners.fusion import FusionSettings
 
-METHODS = ("laplace", "part-aware")
+METHODS = ("laplace", "part-aware", "warped")
 TASK_TERMS = ("laplace", "part-aware")
 
 
@@ -50,7 +51,8 @@ def main():
         regs = register_models(o, models, seed=k)
         register_t.append(time.perf_counter() - t0)
         for m in METHODS:
-            if m == "part-aware":   # the models' worlds built once per process, as a robot would (not timed)
+            if m == "part-aware":   # the models' worlds built once per process, as a robot would (not timed;
+                # the warped method's worlds are of this view's warped shapes: built inside its timing)
                 CategoryPlanner(ctx.hand, grasps, regs, cloud=o.cloud, settings=CategorySettings(method=m), seed=k,
                                 rule=rule).plan()
             t1 = time.perf_counter()
