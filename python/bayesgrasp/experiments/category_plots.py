@@ -52,7 +52,8 @@ def plot_scale_grid(rows: List[dict], densities: Sequence[str], path: Path, titl
         ax.set_yticks(range(len(rs)))
         ax.set_yticklabels([f"{r:g}" for r in rs])
         ax.set_xlabel("s_t (cm)")
-        ax.set_ylabel("s_R (deg)")
+        if ax is axes[0][0]:
+            ax.set_ylabel("s_R (deg)")
         ax.set_title(m, fontsize=9)
     fig.colorbar(im, ax=axes[0].tolist(), shrink=0.8, label="success")
     fig.suptitle(title, fontsize=10)
