@@ -258,8 +258,8 @@ class _Converter:
             # coupling while free: the driver runs from its lower limit at t = 0 with ratio 1
             if k == 0:
                 ratio, offset = 1.0, lo
-            elif self._coupling(j, driver) is not None:
-                m, o = self._coupling(j, driver)
+            elif (coupling := self._coupling(j, driver)) is not None:
+                m, o = coupling
                 if m < 0:
                     self._fail(f"{w}.phalanges[{k}]: joint '{j.name}' turns against '{driver.name}' (mimic multiplier "
                                f"{m:g}): a linkage that keeps a pad parallel; a closing scheme with negative "

@@ -163,9 +163,7 @@ def build_models(obj: Union[str, ObjectModel], hand=DEFAULT_HAND, settings: Opti
     """
     settings = settings or ModelSettings()
     obj = load_object(obj) if isinstance(obj, str) else obj
-    world = World.single(obj, pose=(0.0, 0.0, 0.0), hand=hand)
-    hand_text = world.hand.text or world.hand.name
-    key = cache_key(world.object, hand_text, settings)
+    world, key = _world_and_key(obj, hand, settings)
     say = progress or (lambda msg: None)
     files = None if cache_dir is None else _CacheFiles(cache_dir, key)
     models = None if files is None else files.load(settings)
@@ -173,6 +171,17 @@ def build_models(obj: Union[str, ObjectModel], hand=DEFAULT_HAND, settings: Opti
         say(f"models for {obj.name}: loaded from cache ({key})")
         return models
     return _as_reloaded(_train(world, settings, key, say), files, settings, key)
+
+
+def _world_and_key(obj: ObjectModel, hand, settings: ModelSettings) -> tuple:
+    """The object's world at the origin with ``hand``, and its models' cache key."""
+    world = World.single(obj, pose=(0.0, 0.0, 0.0), hand=hand)
+    return world, cache_key(world.object, world.hand.text or world.hand.name, settings)
+
+
+def _memo_key(obj, hand, settings: ModelSettings, cache_dir) -> tuple:
+    """get_models' per-process memo key (a name, or the object model's identity)."""
+    return obj if isinstance(obj, str) else id(obj), hand, settings, str(cache_dir)
 
 
 def _as_reloaded(models: GraspModels, files: Optional[_CacheFiles], settings: ModelSettings, key: str) -> GraspModels:
@@ -201,11 +210,10 @@ def models_cached(obj: Union[str, ObjectModel], hand=DEFAULT_HAND, settings: Opt
     :func:`default_cache_dir`), i.e. whether :func:`get_models` will not build them. Reads no GP."""
     settings = settings or ModelSettings()
     cache_dir = default_cache_dir() if cache_dir is None else cache_dir
-    if (obj if isinstance(obj, str) else id(obj), hand, settings, str(cache_dir)) in _MODELS:
+    if _memo_key(obj, hand, settings, cache_dir) in _MODELS:
         return True
-    obj = load_object(obj) if isinstance(obj, str) else obj
-    world = World.single(obj, pose=(0.0, 0.0, 0.0), hand=hand)
-    files = _CacheFiles(cache_dir, cache_key(world.object, world.hand.text or world.hand.name, settings))
+    _, key = _world_and_key(load_object(obj) if isinstance(obj, str) else obj, hand, settings)
+    files = _CacheFiles(cache_dir, key)
     return all(f.is_file() for f in (files.measurement, files.stability, files.info))
 
 
@@ -215,7 +223,7 @@ def get_models(obj: Union[str, ObjectModel], hand: str = DEFAULT_HAND, settings:
     ``cache_dir`` None means :func:`default_cache_dir`."""
     settings = settings or ModelSettings()
     cache_dir = default_cache_dir() if cache_dir is None else cache_dir
-    key = (obj if isinstance(obj, str) else id(obj), hand, settings, str(cache_dir))
+    key = _memo_key(obj, hand, settings, cache_dir)
     if key not in _MODELS:
         _MODELS[key] = build_models(obj, hand, settings, cache_dir=cache_dir, progress=progress)
     return _MODELS[key]
