@@ -81,11 +81,16 @@ bench: $(VENV)/.installed $(BENCH_VENV)/.base
 	BENCH_PY=$(BENCH_VENV)/bin/python BAYESGRASP_PY=$(PY) BUILD_DIR=build/py bash bench/bench_all.sh
 
 # Peer planners (issue 52), each in its own virtual environment, driven by bench/peers/*_driver.py
-# (JSON request in, JSON result out; bench/peers/README.md). For now one smoke run on the mug.
+# (JSON request in, JSON result out; bench/peers/README.md), beside bayesgrasp on the YCB scans by
+# bench/peers/protocol.py. PEERS_OBJECTS (comma-separated YCB names; default all 21) and PEERS_RUNS
+# (true poses per object under uncertainty; default 10) size the run; PEERS_ARGS adds options
+# (e.g. --reuse to continue an interrupted run).
 PEER_PBG := .venv-peer-pbg
 PEER_CGN := .venv-peer-cgn
-PEERS_OUT := bench/results/peers_smoke
-PEER_MESH := tests/data/ycb/025_mug.stl
+PEERS_OUT ?= bench/results/peers_protocol
+PEERS_RUNS ?= 10
+PEERS_OBJECTS ?=
+PEERS_ARGS ?=
 $(PEER_PBG)/.installed: bench/peers/requirements-pybullet-grasper.txt | build/.deps-ok
 	$(PYTHON) -m venv $(PEER_PBG)
 	$(PEER_PBG)/bin/pip install -q --upgrade pip
@@ -98,15 +103,9 @@ $(PEER_CGN)/.installed: bench/peers/requirements-cgn.txt bench/peers/requirement
 	$(PEER_CGN)/bin/pip install -q --no-deps -r bench/peers/requirements-cgn-nodeps.txt
 	@touch $@
 
-bench-peers: $(PEER_PBG)/.installed $(PEER_CGN)/.installed
-	mkdir -p $(PEERS_OUT)
-	$(PEER_PBG)/bin/python bench/peers/make_partial_cloud.py $(PEER_MESH) $(PEERS_OUT)/mug_cloud.npy
-	for hand in barrett robotiq_2f85; do \
-	  echo '{"mesh": "$(PEER_MESH)", "pose": [0, 0, 0], "hand": "'$$hand'", "top_k": 5, "seed": 0}' > $(PEERS_OUT)/request_pbg_$$hand.json; \
-	  $(PEER_PBG)/bin/python bench/peers/pybullet_grasper_driver.py $(PEERS_OUT)/request_pbg_$$hand.json $(PEERS_OUT)/pybullet_grasper_$$hand.json || exit 1; \
-	done
-	echo '{"cloud": "$(PEERS_OUT)/mug_cloud.npy", "mesh": "$(PEER_MESH)", "pose": [0, 0, 0], "top_k": 5, "seed": 0}' > $(PEERS_OUT)/request_cgn.json
-	$(PEER_CGN)/bin/python bench/peers/cgn_driver.py $(PEERS_OUT)/request_cgn.json $(PEERS_OUT)/cgn.json
+bench-peers: $(VENV)/.installed $(BENCH_VENV)/.base $(PEER_PBG)/.installed $(PEER_CGN)/.installed
+	$(PY) bench/peers/protocol.py --out $(PEERS_OUT) --runs $(PEERS_RUNS) \
+	  $(if $(PEERS_OBJECTS),--objects $(PEERS_OBJECTS)) $(PEERS_ARGS)
 
 clean:
 	rm -rf build/py out

@@ -57,7 +57,11 @@ OBJECTS = {
     "005_tomato_soup_can": ("tests/data/ycb/005_tomato_soup_can.stl", 0.349),
 }
 TOP_K = 5
-OUR_HAND = {"pybullet_grasper": "barrett_bh8", "cgn": "parallel_jaw.urdf"}
+#: peer -> our hand its grasps are executed with. "pybullet_grasper" closes the peer's Barrett,
+#: "pybullet_grasper_2f85" its Robotiq 2F-85, "cgn" Contact-GraspNet's Panda jaws.
+OUR_HAND = {"pybullet_grasper": "barrett_bh8", "pybullet_grasper_2f85": "parallel_jaw.urdf",
+            "cgn": "parallel_jaw.urdf"}
+PEER_NAMES = tuple(OUR_HAND)
 
 # ---- geometry of the peers' hands (facts, with where they were read) -----------------------------
 # pybullet-grasper's Barrett: .venv-peer-pbg/share/pybullet_grasper/grippers/barrett_hand/barrett_hand.urdf
@@ -90,6 +94,14 @@ CGN_HALF_OPEN = 0.04
 # pads on the planes y = +/-0.04 m (the finger mesh's pad is its link's plane y = 0); the
 # fingers run 0.054 m out along +z from the palm frame.
 PJ_PALM_Z = 0.0584
+# The middle of our jaws' pads along the approach, from the palm frame (the jaw is 0.054 m long).
+PJ_PAD_MID = 0.027
+
+# pybullet-grasper's Robotiq 2F-85 (pybullet_grasper_driver.py docstring, read from its URDF):
+# base link at the coupling face, +z out through the fingers, the open pads (left_contactile,
+# right_contactile) at z = 0.150 m, y = -/+0.0487 m, closing along y.
+PBG_2F85_PAD_Z = 0.150
+PBG_2F85_PAD_Y = 0.0487
 
 
 def trans(x, y, z):
@@ -154,6 +166,20 @@ def cgn_panda_to_parallel_jaw(T_cgn):
     return np.asarray(T_cgn, dtype=float) @ trans(0.0, 0.0, PJ_PALM_Z) @ rot_axis((0, 0, 1), np.pi / 2)
 
 
+def pbg_robotiq_to_parallel_jaw(T_base):
+    """pybullet-grasper's Robotiq 2F-85 pose -> our `parallel_jaw.urdf` hand pose (4x4, table frame).
+
+    Both close along their y axis with +z the approach, so no turn; our palm frame goes where our
+    pads' middle (PJ_PAD_MID out) meets the peer's pads (PBG_2F85_PAD_Z out). The open widths
+    differ (the 2F-85's pads 97.4 mm apart, ours 80 mm): each of our open pads is 8.7 mm inside.
+    """
+    return np.asarray(T_base, dtype=float) @ trans(0.0, 0.0, PBG_2F85_PAD_Z - PJ_PAD_MID)
+
+
+CONVERT = {"pybullet_grasper": pbg_barrett_to_bh8, "pybullet_grasper_2f85": pbg_robotiq_to_parallel_jaw,
+           "cgn": cgn_panda_to_parallel_jaw}
+
+
 # ---- the peers' finger points (their kinematics) and ours ---------------------------------------
 def pbg_barrett_points(T_base, spread=PBG_SPREAD):
     """Named points of pybullet-grasper's open Barrett (finger joints at 0, spread `spread`) at its
@@ -198,7 +224,7 @@ def cgn_panda_points(T_cgn):
     return out
 
 
-def parallel_jaw_points(hand, T_palm):
+def parallel_jaw_points(hand, T_palm, depth=CGN_DEPTH - PJ_PALM_Z, label="pad at 0.1034"):
     """The same named points of our `parallel_jaw.urdf` at the open preshape, from our kinematics
     (hand.py: link poses and each jaw's convex mesh placed by them): the jaw links' origins (their
     joints) and the point of each jaw's pad face 0.045 m out along it (0.1034 m from pj_hand).
@@ -221,7 +247,26 @@ def parallel_jaw_points(hand, T_palm):
         base, tip = V[pad[:2]].mean(axis=0), V[pad[2:]].mean(axis=0)
         length = V0[pad[2:], 2].mean() - V0[pad[:2], 2].mean()
         out[f"{side}/joint"] = links[li][:3, 3]
-        out[f"{side}/pad at 0.1034"] = base + (CGN_DEPTH - PJ_PALM_Z) / length * (tip - base)
+        out[f"{side}/{label}"] = base + depth / length * (tip - base)
+    return out
+
+
+def pbg_robotiq_points(T_base):
+    """pybullet-grasper's open 2F-85 pads at its base-link pose (-y pad, +y pad)."""
+    T = np.asarray(T_base, dtype=float)
+    return {f"{side} pad/middle": (T @ [0.0, y, PBG_2F85_PAD_Z, 1.0])[:3]
+            for side, y in (("-y", -PBG_2F85_PAD_Y), ("+y", PBG_2F85_PAD_Y))}
+
+
+def parallel_jaw_pad_middles(hand, T_palm):
+    """Our open jaws' pad middles (PJ_PAD_MID out), named by the side of the palm frame they are on."""
+    pts = parallel_jaw_points(hand, T_palm, depth=PJ_PAD_MID, label="pad")
+    y = np.asarray(T_palm, dtype=float)[:3, 1]
+    out = {}
+    for name, p in pts.items():
+        if name.endswith("/pad"):
+            side = "+y" if (p - np.asarray(T_palm)[:3, 3]) @ y > 0 else "-y"
+            out[f"{side} pad/middle"] = p
     return out
 
 
@@ -240,8 +285,7 @@ def check_frames(results=None, verbose=True):
     from bayesgrasp.hand import Hand
     bh8 = Hand.load(OUR_HAND["pybullet_grasper"])
     pj = Hand.load(OUR_HAND["cgn"])
-    poses = {"pybullet_grasper": [("tilted test pose", _example_pose())],
-             "cgn": [("tilted test pose", _example_pose())]}
+    poses = {peer: [("tilted test pose", _example_pose())] for peer in PEER_NAMES}
     for (peer, obj), res in (results or {}).items():
         if res.get("grasps"):
             poses[peer].append((f"{obj} top-1", np.array(res["grasps"][0]["pose"])))
@@ -251,6 +295,9 @@ def check_frames(results=None, verbose=True):
             if peer == "pybullet_grasper":
                 theirs, ours = pbg_barrett_points(T), bh8_points(bh8, pbg_barrett_to_bh8(T))
                 title = "pybullet-grasper Barrett -> our barrett_bh8"
+            elif peer == "pybullet_grasper_2f85":
+                theirs, ours = pbg_robotiq_points(T), parallel_jaw_pad_middles(pj, pbg_robotiq_to_parallel_jaw(T))
+                title = "pybullet-grasper Robotiq 2F-85 -> our parallel_jaw.urdf (pads 8.7 mm apart by width)"
             else:
                 theirs, ours = cgn_panda_points(T), parallel_jaw_points(pj, cgn_panda_to_parallel_jaw(T))
                 title = "cgn Panda -> our parallel_jaw.urdf"
@@ -280,27 +327,33 @@ def _run(cmd, log):
     return time.perf_counter() - t
 
 
-def run_peer(peer, obj, pose, out, reuse):
+def _mesh_arg(mesh):
+    """A mesh path as the drivers get it: relative to the repository where it lies inside it."""
+    mesh = Path(mesh).resolve()
+    return str(mesh.relative_to(REPO)) if mesh.is_relative_to(REPO) else str(mesh)
+
+
+def run_peer(peer, obj, pose, out, reuse, mesh=None, seed=0):
     """The peer's result for one object: {peer result JSON}; the request, result, partial cloud
-    and log go to `out`. With `reuse`, a result already there for the same request is kept."""
-    mesh, _ = OBJECTS[obj]
-    req = {"mesh": mesh, "pose": list(pose), "top_k": TOP_K, "seed": 0}
-    if peer == "pybullet_grasper":
-        req["hand"] = "barrett"
+    and log go to `out`. `mesh` defaults to OBJECTS[obj]'s. With `reuse`, a result already there
+    for the same request is kept."""
+    mesh = _mesh_arg(REPO / (mesh or OBJECTS[obj][0]))
+    req = {"mesh": mesh, "pose": list(pose), "top_k": TOP_K, "seed": seed}
+    cloud = out / f"cloud_{obj}.npy"
+    if peer.startswith("pybullet_grasper"):
+        req["hand"] = "robotiq_2f85" if peer == "pybullet_grasper_2f85" else "barrett"
         python, driver = PBG_PYTHON, PEERS / "pybullet_grasper_driver.py"
     else:
         req["hand"] = "panda"
-        cloud = out / f"cloud_{obj}.npy"
-        req["cloud"] = str(cloud.relative_to(REPO))
+        req["cloud"] = _mesh_arg(cloud)
         python, driver = CGN_PYTHON, PEERS / "cgn_driver.py"
     req_path, res_path = out / f"request_{peer}_{obj}.json", out / f"result_{peer}_{obj}.json"
     if reuse and res_path.exists() and req_path.exists() and json.loads(req_path.read_text()) == req:
-        if peer != "cgn" or (out / f"cloud_{obj}.npy").exists():
-            print(f"{peer} on {obj}: reusing {res_path.relative_to(REPO)}")
+        if peer != "cgn" or cloud.exists():
+            print(f"{peer} on {obj}: reusing {res_path}")
             return json.loads(res_path.read_text())
     if peer == "cgn":
-        _run([PBG_PYTHON, PEERS / "make_partial_cloud.py", mesh, out / f"cloud_{obj}.npy",
-              "--pose", *pose], out / f"log_cloud_{obj}.txt")
+        _run([PBG_PYTHON, PEERS / "make_partial_cloud.py", mesh, cloud, "--pose", *pose], out / f"log_cloud_{obj}.txt")
     req_path.write_text(json.dumps(req, indent=1))
     print(f"{peer} on {obj}: running the driver ...", flush=True)
     _run([python, driver, req_path, res_path], out / f"log_{peer}_{obj}.txt")
@@ -308,24 +361,32 @@ def run_peer(peer, obj, pose, out, reuse):
 
 
 # ---- our lift test ------------------------------------------------------------------------------
-def our_world(obj, pose, hand):
+def our_world(obj, pose, hand, mesh=None, mass=None):
+    """Our World with the object (OBJECTS[obj] unless `mesh` and `mass` are given) at the planar
+    `pose`, the mesh's own xy origin kept; and the vertical offset the scene applied to it."""
     from bayesgrasp.objects.library import load_object
     from bayesgrasp.world import World
-    mesh, mass = OBJECTS[obj]
+    if mesh is None:
+        mesh, mass = OBJECTS[obj]
     model = load_object(str(REPO / mesh), mass=mass)
     world = World.single(model, pose=tuple(pose), hand=hand, keep_origin=True)
     z_shift = -float(model.bounds[0][2])   # the scene puts the mesh's lowest point on z = 0
     return world, z_shift
 
 
-def judge(peer, obj, pose, result, threads=0):
-    """Our lift test of the peer's top grasps: one row per rank."""
+def our_hand_poses(peer, result, z_shift, top_k=TOP_K):
+    """The peer's top-k grasps as our hand poses (N, 4, 4), table frame, moved up by `z_shift`."""
+    return np.array([trans(0, 0, z_shift) @ CONVERT[peer](g["pose"]) for g in result.get("grasps", [])[:top_k]])
+
+
+def judge(peer, obj, pose, result, threads=0, world=None):
+    """Our lift test of the peer's top grasps: one row per rank. `world` (from :func:`our_world`,
+    with its z_shift) defaults to OBJECTS[obj]'s at `pose`."""
     grasps = result.get("grasps", [])
     if not grasps:
-        return []
-    world, z_shift = our_world(obj, pose, OUR_HAND[peer])
-    convert = pbg_barrett_to_bh8 if peer == "pybullet_grasper" else cgn_panda_to_parallel_jaw
-    H = np.array([trans(0, 0, z_shift) @ convert(g["pose"]) for g in grasps])
+        return [], None
+    world, z_shift = world or our_world(obj, pose, OUR_HAND[peer])
+    H = our_hand_poses(peer, result, z_shift, top_k=len(grasps))
     spread = PBG_SPREAD if peer == "pybullet_grasper" else None
     b = world.grasp_poses(H, spread=spread, frame="world", lift=True, threads=threads)
     counts = np.diff(np.asarray(b.contacts.offsets))
@@ -338,14 +399,14 @@ def judge(peer, obj, pose, result, threads=0):
                "epsilon": float(b.epsilon[i]), "collision_at_start": bool(b.collision_at_start[i]),
                "object_contacts": n_obj, "lift_displacement": float(b.lift_displacement[i]),
                "our_hand_pose": H[i].tolist(), "joints": np.asarray(b.joint_angles[i]).tolist()}
-        if peer == "pybullet_grasper":
+        if peer.startswith("pybullet_grasper"):
             row["peer_lift_test"] = bool(g.get("lift_test"))
         else:
             row["peer_width"] = g.get("width")
         if row["collision_at_start"]:
             row["approach_retry"] = approach_retry(world, H[i], spread)
         rows.append(row)
-    return rows
+    return rows, b
 
 
 RETRY_BACKOFF = 0.1   # m: pybullet-grasper's own approach (forward_joint's 0.1 m move before closing)
@@ -360,8 +421,11 @@ def approach_retry(world, H, spread):
     from bayesgrasp.hand import Hand
     pre = H @ trans(0.0, 0.0, -RETRY_BACKOFF)
     d = pre[:3, 2]
-    g = world.approach(d, pre[:3, 3], roll=Hand.approach_roll(pre), spread=spread, standoff=0.0,
-                       frame="world", lift=True)
+    try:
+        g = world.approach(d, pre[:3, 3], roll=Hand.approach_roll(pre), spread=spread, standoff=0.0,
+                           frame="world", lift=True)
+    except ValueError as e:   # e.g. the start point lies below the table: no second try
+        return {"lifted": False, "error": str(e)}
     travel = float((np.asarray(g.hand_pose)[:3, 3] - pre[:3, 3]) @ d)
     turn = float(np.degrees(np.arccos(np.clip((np.trace(np.asarray(g.hand_pose)[:3, :3].T @ pre[:3, :3]) - 1) / 2,
                                               -1, 1))))
@@ -374,7 +438,7 @@ def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--objects", nargs="+", default=list(OBJECTS), choices=list(OBJECTS))
     ap.add_argument("--pose", nargs=3, type=float, default=[0.0, 0.0, 0.0], metavar=("X", "Y", "YAW"))
-    ap.add_argument("--peers", nargs="+", default=["pybullet_grasper", "cgn"], choices=["pybullet_grasper", "cgn"])
+    ap.add_argument("--peers", nargs="+", default=["pybullet_grasper", "cgn"], choices=list(PEER_NAMES))
     ap.add_argument("--out", type=Path, default=OUT_DEFAULT)
     ap.add_argument("--reuse", action="store_true", help="keep peer results already in --out for the same request")
     ap.add_argument("--check-frames", action="store_true", help="only compare the hands' finger points")
@@ -383,7 +447,7 @@ def main(argv=None):
 
     if args.check_frames:
         found = {}
-        for peer in ("pybullet_grasper", "cgn"):
+        for peer in PEER_NAMES:
             for obj in OBJECTS:
                 p = args.out / f"result_{peer}_{obj}.json"
                 if p.exists():
@@ -407,14 +471,14 @@ def main(argv=None):
         for peer in args.peers:
             res = results[(peer, obj)]
             t = time.perf_counter()
-            rows = judge(peer, obj, pose, res, threads=args.threads)
+            rows, _ = judge(peer, obj, pose, res, threads=args.threads)
             entry = {"peer_seconds": res.get("seconds"), "peer_counts": res.get("counts"),
                      "judge_seconds": time.perf_counter() - t, "grasps": rows,
                      "top1_lifted": bool(rows and rows[0]["lifted"]),
                      "top5_lifted": any(r["lifted"] for r in rows[:TOP_K]),
                      "top5_lifted_with_retries": any(r["lifted"] or r.get("approach_retry", {}).get("lifted", False)
                                                      for r in rows[:TOP_K])}
-            if peer == "pybullet_grasper":
+            if peer.startswith("pybullet_grasper"):
                 entry["peer_top1_held"] = bool(rows and rows[0]["peer_lift_test"])
                 entry["peer_top5_held"] = any(r["peer_lift_test"] for r in rows[:TOP_K])
                 entry["note"] = ("top 5 by the peer's score among its tested candidates; "
@@ -445,7 +509,8 @@ def main(argv=None):
                 + (f" [retry from {RETRY_BACKOFF} m back: moved {r['approach_retry']['travel']:.3f} m, "
                    f"lifted {yn[r['approach_retry']['lifted']]}"
                    f"{', starts in collision' if r['approach_retry']['collision_at_start'] else ''}]"
-                   if 'approach_retry' in r else "")
+                   if 'travel' in r.get('approach_retry', {}) else
+                   f" [no retry: {r['approach_retry']['error']}]" if 'approach_retry' in r else "")
                 for r in e["grasps"]))
     print()
     for obj, per in report["objects"].items():
