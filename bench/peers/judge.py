@@ -333,10 +333,11 @@ def _mesh_arg(mesh):
     return str(mesh.relative_to(REPO)) if mesh.is_relative_to(REPO) else str(mesh)
 
 
-def run_peer(peer, obj, pose, out, reuse, mesh=None, seed=0):
+def run_peer(peer, obj, pose, out, reuse, mesh=None, seed=0, make_cloud=None):
     """The peer's result for one object: {peer result JSON}; the request, result, partial cloud
-    and log go to `out`. `mesh` defaults to OBJECTS[obj]'s. With `reuse`, a result already there
-    for the same request is kept."""
+    and log go to `out`. `mesh` defaults to OBJECTS[obj]'s. cgn's cloud comes from
+    `make_cloud(path)` if given, else from make_partial_cloud.py. With `reuse`, a result already
+    there for the same request is kept."""
     mesh = _mesh_arg(REPO / (mesh or OBJECTS[obj][0]))
     req = {"mesh": mesh, "pose": list(pose), "top_k": TOP_K, "seed": seed}
     cloud = out / f"cloud_{obj}.npy"
@@ -352,7 +353,9 @@ def run_peer(peer, obj, pose, out, reuse, mesh=None, seed=0):
         if peer != "cgn" or cloud.exists():
             print(f"{peer} on {obj}: reusing {res_path}")
             return json.loads(res_path.read_text())
-    if peer == "cgn":
+    if peer == "cgn" and make_cloud is not None:
+        make_cloud(cloud)
+    elif peer == "cgn":
         _run([PBG_PYTHON, PEERS / "make_partial_cloud.py", mesh, cloud, "--pose", *pose], out / f"log_cloud_{obj}.txt")
     req_path.write_text(json.dumps(req, indent=1))
     print(f"{peer} on {obj}: running the driver ...", flush=True)

@@ -12,8 +12,9 @@ box centred on its origin and its lowest point on z = 0 (`meshes/`), so that a p
 `keep_origin` then coincide). Each object stands at a seeded pose P (x, y within +-5 cm, any yaw).
 
 1. **At the known pose P** (`known`): pybullet-grasper with its Barrett ("pybullet_grasper") and
-   its Robotiq 2F-85 ("pybullet_grasper_2f85") on the mesh, Contact-GraspNet ("cgn") on a rendered
-   partial view (make_partial_cloud.py); each one's top 5 by its own score, converted to our hand
+   its Robotiq 2F-85 ("pybullet_grasper_2f85") on the mesh, Contact-GraspNet ("cgn") on the partial
+   view our own examples get (objects.views.capture_view: the library's noisy depth camera, the
+   table in view); each one's top 5 by its own score, converted to our hand
    frames (judge.py: Barrett -> our barrett_bh8; 2F-85 and Panda -> our parallel_jaw.urdf) and
    judged by (a) our lift test, (b) MuJoCo for the BH8 grasps (bench/lift_mujoco.py replays them;
    it models revolute fingers only, so the parallel-jaw grasps have no MuJoCo verdict), (c) the
@@ -59,6 +60,7 @@ OUR_LABEL = "bayesgrasp (BH8)"
 BELIEF = (0.02, 0.02, float(np.radians(30.0)))      # the issue's estimate error: +-2 cm, +-30 deg
 KNOWN_BELIEF = (0.002, 0.002, float(np.radians(1.0)))
 ATTEMPTS = (1, 2, 4)
+CROP = 0.3   # m: the side of the table square around the object that Contact-GraspNet's cloud keeps
 BH8 = "barrett_bh8"
 
 
@@ -101,6 +103,20 @@ def wrap(a):
     return float((a + np.pi) % (2 * np.pi) - np.pi)
 
 
+def library_view(mesh, pose, path, seed=0):
+    """The partial view our `plan --cloud` / `category` examples get (objects.views.capture_view:
+    the library's noisy depth camera 0.45 m out, up and to the side, looking at the object; the
+    table in view), cropped to a CROP-wide square of table around the object (as one crops a scene
+    for Contact-GraspNet, which keeps 20,000 random points of what it gets: the whole 1.2 m table
+    would leave it a few hundred on the object), written as an (N, 3) table-frame cloud."""
+    from bayesgrasp.objects.views import capture_view
+    v = capture_view(str(mesh), tuple(pose), seed=seed)
+    c = np.asarray(v.cloud, dtype=np.float64)
+    keep = np.all(np.abs(c[:, :2] - np.asarray(pose[:2])) <= CROP / 2, axis=1)
+    np.save(path, c[keep])
+    return path
+
+
 # ---- bayesgrasp's side: the plan command ---------------------------------------------------------
 def plan_cmd(mesh, mass, estimate, truth, attempts, half_width, seed):
     f = lambda p: ",".join(f"{v:.5f}" for v in p)  # noqa: E731
@@ -132,7 +148,8 @@ def known_pose(name, mesh, mass, pose, out, cache, reuse, threads):
     from lift_heldset import export
     res = {"peers": {}}
     for peer in PEERS:
-        r = J.run_peer(peer, name, pose, out / "peers", reuse, mesh=mesh)
+        r = J.run_peer(peer, name, pose, out / "peers", reuse, mesh=mesh,
+                       make_cloud=lambda path: library_view(mesh, pose, path))
         world = J.our_world(name, pose, J.OUR_HAND[peer], mesh=mesh, mass=mass)
         rows, batch = J.judge(peer, name, pose, r, threads=threads, world=world)
         entry = {"seconds": r.get("seconds"), "counts": r.get("counts"), "grasps": rows}
