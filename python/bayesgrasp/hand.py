@@ -131,6 +131,36 @@ class Hand:
         return ([m["name"] for m in self.urdf_joint_map],
                 np.array([m["scale"] * q[m["index"]] + m["offset"] for m in self.urdf_joint_map]))
 
+    #: rad (m for a jaw): how far two URDF joints that read the same joint of ours (a spread on two
+    #: fingers, a mimic) may disagree in a reading given in the URDF's terms.
+    URDF_READING_TOL = 0.05
+
+    def joints_from_urdf(self, values) -> np.ndarray:
+        """The inverse of :meth:`urdf_joints`: a reading in the URDF's terms (its moving joints in the
+        order of ``urdf_joints``' names, its units) as our joint vector. Where several URDF joints
+        read one of ours, their mean is taken; one of ours that no URDF joint reads keeps its open
+        preshape's value; ValueError if they disagree by more than
+        URDF_READING_TOL, naming them, or if the count is wrong."""
+        if self.urdf_joint_map is None:
+            raise ValueError(f"{self.source}: not a URDF hand; its readings are in joint_names' terms")
+        v = np.asarray(values, dtype=float).ravel()
+        names = [m["name"] for m in self.urdf_joint_map]
+        if v.size != len(names):
+            raise ValueError(f"{v.size} values for the URDF's {len(names)} moving joints ({', '.join(names)})")
+        q = self.open_joints()   # a joint of ours with no URDF joint (a jaw's fixed spread) keeps its preshape
+        for i in range(self.num_joints):
+            rows = [(m["name"], (v[k] - m["offset"]) / m["scale"]) for k, m in enumerate(self.urdf_joint_map)
+                    if m["index"] == i and m["scale"] != 0]
+            if not rows:
+                continue
+            vals = np.array([r[1] for r in rows])
+            if np.ptp(vals) > self.URDF_READING_TOL:
+                raise ValueError(f"the URDF joints {', '.join(r[0] for r in rows)} read joint {self.joint_names[i]!r} "
+                                 f"as {', '.join(f'{x:.4g}' for x in vals)}: they disagree by more than "
+                                 f"{self.URDF_READING_TOL}")
+            q[i] = vals.mean()
+        return q
+
     @classmethod
     def from_json(cls, text: str) -> "Hand":
         """A hand from the JSON text of a hand file."""

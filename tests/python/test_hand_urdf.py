@@ -417,3 +417,27 @@ def test_a_mimic_of_an_equivalent_joint_is_the_same_coupling(tmp_path):
     other = _copy_bh8(tmp_path / "other", lambda u: u.replace('<mimic joint="bh_j22" multiplier', '<mimic joint="bh_j32" multiplier'))
     with pytest.raises(HandFileError, match=r"joint 'bh_j23' is neither the finger's first joint nor a mimic of 'bh_j22'"):
         Hand.load(other)
+
+
+@pytest.mark.parametrize("name", ["barrett_bh8.urdf", "robotiq_3f.urdf", "parallel_jaw.urdf"])
+def test_a_reading_in_the_urdf_s_terms_comes_back_as_our_joints(name):
+    """Hand.joints_from_urdf inverts urdf_joints (open and closed hands); URDF joints that read one
+    joint of ours and disagree, a wrong count, or a hand file are refused with what was expected."""
+    from bayesgrasp.world import World
+
+    hand = Hand.load(name)
+    world = World.single("cube", hand=hand)
+    for q in [hand.open_joints(), world.grasp(0.01, 0.0, 0.6).joint_angles]:
+        names, values = hand.urdf_joints(q)
+        np.testing.assert_allclose(hand.joints_from_urdf(values), q, atol=1e-12)
+    with pytest.raises(ValueError, match=f"for the URDF's {len(names)} moving joints"):
+        hand.joints_from_urdf(values[:-1])
+    shared = [i for i in range(hand.num_joints) if sum(m["index"] == i for m in hand.urdf_joint_map) > 1]
+    if shared:   # two URDF joints read one of ours (a spread, a mimic): a reading where they differ
+        k = next(k for k, m in enumerate(hand.urdf_joint_map) if m["index"] == shared[0])
+        bad = values.copy()
+        bad[k] += 0.2 * hand.urdf_joint_map[k]["scale"]
+        with pytest.raises(ValueError, match="disagree by more than"):
+            hand.joints_from_urdf(bad)
+    with pytest.raises(ValueError, match="not a URDF hand"):
+        Hand.load("barrett_bh8").joints_from_urdf(values)

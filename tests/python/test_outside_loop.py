@@ -159,3 +159,37 @@ def test_python_api_resumes_in_a_new_object(tmp_path, cache):
     nxt = again.observe([0.0] + [1.0] * 6, lifted=False)
     assert nxt is not None and nxt["attempt"] == 2 and nxt["top_grasp"] != first
     assert PoseEpisode.open(tmp_path / "p").belief() == again.belief()
+
+
+def test_a_urdf_hand_s_episode_reads_joints_in_the_urdf_s_terms(capsys, tmp_path, cache):
+    """With a URDF hand the printed joints are the URDF's, and --joints takes a reading in them: it
+    updates the belief exactly as the same reading in our terms does (the Python API's observe)."""
+    from bayesgrasp.experiments.outside_loop_category import open_episode
+    from bayesgrasp.hand import Hand
+
+    hand = Hand.load("barrett_bh8.urdf")
+    args = ["episode", "new", "--object", OBJ, "--estimate", ",".join(map(repr, EST)), "--method", "stability",
+            "--attempts", "3", "--seed", SEED, "--hand", "barrett_bh8.urdf", "--cache", cache, *SMALL]
+    main([str(a) for a in args + ["--dir", str(tmp_path / "a")]])
+    text = capsys.readouterr().out
+    urdf_names = hand.urdf_joints(hand.open_joints())[0]
+    assert "  joints " + ",".join(urdf_names) in text           # the URDF's names, not ours
+    doc = cli_json(capsys, *args, "--dir", tmp_path / "b", "--json")
+    ctx = RunContext(cache_dir=cache, hand="barrett_bh8.urdf",
+                     model_settings=model_settings([f"models.{k}={v}" for k, v in SET.items()], "lift"))
+    ex = execute(World.single(OBJ, pose=TRUTH, hand=ctx.hand), ctx.models(OBJ), np.array(doc["next"]["top_grasp"]),
+                 np.array(TRUTH), ctx)
+    q = np.asarray(ex.joint_angles)
+    values = hand.urdf_joints(q)[1]
+    lifted = "yes" if ex.lifted else "no"
+    via_cli = cli_json(capsys, "episode", "observe", tmp_path / "a", "--joints", ",".join(map(repr, values.tolist())),
+                       "--lifted", lifted, "--json")
+    ep = open_episode(tmp_path / "b", cache_dir=cache)
+    ep.observe(q, lifted)
+    assert via_cli["next"] == json.loads(json.dumps(ep.next))
+    assert cli_json(capsys, "episode", "show", tmp_path / "a", "--json")["belief"] == \
+        cli_json(capsys, "episode", "show", tmp_path / "b", "--json")["belief"]
+    # a reading in our terms (7 values for the URDF's 8 joints) is refused, naming the URDF's joints
+    code = main(["episode", "observe", str(tmp_path / "a"), "--joints", ",".join(map(repr, q.tolist())),
+                 "--lifted", "no"])
+    assert code == 2 and "--joints" in capsys.readouterr().err

@@ -58,7 +58,9 @@ def add(sub) -> None:
                                     "grasp the robot just executed, and prints the next grasp.")
     o.add_argument("dir", help="the episode's directory")
     o.add_argument("--joints", required=True, metavar="A,B,...",
-                   help="every hand joint's angle after closing (rad), in the order of the grasp's joint_names")
+                   help="every hand joint's value after closing, in the order the grasp lists them: a URDF "
+                        "hand's moving joints in the URDF's names and units (the grasp's urdf.joint_names), "
+                        "else the hand file's joint_names (rad)")
     o.add_argument("--lifted", required=True, help="yes or no: did the object come up in the lift?")
     o.add_argument("--cache", default=None, help="model cache directory (as at `episode new`)")
     add_format_options(o)
@@ -149,9 +151,20 @@ def _open(args):
 def observe(args) -> int:
     fmt = output_format(args)
     ep = _open(args)
-    ep.observe(floats(args.joints, len(ep.hand.joint_names), "--joints"), args.lifted)
+    ep.observe(_reading(ep.hand, args.joints), args.lifted)
     _print_next(ep, fmt)
     return 0
+
+
+def _reading(hand, text: str):
+    """--joints as our joint vector: a URDF hand's reading is in the URDF's terms."""
+    if hand.urdf_joint_map is None:
+        return floats(text, len(hand.joint_names), "--joints")
+    names = hand.urdf_joints(np.zeros(hand.num_joints))[0]
+    try:
+        return hand.joints_from_urdf(floats(text, len(names), "--joints"))
+    except ValueError as e:
+        raise CliError(f"--joints: {e}") from None
 
 
 def _quality(nxt: dict) -> float:
@@ -190,7 +203,7 @@ def _print_next(ep, fmt: str) -> None:
         p, a = g["position"], g["approach"]
         print(f"attempt {nxt['attempt']} ({nxt['kind']}): palm at ({p[0]:.4f}, {p[1]:.4f}, {p[2]:.4f}) m, approach "
               f"({a[0]:.3f}, {a[1]:.3f}, {a[2]:.3f}), spread {g['spread']:.3f} rad; {_score(nxt)}")
-    print("  joints " + ",".join(g["joint_names"]))
+    print("  joints " + ",".join(g["urdf"]["joint_names"] if "urdf" in g else g["joint_names"]))
     print("  then: bayesgrasp episode observe " + str(ep.directory) + " --joints A,B,... --lifted yes|no")
 
 
