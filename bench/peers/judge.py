@@ -408,14 +408,33 @@ def judge(peer, obj, pose, result, threads=0, world=None):
             row["peer_width"] = g.get("width")
         if row["collision_at_start"]:
             row["approach_retry"] = approach_retry(world, H[i], spread)
+        row["executed_lifted"] = row["approach_retry"]["lifted"] if row["collision_at_start"] else row["lifted"]
         rows.append(row)
     return rows, b
+
+
+def execute(world, H, spread, threads=0):
+    """The grasps at hand poses H (N, 4, 4, world) executed as a robot would: closed where the
+    pose is free; where the open hand would start in collision, moved in from RETRY_BACKOFF
+    behind it until its first contact (approach_retry). Returns (lifted per grasp, the batch of
+    the executed grasps closed again at the poses they closed at, for export; N x 4 x 4 poses)."""
+    b = world.grasp_poses(H, spread=spread, frame="world", lift=True, threads=threads)
+    H_exec = np.array(H, dtype=float)
+    lifted = np.asarray(b.lifted, dtype=bool).copy()
+    for i in np.flatnonzero(np.asarray(b.collision_at_start, dtype=bool)):
+        r = approach_retry(world, H[i], spread, keep_pose=True)
+        lifted[i] = r["lifted"]
+        if "hand_pose" in r:
+            H_exec[i] = r["hand_pose"]
+    if not np.array_equal(H_exec, H):
+        b = world.grasp_poses(H_exec, spread=spread, frame="world", lift=True, threads=threads)
+    return lifted, b, H_exec
 
 
 RETRY_BACKOFF = 0.1   # m: pybullet-grasper's own approach (forward_joint's 0.1 m move before closing)
 
 
-def approach_retry(world, H, spread):
+def approach_retry(world, H, spread, keep_pose=False):
     """A second try of a grasp whose hand starts in collision at the peer's pose: our open hand
     starts RETRY_BACKOFF behind it along its approach (for pybullet-grasper exactly the peer's
     pose before its 0.1 m forward move, converted), moves along +z until its first contact with
@@ -432,9 +451,12 @@ def approach_retry(world, H, spread):
     travel = float((np.asarray(g.hand_pose)[:3, 3] - pre[:3, 3]) @ d)
     turn = float(np.degrees(np.arccos(np.clip((np.trace(np.asarray(g.hand_pose)[:3, :3].T @ pre[:3, :3]) - 1) / 2,
                                               -1, 1))))
-    return {"lifted": bool(g.lifted), "epsilon": float(g.epsilon), "collision_at_start": bool(g.collision_at_start),
-            "travel": travel, "orientation_error_deg": turn,
-            "object_contacts": sum(1 for c in g.contacts if not c.on_table)}
+    out = {"lifted": bool(g.lifted), "epsilon": float(g.epsilon), "collision_at_start": bool(g.collision_at_start),
+           "travel": travel, "orientation_error_deg": turn,
+           "object_contacts": sum(1 for c in g.contacts if not c.on_table)}
+    if keep_pose and not g.collision_at_start:
+        out["hand_pose"] = np.asarray(g.hand_pose)
+    return out
 
 
 def main(argv=None):

