@@ -19,14 +19,16 @@ box centred on its origin and its lowest point on z = 0 (`meshes/`), so that a p
    judged by (a) our lift test, (b) MuJoCo for the BH8 grasps (bench/lift_mujoco.py replays them;
    it models revolute fingers only, so the parallel-jaw grasps have no MuJoCo verdict), (c) the
    peer's own lift-and-shake where it has one (pybullet-grasper). bayesgrasp's first grasp: `plan`
-   with the belief at P (+-2 mm, +-1 deg), one attempt, the BH8 (our models cover that hand only);
-   the same two judges.
+   with the belief at P (+-2 mm, +-1 deg), one attempt, with each hand the peers' grasps are
+   executed with (the BH8, and the parallel jaw for the 2F-85's and the Panda's grasps); the BH8's
+   also replayed in MuJoCo.
 2. **Under uncertainty** (`uncertain`): the estimate is P, the true pose P + d_k with d_k uniform
    in +-2 cm, +-2 cm, +-30 deg (`--runs` seeded draws per object, the same for every planner). The
    peers plan once at P (their part-1 result, open loop, as they are used): their grasps are
    executed at the true pose in rank order, so "after n attempts" is "one of the top n lifted".
-   bayesgrasp runs its closed loop (`plan --estimate P --true-pose P+d_k --attempts 4`, belief
-   +-2 cm / +-30 deg): lifted after 1, 2 and 4 attempts. Judge: our lift test.
+   bayesgrasp runs its closed loop with each hand (`plan --estimate P --true-pose P+d_k
+   --attempts 4 --hand H`, belief +-2 cm / +-30 deg): lifted after 1, 2 and 4 attempts. Judge:
+   our lift test.
 3. **Time**: each peer call's wall time (a new process per call, start-up included); bayesgrasp's
    first call on the object from an empty model cache (its models built) and the same call warm.
 
@@ -40,7 +42,6 @@ import json
 import os
 import subprocess
 import sys
-import tempfile
 import time
 from pathlib import Path
 
@@ -54,15 +55,16 @@ from ycb_objects import MASS_G  # noqa: E402
 
 REPO = J.REPO
 PEERS = ("pybullet_grasper", "pybullet_grasper_2f85", "cgn")
-PEER_LABEL = {"pybullet_grasper": "pybullet-grasper (Barrett)", "pybullet_grasper_2f85": "pybullet-grasper (2F-85)",
-              "cgn": "Contact-GraspNet (Panda)"}
-OUR_LABEL = "bayesgrasp (BH8)"
+BH8 = "barrett_bh8"
+#: bayesgrasp with each hand a peer's grasps are executed with: the BH8 and the parallel jaw.
+OURS = {"bayesgrasp": BH8, "bayesgrasp_jaw": "parallel_jaw.urdf"}
+LABEL = {"bayesgrasp": "bayesgrasp (BH8)", "bayesgrasp_jaw": "bayesgrasp (parallel jaw)",
+         "pybullet_grasper": "pybullet-grasper (Barrett)", "pybullet_grasper_2f85": "pybullet-grasper (2F-85)",
+         "cgn": "Contact-GraspNet (Panda)"}
 BELIEF = (0.02, 0.02, float(np.radians(30.0)))      # the issue's estimate error: +-2 cm, +-30 deg
 KNOWN_BELIEF = (0.002, 0.002, float(np.radians(1.0)))
 ATTEMPTS = (1, 2, 4)
 CROP = 0.3   # m: the side of the table square around the object that Contact-GraspNet's cloud keeps
-BH8 = "barrett_bh8"
-
 
 def log(msg):
     print(msg, file=sys.stderr, flush=True)
@@ -118,11 +120,11 @@ def library_view(mesh, pose, path, seed=0):
 
 
 # ---- bayesgrasp's side: the plan command ---------------------------------------------------------
-def plan_cmd(mesh, mass, estimate, truth, attempts, half_width, seed):
+def plan_cmd(mesh, mass, estimate, truth, attempts, half_width, seed, hand):
     f = lambda p: ",".join(f"{v:.5f}" for v in p)  # noqa: E731
     return [str(Path(sys.executable).parent / "bayesgrasp"), "plan", "--object", str(mesh), "--mass", f"{mass:.4f}",
             "--estimate", f(estimate), "--true-pose", f(truth), "--attempts", str(attempts), "--seed", str(seed),
-            "--set", "planner.half_width=" + f(half_width), "--json"]
+            "--hand", hand, "--set", "planner.half_width=" + f(half_width), "--json"]
 
 
 def run_plan(cmd, cache):
@@ -137,31 +139,31 @@ def run_plan(cmd, cache):
     return {"wall_s": wall, "doc": json.loads(r.stdout)}
 
 
-def lifted_after(attempts, n):
-    """Lifted within the first n attempts (the plan's success is the lift test's verdict)."""
-    return any(a["lifted"] for a in attempts[:n])
-
-
 # ---- one object ---------------------------------------------------------------------------------
-def known_pose(name, mesh, mass, pose, out, cache, reuse, threads):
-    """Part 1 for one object: each peer's top 5 and our first grasp, judged at the pose."""
+def known_peers(name, mesh, mass, pose, out, reuse, threads):
+    """Part 1, the peers: each one's top 5 at the pose, executed and judged; BH8 grasps exported."""
     from lift_heldset import export
-    res = {"peers": {}}
+    res = {}
     for peer in PEERS:
         r = J.run_peer(peer, name, pose, out / "peers", reuse, mesh=mesh,
                        make_cloud=lambda path: library_view(mesh, pose, path))
         world = J.our_world(name, pose, J.OUR_HAND[peer], mesh=mesh, mass=mass)
         rows, _ = J.judge(peer, name, pose, r, threads=threads, world=world)
-        entry = {"seconds": r.get("seconds"), "counts": r.get("counts"), "grasps": rows}
         if rows and J.OUR_HAND[peer] == BH8:   # MuJoCo replays the executed grasps
             spread = J.PBG_SPREAD if peer == "pybullet_grasper" else None
             _, batch, _ = J.execute(world[0], J.our_hand_poses(peer, r, world[1]), spread, threads)
             export(world[0], name, batch, np.arange(len(rows)), peer, str(out / "mujoco"))
-        res["peers"][peer] = entry
+        res[peer] = {"seconds": r.get("seconds"), "counts": r.get("counts"), "grasps": rows}
         log(f"  {name} {peer}: {r.get('seconds', 0):.0f} s, top-1 lifted {bool(rows and rows[0]['executed_lifted'])}, "
             f"top-5 {sum(x['executed_lifted'] for x in rows)}/{len(rows)}")
-    # bayesgrasp: the first call builds the object's models (empty cache), then the same call warm.
-    cmd = plan_cmd(mesh, mass, pose, pose, 1, KNOWN_BELIEF, 0)
+    return res
+
+
+def known_ours(name, mesh, mass, pose, out, cache, hand):
+    """Part 1, bayesgrasp with `hand`: the first call builds the object's models (empty cache),
+    then the same call warm; its grasp closed again at the executed pose for MuJoCo (BH8)."""
+    from lift_heldset import export
+    cmd = plan_cmd(mesh, mass, pose, pose, 1, KNOWN_BELIEF, 0, hand)
     first = run_plan(cmd, cache)
     warm = run_plan(cmd, cache)
     ours = {"first_s": first["wall_s"], "warm_s": warm["wall_s"], "error": first.get("error") or warm.get("error")}
@@ -170,41 +172,40 @@ def known_pose(name, mesh, mass, pose, out, cache, reuse, threads):
         ours.update(lifted=bool(a["lifted"]), family=a["family"], hand_pose=a["grasp"]["pose"],
                     spread=a["grasp"]["spread"], joints=a["joint_angles"],
                     warm_same=("doc" in warm and warm["doc"]["attempts"][0]["grasp"]["pose"] == a["grasp"]["pose"]))
-        world, _ = J.our_world(name, pose, BH8, mesh=mesh, mass=mass)
-        b = world.grasp_poses(np.array([a["grasp"]["pose"]]), spread=a["grasp"]["spread"], frame="world", lift=True)
-        ours["reclosed_lifted"] = bool(b.lifted[0])   # closed again at the executed pose, for MuJoCo's copy
-        export(world, name, b, np.arange(1), "bayesgrasp", str(out / "mujoco"))
-    res["ours"] = ours
-    log(f"  {name} bayesgrasp: first {first['wall_s']:.0f} s, warm {warm['wall_s']:.1f} s, "
+        if hand == BH8:
+            world, _ = J.our_world(name, pose, BH8, mesh=mesh, mass=mass)
+            b = world.grasp_poses(np.array([a["grasp"]["pose"]]), spread=a["grasp"]["spread"], frame="world", lift=True)
+            ours["reclosed_lifted"] = bool(b.lifted[0])
+            export(world, name, b, np.arange(1), "bayesgrasp", str(out / "mujoco"))
+    log(f"  {name} bayesgrasp ({hand}): first {first['wall_s']:.0f} s, warm {warm['wall_s']:.1f} s, "
         f"lifted {ours.get('lifted')}{' ERROR ' + ours['error'] if ours['error'] else ''}")
-    return res
+    return ours
 
 
-def uncertain(name, mesh, mass, pose, errors, known, cache, threads):
-    """Part 2 for one object: the peers' grasps from P executed at each true pose, and our loop."""
-    truths = [[pose[0] + d[0], pose[1] + d[1], wrap(pose[2] + d[2])] for d in errors]
-    res = {"truths": truths, "peers": {}, "ours": []}
+def uncertain_peers(name, mesh, mass, truths, out, threads):
+    """Part 2, the peers: their top grasps from P executed in rank order at each true pose."""
+    res = {}
     for peer in PEERS:
-        r = json.loads((known["result_path"][peer]).read_text())
+        r = json.loads((out / "peers" / f"result_{peer}_{name}.json").read_text())
         rows = []
         for truth in truths:
             world, z_shift = J.our_world(name, truth, J.OUR_HAND[peer], mesh=mesh, mass=mass)
             H = J.our_hand_poses(peer, r, z_shift, top_k=max(ATTEMPTS))
-            if len(H) == 0:
-                rows.append([])
-                continue
             spread = J.PBG_SPREAD if peer == "pybullet_grasper" else None
-            rows.append([bool(v) for v in J.execute(world, H, spread, threads)[0]])
-        res["peers"][peer] = rows
-    for k, truth in enumerate(truths):
-        p = run_plan(plan_cmd(mesh, mass, pose, truth, max(ATTEMPTS), BELIEF, k), cache)
-        if "doc" in p:
-            att = p["doc"]["attempts"]
-            res["ours"].append({"wall_s": p["wall_s"], "lifted": [bool(a["lifted"]) for a in att]})
-        else:
-            res["ours"].append({"wall_s": p["wall_s"], "error": p["error"]})
-        log(f"  {name} loop run {k}: {res['ours'][-1]}")
+            rows.append([bool(v) for v in J.execute(world, H, spread, threads)[0]] if len(H) else [])
+        res[peer] = rows
     return res
+
+
+def uncertain_ours(name, mesh, mass, pose, truths, cache, hand):
+    """Part 2, bayesgrasp with `hand`: its closed loop from the estimate P at each true pose."""
+    runs = []
+    for k, truth in enumerate(truths):
+        p = run_plan(plan_cmd(mesh, mass, pose, truth, max(ATTEMPTS), BELIEF, k, hand), cache)
+        runs.append({"wall_s": p["wall_s"], "lifted": [bool(a["lifted"]) for a in p["doc"]["attempts"]]}
+                    if "doc" in p else {"wall_s": p["wall_s"], "error": p["error"]})
+        log(f"  {name} loop ({hand}) run {k}: {runs[-1]}")
+    return runs
 
 
 # ---- the report ---------------------------------------------------------------------------------
@@ -222,122 +223,123 @@ def mujoco_verdicts(out):
     return {(r["object"], r["source"], r["grasp"]): bool(r["mujoco_lifted"]) for r in json.loads(p.read_text())}
 
 
-def tables(doc, out):
-    mj = mujoco_verdicts(out)
-    yn = lambda v: "-" if v is None else ("yes" if v else "no")  # noqa: E731
-    lines = ["### At the known pose: top-1 lifted (ours / MuJoCo / the peer's own test), top-5: how many lifted in ours",
-             "", "| object | " + " | ".join([OUR_LABEL] + [PEER_LABEL[p] for p in PEERS]) + " |",
-             "|---|" + "---|" * (1 + len(PEERS))]
-    tally = {k: {"ours": [0, 0], "mujoco": [0, 0], "own": [0, 0], "top5": [0, 0]} for k in ["bayesgrasp", *PEERS]}
+def _yn(v):
+    return "-" if v is None else ("yes" if v else "no")
+
+
+def known_table(doc, mj):
+    """Part 1's table: per object, each planner's top-1 (ours / MuJoCo / own), the top 5 in ours."""
+    keys = [*OURS, *PEERS]
+    lines = ["### At the known pose: top-1 lifted (our lift test / MuJoCo / the peer's own test); of the top 5, lifted in ours",
+             "", "| object | " + " | ".join(LABEL[k] for k in keys) + " |", "|---|" + "---|" * len(keys)]
+    tally = {k: {"ours": [0, 0], "mujoco": [0, 0], "own": [0, 0], "top5": [0, 0]} for k in keys}
     disagree = {"ours_vs_mujoco": [0, 0], "ours_vs_own": [0, 0]}
+
+    def add(t, key, v):
+        if v is not None:
+            t[key][0] += bool(v)
+            t[key][1] += 1
+
     for name, o in doc["objects"].items():
-        if "known" not in o:
-            continue
-        k = o["known"]
         cells = []
-        ours = k["ours"]
-        m = mj.get((name, "bayesgrasp", 0))
-        if "lifted" in ours:
-            tally["bayesgrasp"]["ours"][0] += ours["lifted"]
-            tally["bayesgrasp"]["ours"][1] += 1
+        for key, hand in OURS.items():
+            ours = o["known"]["ours"][hand]
+            m = mj.get((name, "bayesgrasp", 0)) if hand == BH8 else None
+            add(tally[key], "ours", ours.get("lifted"))
+            add(tally[key], "mujoco", m)
             if m is not None:
-                tally["bayesgrasp"]["mujoco"][0] += m
-                tally["bayesgrasp"]["mujoco"][1] += 1
-                disagree["ours_vs_mujoco"][0] += m != ours["reclosed_lifted"]
-                disagree["ours_vs_mujoco"][1] += 1
-        cells.append(f"{yn(ours.get('lifted'))} / {yn(m)} / -" if "lifted" in ours else f"error: {ours.get('error')}")
+                add(disagree, "ours_vs_mujoco", m != ours["reclosed_lifted"])
+            cells.append(f"{_yn(ours.get('lifted'))} / {_yn(m)} / -" if "lifted" in ours else f"error: {ours['error']}")
         for peer in PEERS:
-            rows = k["peers"][peer]["grasps"]
+            rows = o["known"]["peers"][peer]["grasps"]
             t = tally[peer]
             if not rows:
                 cells.append("no grasp")
-                t["ours"][1] += 1
-                t["top5"][1] += 1
+                add(t, "ours", False)
+                add(t, "top5", False)
                 continue
-            top = rows[0]
-            t["ours"][0] += top["executed_lifted"]
-            t["ours"][1] += 1
-            t["top5"][0] += any(r["executed_lifted"] for r in rows)
-            t["top5"][1] += 1
             m = mj.get((name, peer, 0))
-            if m is not None:
-                t["mujoco"][0] += m
-                t["mujoco"][1] += 1
-            own = top.get("peer_lift_test")
-            if own is not None:
-                t["own"][0] += own
-                t["own"][1] += 1
+            own = rows[0].get("peer_lift_test")
+            add(t, "ours", rows[0]["executed_lifted"])
+            add(t, "top5", any(r["executed_lifted"] for r in rows))
+            add(t, "mujoco", m)
+            add(t, "own", own)
             for i, r in enumerate(rows):
                 mi = mj.get((name, peer, i))
                 if mi is not None:
-                    disagree["ours_vs_mujoco"][0] += mi != r["executed_lifted"]
-                    disagree["ours_vs_mujoco"][1] += 1
+                    add(disagree, "ours_vs_mujoco", mi != r["executed_lifted"])
                 if r.get("peer_lift_test") is not None:
-                    disagree["ours_vs_own"][0] += r["peer_lift_test"] != r["executed_lifted"]
-                    disagree["ours_vs_own"][1] += 1
-            start = sum(r["collision_at_start"] for r in rows)
-            cells.append(f"{yn(top['executed_lifted'])} / {yn(m)} / {yn(own)}; "
+                    add(disagree, "ours_vs_own", r["peer_lift_test"] != r["executed_lifted"])
+            moved = sum(r["collision_at_start"] for r in rows)
+            cells.append(f"{_yn(rows[0]['executed_lifted'])} / {_yn(m)} / {_yn(own)}; "
                          f"{sum(r['executed_lifted'] for r in rows)} of {len(rows)}"
-                         + (f" ({start} moved in from behind)" if start else ""))
+                         + (f" ({moved} moved in from behind)" if moved else ""))
         lines.append(f"| {name} | " + " | ".join(cells) + " |")
-    lines += ["", "| overall, top-1 | judge: ours | MuJoCo | the peer's own | any of top-5 (ours) |", "|---|---|---|---|---|"]
-    for key in ["bayesgrasp", *PEERS]:
+    lines += ["", "| overall, top-1 | judge: ours | MuJoCo | the peer's own | one of the top 5 (ours) |",
+              "|---|---|---|---|---|"]
+    for key in keys:
         t = tally[key]
-        lines.append(f"| {OUR_LABEL if key == 'bayesgrasp' else PEER_LABEL[key]} | {share(*t['ours'])} | "
-                     f"{share(*t['mujoco'])} | {share(*t['own'])} | {share(*t['top5']) if key != 'bayesgrasp' else '-'} |")
+        lines.append(f"| {LABEL[key]} | {share(*t['ours'])} | {share(*t['mujoco'])} | {share(*t['own'])} | "
+                     f"{share(*t['top5']) if key in PEERS else '-'} |")
     lines += ["", f"Judges disagree: ours vs MuJoCo on {disagree['ours_vs_mujoco'][0]} of "
               f"{disagree['ours_vs_mujoco'][1]} BH8 grasps; ours vs pybullet-grasper's own test on "
               f"{disagree['ours_vs_own'][0]} of {disagree['ours_vs_own'][1]} of its grasps (both hands)."]
+    return lines
 
-    # under uncertainty
-    lines += ["", f"### Under +-2 cm / +-30 deg: lifted after 1 / 2 / 4 attempts (our lift test)", "",
-              "| object | runs | " + " | ".join([OUR_LABEL + " (closed loop)"] + [PEER_LABEL[p] + " (open loop)" for p in PEERS]) + " |",
-              "|---|---|" + "---|" * (1 + len(PEERS))]
-    total = {k: {n: [0, 0] for n in ATTEMPTS} for k in ["bayesgrasp", *PEERS]}
+
+def uncertain_table(doc):
+    """Part 2's table: lifted after 1, 2 and 4 attempts per object and overall."""
+    keys = [*OURS, *PEERS]
+    lines = ["### Under +-2 cm / +-30 deg: runs lifted after 1 / 2 / 4 attempts (our lift test)", "",
+             "| object | runs | " + " | ".join(LABEL[k] + (" (open loop)" if k in PEERS else " (closed loop)")
+                                         for k in keys) + " |", "|---|---|" + "---|" * len(keys)]
+    total = {k: {n: [0, 0] for n in ATTEMPTS} for k in keys}
     for name, o in doc["objects"].items():
-        if "uncertain" not in o:
-            continue
         u = o["uncertain"]
         cells = []
-        runs = [r for r in u["ours"] if "lifted" in r]
-        for n in ATTEMPTS:
-            total["bayesgrasp"][n][0] += sum(lifted_after([{"lifted": v} for v in r["lifted"]], n) for r in runs)
-            total["bayesgrasp"][n][1] += len(runs)
-        errs = len(u["ours"]) - len(runs)
-        cells.append(" / ".join(f"{sum(any(r['lifted'][:n]) for r in runs)}" for n in ATTEMPTS)
-                     + (f" ({errs} errors)" if errs else ""))
-        for peer in PEERS:
-            rows = u["peers"][peer]
+        for key in keys:
+            if key in PEERS:
+                rows, errs = u["peers"][key], 0
+            else:
+                runs = u["ours"][OURS[key]]
+                rows = [r["lifted"] for r in runs if "lifted" in r]
+                errs = len(runs) - len(rows)
             for n in ATTEMPTS:
-                total[peer][n][0] += sum(any(r[:n]) for r in rows)
-                total[peer][n][1] += len(rows)
-            cells.append(" / ".join(f"{sum(any(r[:n]) for r in rows)}" for n in ATTEMPTS))
+                total[key][n][0] += sum(any(r[:n]) for r in rows)
+                total[key][n][1] += len(rows)
+            cells.append(" / ".join(str(sum(any(r[:n]) for r in rows)) for n in ATTEMPTS)
+                         + (f" ({errs} errors)" if errs else ""))
         lines.append(f"| {name} | {len(u['truths'])} | " + " | ".join(cells) + " |")
     lines += ["", "| overall | after 1 | after 2 | after 4 |", "|---|---|---|---|"]
-    for key in ["bayesgrasp", *PEERS]:
-        lines.append(f"| {OUR_LABEL if key == 'bayesgrasp' else PEER_LABEL[key]} | "
-                     + " | ".join(share(*total[key][n]) for n in ATTEMPTS) + " |")
+    for key in keys:
+        lines.append(f"| {LABEL[key]} | " + " | ".join(share(*total[key][n]) for n in ATTEMPTS) + " |")
+    return lines
 
-    # time
-    lines += ["", "### Time per object (s, wall, one call each)", "",
-              "| object | bayesgrasp first (models built) | bayesgrasp warm | " + " | ".join(PEER_LABEL[p] for p in PEERS) + " |",
-              "|---|---|---|" + "---|" * len(PEERS)]
-    med = {k: [] for k in ["first", "warm", *PEERS]}
+
+def time_table(doc):
+    """Part 3's table: wall seconds per call."""
+    cols = [(f"{LABEL[k]} first (models built)", ("ours", OURS[k], "first_s")) for k in OURS] + \
+           [(f"{LABEL[k]} warm", ("ours", OURS[k], "warm_s")) for k in OURS] + \
+           [(LABEL[p], ("peers", p, "seconds")) for p in PEERS]
+    lines = ["### Time per object (s, wall, one call each: a new process)", "",
+             "| object | " + " | ".join(c[0] for c in cols) + " |", "|---|" + "---|" * len(cols)]
+    values = {c[0]: [] for c in cols}
     for name, o in doc["objects"].items():
-        if "known" not in o:
-            continue
-        k = o["known"]
-        med["first"].append(k["ours"]["first_s"])
-        med["warm"].append(k["ours"]["warm_s"])
-        cells = [f"{k['ours']['first_s']:.1f}", f"{k['ours']['warm_s']:.1f}"]
-        for peer in PEERS:
-            s = k["peers"][peer]["seconds"]
-            med[peer].append(s if s is not None else np.nan)
-            cells.append(f"{s:.1f}" if s is not None else "-")
+        cells = []
+        for label, (side, key, field) in cols:
+            v = o["known"][side][key].get(field)
+            values[label].append(np.nan if v is None else v)
+            cells.append("-" if v is None else f"{v:.1f}")
         lines.append(f"| {name} | " + " | ".join(cells) + " |")
-    if med["first"]:
-        lines.append("| median | " + " | ".join(f"{np.nanmedian(med[k]):.1f}" for k in ["first", "warm", *PEERS]) + " |")
-    text = "\n".join(lines) + "\n"
+    if doc["objects"]:
+        lines.append("| median | " + " | ".join(f"{np.nanmedian(values[c[0]]):.1f}" for c in cols) + " |")
+    return lines
+
+
+def tables(doc, out):
+    done = {"objects": {n: o for n, o in doc["objects"].items() if "uncertain" in o}}
+    text = "\n".join(known_table(done, mujoco_verdicts(out)) + [""] + uncertain_table(done) + [""]
+                     + time_table(done)) + "\n"
     (out / "tables.md").write_text(text)
     return text
 
@@ -387,10 +389,12 @@ def main(argv=None):
         pose = seeded_pose(args.seed, i)
         log(f"[{j + 1}/{len(names)}] {name} at ({pose[0]:.3f}, {pose[1]:.3f}, {np.degrees(pose[2]):.0f} deg), "
             f"{time.perf_counter() - t0:.0f} s so far")
-        known = known_pose(name, mesh, mass, pose, out, cache, args.reuse or args.reuse_peers, args.threads)
-        known["result_path"] = {p: out / "peers" / f"result_{p}_{name}.json" for p in PEERS}
-        unc = uncertain(name, mesh, mass, pose, pose_errors(args.seed, i, args.runs), known, cache, args.threads)
-        known.pop("result_path")
+        known = {"peers": known_peers(name, mesh, mass, pose, out, args.reuse or args.reuse_peers, args.threads),
+                 "ours": {hand: known_ours(name, mesh, mass, pose, out, cache, hand) for hand in OURS.values()}}
+        errors = pose_errors(args.seed, i, args.runs)
+        truths = [[pose[0] + d[0], pose[1] + d[1], wrap(pose[2] + d[2])] for d in errors]
+        unc = {"truths": truths, "peers": uncertain_peers(name, mesh, mass, truths, out, args.threads),
+               "ours": {hand: uncertain_ours(name, mesh, mass, pose, truths, cache, hand) for hand in OURS.values()}}
         doc["objects"][name] = {"mass": mass, "pose": pose, "known": known, "uncertain": unc}
         doc_path.write_text(json.dumps(doc, indent=1))
     if not args.no_mujoco:
