@@ -38,11 +38,8 @@ from bayesgrasp import _core
 from bayesgrasp.decomposition import convex_decomposition, decomposition_cache_dir
 from bayesgrasp.sim import set_fields
 
-__all__ = ["BARRETT_HAND", "LiftBatch", "LiftOptions", "LiftResult", "LiftTester", "convex_decomposition",
+__all__ = ["LiftBatch", "LiftOptions", "LiftResult", "LiftTester", "convex_decomposition",
            "decomposition_cache_dir", "is_concave", "lift_test", "lift_test_batch", "make_options"]
-
-#: Path of the built-in Barrett BH8 hand file.
-BARRETT_HAND = os.path.join(os.path.dirname(__file__), "data", "hands", "barrett_bh8.json")
 
 LiftOptions = _core.physics.LiftOptions
 LiftResult = _core.physics.LiftResult
@@ -60,7 +57,9 @@ def _hand(hand):
     from .hand import Hand
 
     if hand is None:
-        return BARRETT_HAND
+        from . import DEFAULT_HAND
+        from .hand import resolve_hand
+        return str(resolve_hand(DEFAULT_HAND))
     if isinstance(hand, Hand):
         return hand.core
     if isinstance(hand, (str, os.PathLike)) and (Path(hand).suffix.lower() == ".urdf" or not Path(hand).exists()):
@@ -84,7 +83,7 @@ class LiftTester:
     tester with the pieces given up front: the same shape for every grasp).
 
     Args:
-        hand: path to a hand JSON file (None: the built-in Barrett hand) or a HandModel.
+        hand: path to a hand JSON file (None: the default hand, bayesgrasp.DEFAULT_HAND) or a HandModel.
         vertices: (N, 3) object vertices (m). faces: (M, 3) int triangles.
         convex_pieces: the object's convex decomposition for shapes ``auto`` (concave objects)
             and ``decomposition``: a list of (K, 3) point arrays in the world frame, a callable
@@ -195,7 +194,7 @@ def lift_test(hand, hand_pose, joints, vertices, faces, **options) -> LiftResult
     """One lift test of a closed grasp.
 
     Args:
-        hand: path to a hand JSON file (None: the built-in Barrett hand) or a HandModel.
+        hand: path to a hand JSON file (None: the default hand, bayesgrasp.DEFAULT_HAND) or a HandModel.
         hand_pose: (4, 4) world pose of the hand.
         joints: (J,) closed joint angles (rad), e.g. from the grasp simulator.
         vertices, faces: the object mesh in the world frame.

@@ -15,8 +15,8 @@ import pytest
 
 from bayesgrasp import _core, belief, optim, quality, vision
 from bayesgrasp.gp import ExactGP, SparseGP
-from bayesgrasp.models import ModelSettings, build_models
 from bayesgrasp.planners import Reading
+from testkit import TINY, tiny_planner
 
 X = np.random.default_rng(0).uniform(size=(20, 2))
 Y = np.sin(3 * X[:, 0]) + 0.5 * X[:, 1]
@@ -128,21 +128,9 @@ def test_an_unfitted_core_gp_has_no_log_marginal_likelihood(cls):
         cls().log_marginal_likelihood()
 
 
-def _planner():
-    from bayesgrasp.models.grasp_models import GraspModels  # noqa: F401  (the planner's models)
-    from bayesgrasp.planners import make_planner
-
-    models = build_models("cube", settings=TINY, cache_dir=None)
-    return make_planner("stability", models, estimate=(0.0, 0.0, 0.0))
-
-
-TINY = ModelSettings(n_samples=120, n_inducing=20, xy_range=0.03, max_iter=10, seed=5, n_lift_samples=20,
-                     n_calibration=0, n_pilot=20, spread=0.0)
-
-
 @pytest.fixture(scope="module")
 def planner():
-    return _planner()
+    return tiny_planner()
 
 
 def test_a_measurement_far_outside_any_joint_range_warns(planner):

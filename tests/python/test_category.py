@@ -2,26 +2,9 @@
 import numpy as np
 import pytest
 
-from bayesgrasp.hand import Hand
 from bayesgrasp.vision import RegistrationResult
-from bayesgrasp.planners.category import (CategoryPlanner, CategorySettings, TaskGrasp, psi)
-
-
-def rz(yaw, t=(0, 0, 0)):
-    T = np.eye(4)
-    c, s = np.cos(yaw), np.sin(yaw)
-    T[:2, :2] = [[c, -s], [s, c]]
-    T[:3, 3] = t
-    return T
-
-
-HAND = Hand.load("barrett_bh8")
-# a palm-down grasp 30 cm above the model's origin: far from the table, nothing else around
-TOP = Hand.top_grasp_pose(0.0, 0.0, 0.0, 0.3)
-
-
-def grasp(model, pose, eps=0.2, spread=0.5):
-    return TaskGrasp(model=model, task="top", pose=pose, spread=spread, epsilon=eps, lifted=True)
+from bayesgrasp.planners.category import CategoryPlanner, CategorySettings, psi
+from testkit import HAND, TOP, grasp, rz
 
 
 @pytest.mark.parametrize("method", ["laplace", "regularised", "gaussian"])

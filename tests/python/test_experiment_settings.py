@@ -9,7 +9,7 @@ import pytest
 from bayesgrasp.experiments.context import RunContext
 from bayesgrasp.experiments.runner import ResultStore, RunKey, run_experiment, settings_difference
 
-from test_cli import run_cli
+from testkit import run_cli
 
 
 def _square(experiment, obj, run_index, seed):

@@ -3,47 +3,9 @@ angles follow the relative grasp linearly, and one that predicts the same angles
 import numpy as np
 import pytest
 
-from bayesgrasp import _core
-from bayesgrasp.models import ModelTable
 from bayesgrasp.belief.model_mixture import ModelMixtureBelief
 from bayesgrasp.planners.fusion import FusionPlanner, FusionSettings
-
-R = 0.06
-
-
-class TableModels:
-    """The planners' view of GraspModels: n_joints and a ModelTable."""
-
-    def __init__(self, table, k=2):
-        self._table, self.n_joints = table, k
-
-    def table(self):
-        return self._table
-
-
-def analytic(informative: bool):
-    xs = np.linspace(-R, R, 25)
-    yaws = -np.pi + 2 * np.pi * np.arange(36) / 36
-    X, Y, T = np.meshgrid(xs, xs, yaws, indexing="ij")
-    x, y = X.ravel(), Y.ravel()
-    ps = np.exp(-(x ** 2 + y ** 2) / (2 * 0.01 ** 2))                   # stable when centred
-    if informative:
-        mean = np.column_stack([10 * x, 10 * y])
-    else:
-        mean = np.full((len(x), 2), 0.3)
-    var = np.full((len(x), 2), 0.0025)
-    grid = _core.belief.RelativePoseGrid(np.array([-R, -R]), np.array([R, R]), 25, 25, 36,
-                                         np.column_stack([ps, mean, var]), np.array([0.0] + [np.nan] * 4))
-    return TableModels(ModelTable(grid, 2, np.array([[-R, -R], [R, R]]), np.zeros((1, 3))))
-
-
-TRUE = np.array([0.01, -0.005, 0.0])
-
-
-def measurement(grasp):
-    rel = np.asarray(grasp) - TRUE   # yaw 0: the relative grasp is the difference
-    return np.array([10 * rel[0], 10 * rel[1]])
-
+from testkit import TRUE, analytic, measurement
 
 @pytest.mark.parametrize("kind", ["map", "particles"])
 def test_one_touch_moves_the_true_models_pose_towards_the_truth_and_raises_its_weight(kind):

@@ -14,6 +14,7 @@ from bayesgrasp.experiments.context import RunContext
 from bayesgrasp.experiments.episode import EpisodeSettings, execute, run_episode
 from bayesgrasp.experiments.outside_loop import PoseEpisode
 from bayesgrasp.world import World
+from testkit import cli_json
 
 SET = {"n_samples": 300, "n_inducing": 50, "max_iter": 30, "n_lift_samples": 150, "n_calibration": 100, "n_pilot": 40,
        "n_pilot_lifts": 10}
@@ -29,13 +30,6 @@ def cache(tmp_path_factory):
 def ctx_for(cache):
     return RunContext(cache_dir=cache, model_settings=model_settings([f"models.{k}={v}" for k, v in SET.items()],
                                                                      "lift"))
-
-
-def cli_json(capsys, *argv):
-    code = main([str(a) for a in argv])
-    out, err = capsys.readouterr()
-    assert code == 0, err
-    return json.loads(out)
 
 
 def belief_sha(planner):

@@ -13,51 +13,20 @@ from bayesgrasp.experiments.outside_loop_category import VIEW_FILE, CategoryTask
 from bayesgrasp.experiments.tactile_fusion import top_grasp
 from bayesgrasp.hand import Hand
 from bayesgrasp.io.grasp_schema import validate
-from bayesgrasp.models.task_grasps import TaskGraspSettings, generate_task_grasps, grasp_to_json
-from bayesgrasp.models.tasks import task_rule
+from testkit import task_grasp_options, without_set
 from bayesgrasp.world import World
+from testkit import cli_json
 
 SET = {"n_samples": 400, "n_inducing": 60, "max_iter": 40, "n_lift_samples": 200, "n_calibration": 150, "n_pilot": 60,
        "n_pilot_lifts": 15}
 KEEP = ("mug/1", "mug/2")
-EXCLUDE = [f"mug/{i}" for i in range(7) if f"mug/{i}" not in KEEP]
 SCENE, POSE, SEED = "mug/3", [0.01, 0.02, 0.7], 3
 
 
 @pytest.fixture(scope="module")
 def options(tmp_path_factory):
     """The options both sides share: the small models' cache and settings, the task grasps file."""
-    d = tmp_path_factory.mktemp("cat")
-    grasps = []
-    for m in KEEP:
-        grasps += generate_task_grasps(m, task_rule("mug", "top"),
-                                       settings=TaskGraspSettings(candidates=150, spreads=(0.0, float(np.radians(60))),
-                                                                  lift_tests=6, keep=2))
-    f = d / "grasps.json"
-    f.write_text(json.dumps({"grasps": [grasp_to_json(g) for g in grasps]}))
-    out = ["--cache", str(d / "models"), "--task-grasps", str(f), "--exclude", *EXCLUDE, "--seed", str(SEED)]
-    return out + [a for k, v in SET.items() for a in ("--set", f"models.{k}={v}")]
-
-
-def without_set(options):
-    """The options without their --set pairs: the category commands read no model settings (and
-    refuse them; fuse and the pose planners take them)."""
-    out, skip = [], False
-    for a in options:
-        if skip:
-            skip = False
-        elif a == "--set":
-            skip = True
-        else:
-            out.append(a)
-    return out
-
-
-def cli_json(capsys, *argv):
-    code = main([str(a) for a in argv])
-    out, err = capsys.readouterr()
-    assert code == 0, err
-    return json.loads(out)
+    return task_grasp_options(tmp_path_factory.mktemp("cat"), KEEP, SEED, SET)
 
 
 def pose_text():

@@ -8,28 +8,15 @@ import pytest
 import trimesh
 
 from bayesgrasp import physics
-from bayesgrasp.cli import main
 from bayesgrasp.hand import Hand
 from bayesgrasp.io.grasp_schema import validate
 from bayesgrasp.models.task_grasps import TaskGraspSettings, generate_task_grasps, grasp_to_json
 from bayesgrasp.models.tasks import task_rule
 from bayesgrasp.objects import load_object
 from bayesgrasp.sim import GraspSimulator
+from testkit import cli_json, small
 
 JAW = "parallel_jaw.urdf"
-SMALL = {"n_samples": 300, "n_inducing": 50, "max_iter": 30, "n_lift_samples": 150, "n_calibration": 100,
-         "n_pilot": 40, "n_pilot_lifts": 10}
-
-
-def small(cache) -> list:
-    return ["--cache", str(cache)] + [a for k, v in SMALL.items() for a in ("--set", f"models.{k}={v}")]
-
-
-def cli_json(capsys, *argv):
-    code = main([str(a) for a in argv])
-    out, err = capsys.readouterr()
-    assert code == 0, err
-    return json.loads(out)
 
 
 @pytest.fixture(scope="module")
@@ -95,7 +82,7 @@ def test_grasp_command_with_the_jaw(capsys):
 
 
 def test_plan_category_and_view_with_the_jaw(capsys, tmp_path):
-    from test_viewer_results import served_nodes
+    from testkit import served_nodes
 
     from bayesgrasp.viewer import scene_from_result
 

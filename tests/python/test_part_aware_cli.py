@@ -1,7 +1,6 @@
 """The part-aware plan and task term through the CLI (issue 29), with test_viewer_results' small
 models and two training mugs."""
-from test_outside_loop_category import without_set
-from test_viewer_results import cat_options, cli_json  # noqa: F401  (cat_options: the fixture)
+from testkit import cli_json, without_set   # the fixture cat_options: conftest.py
 
 
 def test_the_cli_plans_part_aware_and_fuses_with_the_part_aware_term(capsys, cat_options):

@@ -124,7 +124,7 @@ def test_the_part_aware_plan_returns_a_checked_candidate():
 def test_fusion_part_aware_takes_a_passing_grasp_and_multiplies_eq46():
     """Eq. 4.6 alone takes the task grasp at (0.02, 0.01, 0.3); a part check that passes only
     grasps 5 mm or more to its +x moves the choice there, and the round reports P there."""
-    from test_fusion import analytic
+    from testkit import analytic
 
     from bayesgrasp.belief.model_mixture import ModelMixtureBelief
     from bayesgrasp.planners.fusion import FusionPlanner, FusionSettings

@@ -156,6 +156,15 @@ def test_success_rises_over_attempts_on_a_batch(cube):
     # (cumulative success cannot fall; it has to rise by a margin)
     assert np.mean(by_four) >= np.mean(first) + 0.25
     assert np.mean(by_four) >= 0.75
+    # and the belief's updates are what makes it rise: the same problems open loop (the same four
+    # grasps planned from the prior, no update) succeed less often by the fourth attempt
+    rng = np.random.default_rng(42)
+    open_loop = []
+    for i in range(12):
+        pose = (rng.uniform(-0.08, 0.08), rng.uniform(-0.08, 0.08), rng.uniform(-np.pi, np.pi))
+        r = run_episode("cube", pose, EpisodeSettings(method="open_loop"), NO_LIFT, seed=i, models=cube)
+        open_loop.append(r["success"])
+    assert np.mean(by_four) > np.mean(open_loop)
 
 
 def test_informative_grasp_shrinks_the_pose_error_and_beats_a_random_grasp(cube):
@@ -175,15 +184,24 @@ def test_lift_criterion_loop_stops_at_a_lifted_grasp_and_learns_from_dropped_one
     ctx = RunContext()   # success = lifted, the default
     runs = [run_episode("cube", (0.02 * i, -0.01, 0.5 * i), EpisodeSettings(method="stability"), ctx, seed=i,
                         models=models) for i in range(4)]
+    dropped = 0
     for r in runs:
         for a in r["attempts"]:
             assert a["lifted"] is not None and a["success"] == a["lifted"]
-        for a in r["attempts"][:-1]:          # every attempt before the last was dropped ...
-            assert not a["success"] and "belief_after" in a   # ... and updated the belief
+        for a, nxt in zip(r["attempts"][:-1], r["attempts"][1:]):   # every attempt before the last was dropped ...
+            assert not a["success"]
+            before, after = a["belief_before"], a["belief_after"]
+            # ... and moved the belief (a planner that never updates leaves mean, spread and ESS as
+            # they were), and the next attempt was planned from the moved belief
+            assert not (np.allclose(after["mean"], before["mean"]) and np.allclose(after["std"], before["std"])
+                        and np.isclose(after["ess"], before["ess"]))
+            assert nxt["belief_before"]["mean"] == after["mean"]
+            dropped += 1
         last = r["attempts"][-1]
         assert r["success"] == last["success"]
         assert ("belief_after" in last) == (not last["success"])
     assert any(r["success"] for r in runs)
+    assert dropped > 0   # the check above ran on at least one dropped grasp
 
 
 def test_an_episode_takes_the_planner_settings_and_the_noise_from_the_context_alone(cube):

@@ -14,9 +14,7 @@ from bayesgrasp.planners import touch as T
 from bayesgrasp.planners.category import CategoryPlanner, CategorySettings
 from bayesgrasp.planners.fusion import FusionPlanner
 from bayesgrasp.vision import RegistrationResult
-from test_bad_input import TINY, _planner
-from test_category import HAND, TOP, grasp, rz
-from test_fusion import analytic, measurement
+from testkit import HAND, TINY, TOP, analytic, grasp, measurement, rz, tiny_planner
 
 
 def _round_trip(result) -> dict:
@@ -26,7 +24,7 @@ def _round_trip(result) -> dict:
 
 
 def test_the_pose_planner_has_the_interface():
-    p = _planner()
+    p = tiny_planner()
     assert isinstance(p, GraspPlanner)
     plan = p.plan()
     assert _round_trip(plan)["action"] == plan.action.tolist()

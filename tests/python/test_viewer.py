@@ -12,26 +12,7 @@ pytest.importorskip("viser")
 
 from bayesgrasp.cli import main  # noqa: E402
 from bayesgrasp.viewer import ResultError, read_result, scene_from_result, serve  # noqa: E402
-
-
-def cli_json(capsys, *argv):
-    code = main([str(a) for a in argv])
-    out, err = capsys.readouterr()
-    assert code == 0, err
-    return json.loads(out)
-
-
-def free_port() -> int:
-    with socket.socket() as s:
-        s.bind(("127.0.0.1", 0))
-        return s.getsockname()[1]
-
-
-def port_free(port: int) -> bool:
-    """Nothing listens on the port any more (a connection is refused)."""
-    with socket.socket() as s:
-        s.settimeout(1.0)
-        return s.connect_ex(("127.0.0.1", port)) != 0
+from testkit import cli_json, free_port, port_free  # noqa: E402
 
 
 def nodes(server) -> set:

@@ -4,7 +4,6 @@ transform), fuse (the cloud, the models per round), grasp --lift-trace (the obje
 hand), an episode on disk; `--view` on a command; the demo's per-attempt pictures; the matplotlib
 fallback (small models, two training mugs, a few demonstrated grasps)."""
 import json
-import socket
 
 import numpy as np
 import pytest
@@ -12,63 +11,9 @@ import pytest
 pytest.importorskip("viser")
 
 from bayesgrasp.cli import main  # noqa: E402
-from bayesgrasp.models.task_grasps import TaskGraspSettings, generate_task_grasps, grasp_to_json  # noqa: E402
-from bayesgrasp.models.tasks import task_rule  # noqa: E402
-from bayesgrasp.viewer import read_result, scene_from_result, serve  # noqa: E402
-from bayesgrasp.viewer.serve import stop  # noqa: E402
-from test_outside_loop_category import without_set  # noqa: E402
+from bayesgrasp.viewer import read_result, scene_from_result  # noqa: E402
+from testkit import cli_json, free_port, port_free, served_nodes, small, without_set  # noqa: E402
 
-SET = {"n_samples": 300, "n_inducing": 50, "max_iter": 30, "n_lift_samples": 150, "n_calibration": 100, "n_pilot": 40,
-       "n_pilot_lifts": 10}
-KEEP = ("mug/1", "mug/2")
-EXCLUDE = [f"mug/{i}" for i in range(7) if f"mug/{i}" not in KEEP]
-
-
-def small(cache) -> list:
-    return ["--cache", str(cache)] + [a for k, v in SET.items() for a in ("--set", f"models.{k}={v}")]
-
-
-def cli_json(capsys, *argv):
-    code = main([str(a) for a in argv])
-    out, err = capsys.readouterr()
-    assert code == 0, err
-    return json.loads(out)
-
-
-def free_port() -> int:
-    with socket.socket() as s:
-        s.bind(("127.0.0.1", 0))
-        return s.getsockname()[1]
-
-
-def port_free(port: int) -> bool:
-    with socket.socket() as s:
-        s.settimeout(1.0)
-        return s.connect_ex(("127.0.0.1", port)) != 0
-
-
-def served_nodes(scene) -> dict:
-    """The scene's nodes by name (through viser's scene API), the server stopped after."""
-    port = free_port()
-    server, view = serve(scene, port=port)
-    try:
-        return dict(server.scene._handle_from_node_name), view
-    finally:
-        stop(server)
-        assert port_free(port)
-
-
-@pytest.fixture(scope="module")
-def cat_options(tmp_path_factory):
-    d = tmp_path_factory.mktemp("viewcat")
-    grasps = []
-    for m in KEEP:
-        grasps += generate_task_grasps(m, task_rule("mug", "top"),
-                                       settings=TaskGraspSettings(candidates=150, spreads=(0.0, float(np.radians(60))),
-                                                                  lift_tests=6, keep=2))
-    f = d / "grasps.json"
-    f.write_text(json.dumps({"grasps": [grasp_to_json(g) for g in grasps]}))
-    return small(d / "models") + ["--task-grasps", str(f), "--exclude", *EXCLUDE, "--seed", "3"]
 
 
 def test_plan_shows_each_attempts_particles_and_contacts(capsys, tmp_path):

@@ -18,7 +18,7 @@ from bayesgrasp.models.tasks import task_rule  # noqa: E402
 from bayesgrasp.viewer import ResultError  # noqa: E402
 from bayesgrasp.viewer.runs import list_runs, read_run, scene_from_run  # noqa: E402
 
-from test_viewer_results import free_port, port_free, served_nodes  # noqa: E402
+from testkit import free_port, port_free, served_nodes  # noqa: E402
 
 SMALL = ModelSettings(n_samples=300, n_inducing=50, max_iter=30, n_lift_samples=150, n_calibration=100, n_pilot=40,
                       n_pilot_lifts=10)

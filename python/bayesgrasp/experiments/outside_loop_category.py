@@ -25,6 +25,7 @@ from ..cache import atomic_write
 from ..io.grasp_schema import hand_grasp_record
 from ..models.task_grasps import grasp_from_json, grasp_to_json
 from ..models.tasks import task_rule
+from ..planners.category import THESIS_METHODS
 from ..planners.fusion import FusionSettings
 from .category import Observation, demonstrated, plan_and_execute, see, training_models
 from .context import RunContext
@@ -33,7 +34,7 @@ from .outside_loop import (STATE_FILE, DiskEpisode, EpisodeError, PoseEpisode, o
 from .tactile_fusion import FusionTrial
 
 VIEW_FILE = "view.npz"
-CATEGORY_METHODS = ("laplace", "regularised", "gaussian", "baseline")
+CATEGORY_METHODS = THESIS_METHODS   # the planners that plan once from a view (fusion: its own episode)
 
 
 # ---- the stored view ----------------------------------------------------------------------------

@@ -31,7 +31,7 @@ from scipy import stats
 
 from ..belief import relative_planar_pose, weight_entropy
 from ..models import relative_top_grasps
-from ..planners import PlannerSettings, make_planner
+from ..planners import PLANNERS, PlannerSettings, make_planner
 from ..world import World
 from .context import RunContext
 from .episode import EpisodeSettings, run_episode
@@ -41,7 +41,7 @@ from .registry import Experiment, register
 from .runner import run_seed
 
 FIVE = ("cube", "cylinder", "mug", "mug2", "pitcher")
-METHODS = ("stability", "explore", "ml_pose", "open_loop")
+METHODS = tuple(PLANNERS)   # every pose planner, in the registry's order
 
 
 def true_pose(seed: int) -> np.ndarray:
