@@ -212,7 +212,7 @@ def uncertain_ours(name, mesh, mass, pose, truths, cache, hand):
 def share(k, n):
     from bayesgrasp.experiments.category_stats import wilson
     lo, hi = wilson(k, n)
-    return f"{k}/{n} = {k / n:.2f} [{lo:.2f}, {hi:.2f}]" if n else "-"
+    return f"{k}/{n} = {k / n:.2f} [{max(0.0, lo):.2f}, {min(1.0, hi):.2f}]" if n else "-"
 
 
 def mujoco_verdicts(out):
