@@ -208,6 +208,29 @@ def uncertain_ours(name, mesh, mass, pose, truths, cache, hand):
     return runs
 
 
+def cgn_view_check(doc, out, threads):
+    """Contact-GraspNet once more on each finished object, on make_partial_cloud.py's denser view
+    (640 x 480, 45 deg, from (0.5, 0, 0.5) m: about 4x the points on the object): how much of its
+    result is the view. Top-1 and top-5 executed and judged as in part 1 (out/peers_dense/)."""
+    d = out / "peers_dense"
+    d.mkdir(exist_ok=True)
+    lines = ["| object | library view: top-1 / of top 5 | dense view: top-1 / of top 5 | object points (library / dense) |",
+             "|---|---|---|---|"]
+    for name, o in doc["objects"].items():
+        if "uncertain" not in o:
+            continue
+        mesh, pose = out / "meshes" / f"{name}.stl", o["pose"]
+        r = J.run_peer("cgn", name, pose, d, True, mesh=mesh)
+        world = J.our_world(name, pose, J.OUR_HAND["cgn"], mesh=mesh, mass=o["mass"])
+        rows, _ = J.judge("cgn", name, pose, r, threads=threads, world=world)
+        lib = o["known"]["peers"]["cgn"]["grasps"]
+        pts = [int(np.count_nonzero(np.load(p)[:, 2] > 0.003)) for p in (out / "peers" / f"cloud_{name}.npy",
+                                                                            d / f"cloud_{name}.npy")]
+        cell = lambda rr: f"{_yn(bool(rr) and rr[0]['executed_lifted'])} / {sum(x['executed_lifted'] for x in rr)}"  # noqa: E731
+        lines.append(f"| {name} | {cell(lib)} | {cell(rows)} | {pts[0]} / {pts[1]} |")
+    return lines
+
+
 # ---- the report ---------------------------------------------------------------------------------
 def share(k, n):
     from bayesgrasp.experiments.category_stats import wilson
@@ -359,11 +382,16 @@ def main(argv=None):
     ap.add_argument("--threads", type=int, default=2)
     ap.add_argument("--table", action="store_true", help="only print the tables from --out/protocol.json")
     ap.add_argument("--no-mujoco", action="store_true", help="skip the MuJoCo replay")
+    ap.add_argument("--cgn-view-check", action="store_true",
+                    help="only: Contact-GraspNet again on a denser view of each finished object (cgn_view_check)")
     args = ap.parse_args(argv)
     out = args.out.resolve()
     doc_path = out / "protocol.json"
     if args.table:
         print(tables(json.loads(doc_path.read_text()), out))
+        return
+    if args.cgn_view_check:
+        print("\n".join(cgn_view_check(json.loads(doc_path.read_text()), out, args.threads)))
         return
     names = [n for n in args.objects.split(",") if n]
     unknown = [n for n in names if n not in MASS_G]
