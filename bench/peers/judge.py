@@ -383,11 +383,12 @@ def our_hand_poses(peer, result, z_shift, top_k=TOP_K):
 
 
 def judge(peer, obj, pose, result, threads=0, world=None):
-    """Our lift test of the peer's top grasps: one row per rank. `world` (from :func:`our_world`,
-    with its z_shift) defaults to OBJECTS[obj]'s at `pose`."""
+    """Our lift test of the peer's top grasps: one row per rank (closed at the peer's pose, and
+    as executed: `executed_lifted`), and the hand poses they were executed at. `world` (from
+    :func:`our_world`, with its z_shift) defaults to OBJECTS[obj]'s at `pose`."""
     grasps = result.get("grasps", [])
     if not grasps:
-        return [], None
+        return [], np.zeros((0, 4, 4))
     world, z_shift = world or our_world(obj, pose, OUR_HAND[peer])
     H = our_hand_poses(peer, result, z_shift, top_k=len(grasps))
     spread = PBG_SPREAD if peer == "pybullet_grasper" else None
@@ -406,29 +407,35 @@ def judge(peer, obj, pose, result, threads=0, world=None):
             row["peer_lift_test"] = bool(g.get("lift_test"))
         else:
             row["peer_width"] = g.get("width")
-        if row["collision_at_start"]:
-            row["approach_retry"] = approach_retry(world, H[i], spread)
-        row["executed_lifted"] = row["approach_retry"]["lifted"] if row["collision_at_start"] else row["lifted"]
         rows.append(row)
-    return rows, b
+    lifted, H_exec, retries = _executed(world, H, b, spread)
+    for row, ok, retry in zip(rows, lifted, retries):
+        if retry is not None:
+            row["approach_retry"] = {k: v for k, v in retry.items() if k != "hand_pose"}
+        row["executed_lifted"] = bool(ok)
+    return rows, H_exec
+
+
+def _executed(world, H, b, spread):
+    """The grasps at hand poses H (N, 4, 4, world), closed at them in the batch `b`, executed as a
+    robot would: as closed where the pose is free; where the open hand would start in collision,
+    moved in from RETRY_BACKOFF behind until its first contact (approach_retry). Returns (lifted
+    per grasp, the poses the hand closed at, per grasp its retry or None)."""
+    H_exec = np.array(H, dtype=float)
+    lifted = np.asarray(b.lifted, dtype=bool).copy()
+    retries = [None] * len(H)
+    for i in np.flatnonzero(np.asarray(b.collision_at_start, dtype=bool)):
+        retries[i] = approach_retry(world, H[i], spread, keep_pose=True)
+        lifted[i] = retries[i]["lifted"]
+        if "hand_pose" in retries[i]:
+            H_exec[i] = retries[i]["hand_pose"]
+    return lifted, H_exec, retries
 
 
 def execute(world, H, spread, threads=0):
-    """The grasps at hand poses H (N, 4, 4, world) executed as a robot would: closed where the
-    pose is free; where the open hand would start in collision, moved in from RETRY_BACKOFF
-    behind it until its first contact (approach_retry). Returns (lifted per grasp, the batch of
-    the executed grasps closed again at the poses they closed at, for export; N x 4 x 4 poses)."""
+    """Lifted per grasp for hand poses H (N, 4, 4, world) executed as a robot would (_executed)."""
     b = world.grasp_poses(H, spread=spread, frame="world", lift=True, threads=threads)
-    H_exec = np.array(H, dtype=float)
-    lifted = np.asarray(b.lifted, dtype=bool).copy()
-    for i in np.flatnonzero(np.asarray(b.collision_at_start, dtype=bool)):
-        r = approach_retry(world, H[i], spread, keep_pose=True)
-        lifted[i] = r["lifted"]
-        if "hand_pose" in r:
-            H_exec[i] = r["hand_pose"]
-    if not np.array_equal(H_exec, H):
-        b = world.grasp_poses(H_exec, spread=spread, frame="world", lift=True, threads=threads)
-    return lifted, b, H_exec
+    return _executed(world, H, b, spread)[0]
 
 
 RETRY_BACKOFF = 0.1   # m: pybullet-grasper's own approach (forward_joint's 0.1 m move before closing)

@@ -148,10 +148,10 @@ def known_peers(name, mesh, mass, pose, out, reuse, threads):
         r = J.run_peer(peer, name, pose, out / "peers", reuse, mesh=mesh,
                        make_cloud=lambda path: library_view(mesh, pose, path))
         world = J.our_world(name, pose, J.OUR_HAND[peer], mesh=mesh, mass=mass)
-        rows, _ = J.judge(peer, name, pose, r, threads=threads, world=world)
-        if rows and J.OUR_HAND[peer] == BH8:   # MuJoCo replays the executed grasps
+        rows, H_exec = J.judge(peer, name, pose, r, threads=threads, world=world)
+        if rows and J.OUR_HAND[peer] == BH8:   # MuJoCo replays the executed grasps, closed again at their poses
             spread = J.PBG_SPREAD if peer == "pybullet_grasper" else None
-            _, batch, _ = J.execute(world[0], J.our_hand_poses(peer, r, world[1]), spread, threads)
+            batch = world[0].grasp_poses(H_exec, spread=spread, frame="world", lift=True, threads=threads)
             export(world[0], name, batch, np.arange(len(rows)), peer, str(out / "mujoco"))
         res[peer] = {"seconds": r.get("seconds"), "counts": r.get("counts"), "grasps": rows}
         log(f"  {name} {peer}: {r.get('seconds', 0):.0f} s, top-1 lifted {bool(rows and rows[0]['executed_lifted'])}, "
@@ -192,7 +192,7 @@ def uncertain_peers(name, mesh, mass, truths, out, threads):
             world, z_shift = J.our_world(name, truth, J.OUR_HAND[peer], mesh=mesh, mass=mass)
             H = J.our_hand_poses(peer, r, z_shift, top_k=max(ATTEMPTS))
             spread = J.PBG_SPREAD if peer == "pybullet_grasper" else None
-            rows.append([bool(v) for v in J.execute(world, H, spread, threads)[0]] if len(H) else [])
+            rows.append([bool(v) for v in J.execute(world, H, spread, threads)] if len(H) else [])
         res[peer] = rows
     return res
 

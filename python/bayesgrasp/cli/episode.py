@@ -160,9 +160,8 @@ def _reading(hand, text: str):
     """--joints as our joint vector: a URDF hand's reading is in the URDF's terms."""
     if hand.urdf_joint_map is None:
         return floats(text, len(hand.joint_names), "--joints")
-    names = hand.urdf_joints(np.zeros(hand.num_joints))[0]
     try:
-        return hand.joints_from_urdf(floats(text, len(names), "--joints"))
+        return hand.joints_from_urdf(floats(text, len(hand.urdf_joint_map), "--joints"))
     except ValueError as e:
         raise CliError(f"--joints: {e}") from None
 
