@@ -69,6 +69,10 @@ void bind_shape(py::module_& m) {
 void def_kinematics(py::class_<HandModel>& hand) {
   hand      .def_property_readonly("spread_default", &HandModel::spread_default, "Default spread (rad).")
       .def_property_readonly(
+          "closing", [](const HandModel& h) { return h.closing() == Closing::Linkage ? "linkage" : "breakaway"; },
+          "The closing scheme: 'breakaway' (a stopped phalanx freezes itself and those before it) or 'linkage' "
+          "(a contact stops the whole finger; couplings of either sign).")
+      .def_property_readonly(
           "prismatic_joints",
           [](const HandModel& h) {
             std::vector<bool> out(static_cast<size_t>(h.num_joints()), false);

@@ -11,6 +11,7 @@ from bayesgrasp.hand import HANDS_DIR, Hand, builtin_hands
 from bayesgrasp.hand_urdf import HandFileError, hand_json_from_urdf
 from bayesgrasp.objects import load_object
 from bayesgrasp.sim import GraspSimulator
+from testkit import urdf_fk
 
 
 def _grasp_set(obj, n_top, n_side, seed):
@@ -297,31 +298,7 @@ def test_a_hand_inside_an_arm_urdf_is_read_from_its_root_link(tmp_path):
         Hand.load(_copy_bh8(tmp_path / "x", lambda u: u.replace("</robot>", arm), lambda s: s.update(root="bh_wrist")))
 
 
-def _urdf_fk(urdf: str, values: dict) -> dict:
-    """Every link's pose in the URDF's root frame with the joints at ``values`` (name -> rad or m):
-    the URDF's own chain (origin, then the joint's motion about or along its axis), read with
-    yourdfpy; independent of our conversion."""
-    import yourdfpy
-    from scipy.spatial.transform import Rotation
-
-    robot = yourdfpy.URDF.load(urdf, build_scene_graph=False, load_meshes=False).robot
-    parent = {j.child: j for j in robot.joints}
-
-    def pose(link):
-        if link not in parent:
-            return np.eye(4)
-        j = parent[link]
-        T = pose(j.parent) @ (np.eye(4) if j.origin is None else np.asarray(j.origin, float))
-        M = np.eye(4)
-        if j.type in ("revolute", "continuous"):
-            M[:3, :3] = Rotation.from_rotvec(np.asarray(j.axis, float) * values.get(j.name, 0.0)).as_matrix()
-        elif j.type == "prismatic":
-            M[:3, 3] = np.asarray(j.axis, float) * values.get(j.name, 0.0)
-        return T @ M
-    return {l.name: pose(l.name) for l in robot.links}
-
-
-@pytest.mark.parametrize("name", ["barrett_bh8.urdf", "robotiq_3f.urdf", "parallel_jaw.urdf"])
+@pytest.mark.parametrize("name", ["barrett_bh8.urdf", "robotiq_3f.urdf", "parallel_jaw.urdf", "robotiq_2f85.urdf"])
 def test_the_joint_values_out_drive_the_urdf_to_the_simulator_s_fingertips(name):
     """Our joint vector in the URDF's own terms (Hand.urdf_joints): every moving URDF joint,
     mimic joints included, put into the URDF's own kinematic chain, brings each finger's tip (the
@@ -336,7 +313,7 @@ def test_the_joint_values_out_drive_the_urdf_to_the_simulator_s_fingertips(name)
     for q in [hand.open_joints()] + closed:
         names, values = hand.urdf_joints(q)
         assert len(names) == len(set(names)) and len(names) >= hand.num_joints - 1
-        links = _urdf_fk(str(urdf), dict(zip(names, values)))
+        links = urdf_fk(str(urdf), dict(zip(names, values)))
         palm = side["palm"]
         from scipy.spatial.transform import Rotation
 
@@ -419,7 +396,7 @@ def test_a_mimic_of_an_equivalent_joint_is_the_same_coupling(tmp_path):
         Hand.load(other)
 
 
-@pytest.mark.parametrize("name", ["barrett_bh8.urdf", "robotiq_3f.urdf", "parallel_jaw.urdf"])
+@pytest.mark.parametrize("name", ["barrett_bh8.urdf", "robotiq_3f.urdf", "parallel_jaw.urdf", "robotiq_2f85.urdf"])
 def test_a_reading_in_the_urdf_s_terms_comes_back_as_our_joints(name):
     """Hand.joints_from_urdf inverts urdf_joints (open and closed hands); URDF joints that read one
     joint of ours and disagree, a wrong count, or a hand file are refused with what was expected."""

@@ -162,3 +162,27 @@ def tiny_planner():
 
 TINY = ModelSettings(n_samples=120, n_inducing=20, xy_range=0.03, max_iter=10, seed=5, n_lift_samples=20,
                      n_calibration=0, n_pilot=20, spread=0.0)
+
+
+def urdf_fk(urdf: str, values: dict) -> dict:
+    """Every link's pose in the URDF's root frame with the joints at ``values`` (name -> rad or m):
+    the URDF's own chain (origin, then the joint's motion about or along its axis), read with
+    yourdfpy; independent of our conversion."""
+    import yourdfpy
+    from scipy.spatial.transform import Rotation
+
+    robot = yourdfpy.URDF.load(urdf, build_scene_graph=False, load_meshes=False).robot
+    parent = {j.child: j for j in robot.joints}
+
+    def pose(link):
+        if link not in parent:
+            return np.eye(4)
+        j = parent[link]
+        T = pose(j.parent) @ (np.eye(4) if j.origin is None else np.asarray(j.origin, float))
+        M = np.eye(4)
+        if j.type in ("revolute", "continuous"):
+            M[:3, :3] = Rotation.from_rotvec(np.asarray(j.axis, float) * values.get(j.name, 0.0)).as_matrix()
+        elif j.type == "prismatic":
+            M[:3, 3] = np.asarray(j.axis, float) * values.get(j.name, 0.0)
+        return T @ M
+    return {l.name: pose(l.name) for l in robot.links}

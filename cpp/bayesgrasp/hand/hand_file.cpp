@@ -181,12 +181,26 @@ Phalanx parse_phalanx(const json& j, size_t p, const std::string& where) {
   phalanx.upper = number(j, m ? "upper_m" : "upper_deg", where) * unit;
   if (phalanx.lower > phalanx.upper) fail(where, m ? "lower_m > upper_m" : "lower_deg > upper_deg");
   phalanx.offset = number(j, m ? "offset_m" : "offset_deg", where) * unit;
-  phalanx.ratio = number(j, "ratio", where);
-  if (phalanx.ratio < 0) fail(where, "ratio must be >= 0");
+  phalanx.ratio = number(j, "ratio", where);  // its sign is checked against the closing scheme
   phalanx.torque = number(j, effort, where);
   if (!(phalanx.torque >= 0) || !std::isfinite(phalanx.torque)) fail(where, std::string(effort) + " must be >= 0 and finite");
   phalanx.shapes = shapes(j, where);
   return phalanx;
+}
+
+/// The couplings' signs against the closing scheme: breakaway needs every ratio >= 0; a linkage
+/// a first ratio > 0 (the driver closes the finger) and any finite ratio after it.
+void check_ratios(const Finger& finger, Closing closing, const std::string& where) {
+  for (size_t p = 0; p < finger.phalanges.size(); ++p) {
+    const double r = finger.phalanges[p].ratio;
+    const std::string w = where + ".phalanges[" + std::to_string(p) + "]";
+    if (!std::isfinite(r)) fail(w, "ratio must be finite");
+    if (closing == Closing::Breakaway && r < 0)
+      fail(w, "ratio must be >= 0 with closing 'breakaway' (a phalanx turning against its driver, e.g. a pad "
+              "kept parallel, needs \"closing\": \"linkage\")");
+    if (closing == Closing::Linkage && p == 0 && !(r > 0))
+      fail(w, "ratio must be > 0 for a finger's first phalanx (its driver) with closing 'linkage'");
+  }
 }
 
 /// Indices into q of the joints the "fingers read" measurement uses, from their link names
@@ -221,7 +235,12 @@ HandModel HandModel::from_json(const std::string& json_text) {
   HandModel h;
   // name, geometry and actuation are required; description and frame are documentation
   exactly(root, {"name", "actuation", "palm", "spread", "fingers", "measured_joints"}, "top level",
-          {"description", "frame"});
+          {"description", "frame", "closing"});
+  if (root.contains("closing")) {
+    const std::string c = text(root, "closing", "top level");
+    if (c == "linkage") h.closing_ = Closing::Linkage;
+    else if (c != "breakaway") fail("closing", "must be 'breakaway' or 'linkage', got '" + c + "'");
+  }
   h.name_ = text(root, "name", "top level");
   if (!root.at("actuation").is_object()) fail("actuation", "must be an object (the strength's figures and sources)");
 
@@ -283,6 +302,7 @@ HandModel HandModel::from_json(const std::string& json_text) {
     for (const Phalanx& p : finger.phalanges)
       if (p.prismatic && finger.phalanges.size() != 1)
         fail(w, "a prismatic phalanx must be its finger's only phalanx (a jaw)");
+    check_ratios(finger, h.closing_, w);
     h.fingers_.push_back(finger);
   }
   h.num_joints_ = joint;

@@ -36,7 +36,7 @@ double Shape::plane_distance(const Vec3& p) const {
 double Finger::t_max() const {
   double t = 0.0;
   for (const Phalanx& p : phalanges)
-    if (p.ratio > 0) t = std::max(t, (p.upper - p.offset) / p.ratio);
+    if (p.ratio != 0) t = std::max(t, (p.closing_limit() - p.offset) / p.ratio);
   return t;
 }
 

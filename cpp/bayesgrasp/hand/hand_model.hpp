@@ -19,10 +19,16 @@
 // phalanx angles are relative to the previous phalanx (or to the palm plane for phalanx 0).
 //
 // Closing. Each finger has one actuator parameter t >= 0; while free, phalanx j follows
-// q_j(t) = offset_j + ratio_j * t, clamped to [lower_j, upper_j]. Breakaway: when phalanx k is
-// stopped by a contact, phalanges 0..k freeze, and phalanges after k keep closing; a phalanx
-// that reaches its upper limit stops alone. The finger is done when every phalanx is frozen
-// or at its limit.
+// q_j(t) = offset_j + ratio_j * t, clamped to [lower_j, upper_j]. Two schemes (the hand file's
+// "closing"):
+//  * breakaway (the BH8's TorqueSwitch; every ratio >= 0): when phalanx k is stopped by a contact,
+//    phalanges 0..k freeze, and phalanges after k keep closing; a phalanx that reaches its upper
+//    limit stops alone.
+//  * linkage (a four-bar or a mimic chain, e.g. a 2F-85's pads kept parallel): the first ratio
+//    > 0, the others of any sign (a negative ratio turns the phalanx back as the finger closes:
+//    -1 keeps it at a constant absolute angle); a contact on any phalanx stops the whole finger.
+// A phalanx that reaches the limit it moves towards (upper for ratio > 0, lower for ratio < 0)
+// stops alone. The finger is done when every phalanx is frozen or at that limit.
 //
 // Parallel jaws. A finger whose only phalanx is prismatic translates along -d_f (inwards) by
 // q metres instead of turning (Phalanx::prismatic).
@@ -61,6 +67,8 @@ struct Phalanx {
   double length = 0.0;  // joint to next joint / fingertip (m)
   double lower = 0.0, upper = 0.0;  // joint limits (rad; m for a prismatic joint)
   double offset = 0.0, ratio = 1.0; // coupling: q(t) = offset + ratio * t
+  /// The limit the coupling moves this joint towards (upper for ratio > 0, lower for ratio < 0).
+  double closing_limit() const { return ratio < 0 ? lower : upper; }
   double torque = 0.0;  // N m (N for a prismatic joint): the finger motor's limit at this joint while it drives it
   // A prismatic phalanx (a parallel jaw, its finger's only phalanx): its link points along the
   // approach (the revolute frame at Theta = 90 deg: x = +z_hand, local +z = d_f outwards, the
@@ -84,6 +92,8 @@ struct Finger {
   /// Actuator parameter at which every phalanx has reached its upper limit.
   double t_max() const;
 };
+
+enum class Closing { Breakaway, Linkage };
 
 struct Link {
   std::string name;
@@ -110,6 +120,7 @@ class HandModel {
   double spread_lower() const { return spread_lower_; }
   double spread_upper() const { return spread_upper_; }
   double spread_default() const { return spread_default_; }
+  Closing closing() const { return closing_; }
   /// Indices into q of the joints the "fingers read" measurement uses (the file's measured_joints).
   const std::vector<int>& measured_joints() const { return measured_joints_; }
 
@@ -163,6 +174,7 @@ class HandModel {
   std::vector<Link> links_;
   int num_joints_ = 1;
   std::vector<int> measured_joints_;
+  Closing closing_ = Closing::Breakaway;
   double spread_lower_ = 0.0, spread_upper_ = 0.0, spread_default_ = 0.0;
 };
 

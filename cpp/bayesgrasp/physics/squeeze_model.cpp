@@ -23,7 +23,8 @@ SqueezeModel::SqueezeModel(const HandModel& hand, const Eigen::VectorXd& joints,
       cmd_(static_cast<size_t>(hand.num_joints())) {
   // The breakaway state of the closed grasp: phalanx a has broken away when it is at its limit
   // or a later phalanx is past the closing law at a's actuator value t_a = (q_a - offset_a) / ratio_a.
-  for (size_t f = 0; f < hand.fingers().size(); ++f) {
+  // A linkage has no breakaway: its driver (phalanx 0) stays driven.
+  for (size_t f = 0; f < hand.fingers().size() && hand.closing() == Closing::Breakaway; ++f) {
     const Finger& fi = hand.fingers()[f];
     const int n = static_cast<int>(fi.phalanges.size());
     int a = 0;
@@ -54,7 +55,7 @@ bool SqueezeModel::at_upper(int finger, int phalanx, const Eigen::VectorXd& q) c
 bool SqueezeModel::update(const Eigen::VectorXd& q, const Eigen::VectorXd& qdot, const std::vector<char>& link_touches) {
   for (Eigen::Index j = 0; j < q.size(); ++j) reached_[j] = std::max(reached_[j], q[j]);
   bool changed = false;
-  for (size_t f = 0; f < hand_.fingers().size(); ++f) {
+  for (size_t f = 0; f < hand_.fingers().size() && hand_.closing() == Closing::Breakaway; ++f) {
     const Finger& fi = hand_.fingers()[f];
     const int a = driven_[f];
     if (a + 1 >= static_cast<int>(fi.phalanges.size())) continue;  // the last phalanx stays driven

@@ -55,8 +55,11 @@ class FingerCloser {
  private:
   LinkDistance& known(int j) { return known_[F_.phalanges[j].link]; }
   void update_poses() { s_.hand.phalanx_poses(H_, f_, spread_, angles_, T_); }
+  /// A contact on phalanx j: breakaway freezes 0..j (the later ones keep closing); a linkage
+  /// stops the whole finger.
   void freeze_through(int j) {
-    for (int i = 0; i <= j; ++i) frozen_[i] = true;
+    const int last = s_.hand.closing() == Closing::Linkage ? n_ - 1 : j;
+    for (int i = 0; i <= last; ++i) frozen_[i] = true;
   }
 
   /// Culling: a finger whose whole reach (a sphere about its first phalanx joint) misses the
@@ -155,7 +158,7 @@ class FingerCloser {
     for (int i = first_; i < n_; ++i)
       if (moving_[i]) {
         const Phalanx& P = F_.phalanges[i];
-        dt = std::min(dt, (P.upper - P.offset) / P.ratio - t_);
+        dt = std::min(dt, (P.closing_limit() - P.offset) / P.ratio - t_);
       }
     dt = resolve_deferred(
         deferred, n_deferred, dt, [&](int k, double d) { return (d - 0.5 * tol_) / speed_[deferred_phalanx[k]]; },
@@ -172,8 +175,10 @@ class FingerCloser {
     for (int i = first_; i < n_; ++i)
       if (moving_[i]) {
         const Phalanx& P = F_.phalanges[i];
-        angles_[i] = P.offset + P.ratio * t >= P.upper - 1e-12 ? P.upper
-                                                                : std::clamp(P.offset + P.ratio * t, P.lower, P.upper);
+        const double q = P.offset + P.ratio * t;  // snapped onto the limit it heads for when within 1e-12
+        angles_[i] = P.ratio > 0 && q >= P.upper - 1e-12   ? P.upper
+                     : P.ratio < 0 && q <= P.lower + 1e-12 ? P.lower
+                                                           : std::clamp(q, P.lower, P.upper);
       }
     update_poses();
   }

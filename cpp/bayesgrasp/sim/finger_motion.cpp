@@ -1,6 +1,7 @@
 #include "bayesgrasp/sim/finger_motion.hpp"
 
 #include <algorithm>
+#include <cmath>
 #include <stdexcept>
 #include <string>
 
@@ -35,7 +36,8 @@ int moving_phalanges(const Finger& F, const bool* frozen, const double* angles, 
   int first = n;
   for (int i = 0; i < n; ++i) {
     const Phalanx& P = F.phalanges[i];
-    moving[i] = !frozen[i] && P.ratio > 0 && angles[i] < P.upper;
+    // moving towards the limit its coupling heads for (upper, or lower for a negative ratio)
+    moving[i] = !frozen[i] && (P.ratio > 0 ? angles[i] < P.upper : P.ratio < 0 && angles[i] > P.lower);
     if (moving[i] && first == n) first = i;
   }
   return first;
@@ -44,7 +46,7 @@ int moving_phalanges(const Finger& F, const bool* frozen, const double* angles, 
 double link_speed(const Finger& F, const FingerMotion& motion, const bool* moving, int first, int j) {
   double v = 0.0;
   for (int i = first; i <= j; ++i)
-    if (moving[i]) v += F.phalanges[i].ratio * motion.arm[i][j];
+    if (moving[i]) v += std::abs(F.phalanges[i].ratio) * motion.arm[i][j];  // a bound: |ratio| for either sign
   return v;
 }
 

@@ -16,7 +16,12 @@ What the conversion needs of the URDF (each is checked and refused in one line n
   gripper's second jaw) is dropped: each finger closes on its own;
 * a finger's spread joint (if any) is a revolute joint about the approach axis between the palm
   and the finger's first phalanx joint: the sidecar's spread joint or a mimic of it;
-* every other link hangs from the palm or a phalanx by fixed joints (it joins that body);
+* every other link hangs from the palm or a phalanx by fixed joints (it joins that body), or
+  from one of the sidecar's ``passive_joints`` (a four-bar's other bar, a <mimic> of a finger's
+  first joint): those links' collision geometry is left out;
+* the closing scheme: ``breakaway`` (the BH8) needs every coupling's multiplier >= 0;
+  ``linkage`` takes any sign (a 2F-85's pad joint, multiplier -1, stays parallel) and a contact
+  stops the whole finger;
 * the tree has no loop (a link that is the child of two joints).
 
 Collision shapes: boxes (axis-aligned with the link after the conversion, else their 8 corners
@@ -260,10 +265,10 @@ class _Converter:
                 ratio, offset = 1.0, lo
             elif (coupling := self._coupling(j, driver)) is not None:
                 m, o = coupling
-                if m < 0:
+                if m < 0 and self.side["closing"] != "linkage":
                     self._fail(f"{w}.phalanges[{k}]: joint '{j.name}' turns against '{driver.name}' (mimic multiplier "
-                               f"{m:g}): a linkage that keeps a pad parallel; a closing scheme with negative "
-                               "couplings is not supported yet (each phalanx must close with its finger's driver)")
+                               f"{m:g}), which closing '{self.side['closing']}' cannot do; a linkage that keeps a "
+                               "pad parallel is \"closing\": \"linkage\" in the sidecar")
                 ratio, offset = m, phi + m * lower0 + o
             else:
                 self._fail(f"{w}.phalanges[{k}]: joint '{j.name}' is neither the finger's first joint nor a mimic "
@@ -349,8 +354,37 @@ class _Converter:
         for f in fingers:
             for name, index, scale, offset in f["urdf_map"]:
                 entries.setdefault(name, (index, scale, offset))
+        for name, (f, m, o) in self._passive(fingers).items():
+            # URDF passive = m * URDF driver + o, URDF driver = scale * ours + offset (the driver's map)
+            _, index, scale, offset = next(e for e in f["urdf_map"] if e[0] == f["joints"][0].name)
+            entries.setdefault(name, (index, m * scale, m * offset + o))
         return [{"name": j.name, "index": entries[j.name][0], "scale": entries[j.name][1], "offset": entries[j.name][2]}
                 for j in self.tree.joints.values() if j.name in entries]
+
+    def _passive(self, fingers: list) -> dict:
+        """The sidecar's passive joints: name -> (the finger whose first joint drives it, m, o) with
+        URDF value = m * that joint's + o. Of the fingers whose first joint it follows (by the URDF's
+        mimics, one gripper's fingers are all equivalent), the one whose first joint is nearest (a
+        four-bar's bars sit on one side); a passive joint no finger's first joint drives is refused."""
+        out = {}
+        for k, name in enumerate(self.side.get("passive_joints", [])):
+            j = self.tree.joint(name, f"passive_joints[{k}]")
+            if j.type == "fixed":
+                self._fail(f"passive_joints[{k}]: joint '{name}' is fixed (only moving joints are passive)")
+            for f in fingers:
+                if j in f["joints"]:
+                    self._fail(f"passive_joints[{k}]: joint '{name}' closes {f['spec']['name']}/"
+                               f"{f['phalanges'][f['joints'].index(j)]['name']} (a phalanx is not passive)")
+            at = self.tree.zero_pose(j.child)[:3, 3]
+            near = sorted(((np.linalg.norm(self.tree.zero_pose(f["joints"][0].child)[:3, 3] - at), i, f, c)
+                           for i, f in enumerate(fingers) if (c := self._coupling(j, f["joints"][0])) is not None),
+                          key=lambda e: e[:2])
+            if near:
+                out[name] = (near[0][2], *near[0][3])
+            else:
+                self._fail(f"passive_joints[{k}]: joint '{name}' is not a <mimic> of any finger's first joint "
+                           f"({', '.join(f['joints'][0].name for f in fingers)})")
+        return out
 
     # -- which URDF links make each of our links --
     def _bodies(self, fingers: list) -> dict:
@@ -370,7 +404,10 @@ class _Converter:
             for p, j, frame in zip(f["phalanges"], f["joints"], f["frames"]):
                 by_joint[j.name] = f"{fname}/{p['name']}"
                 ours[f"{fname}/{p['name']}"] = (frame, [])
+        passive = set(self._passive(fingers))
         for name, j in owner.items():
+            if j in passive:
+                continue   # a linkage's other bar: its geometry is left out
             if j not in by_joint:
                 self._fail(f"joint '{j}' moves link '{name}', but the sidecar names it nowhere "
                            "(neither the spread nor a finger's phalanx)")
@@ -433,4 +470,5 @@ class _Converter:
                 "actuation": self.side["actuation"], "frame": "converted from a URDF: origin at the centre of the palm "
                 "face (the sidecar's palm frame); +z is the approach direction",
                 "palm": {"shapes": self._link_shapes(*bodies["palm"])}, "spread": spread,
-                "fingers": out_fingers, "measured_joints": measured}
+                "fingers": out_fingers, "measured_joints": measured} | (
+                    {"closing": "linkage"} if self.side["closing"] == "linkage" else {})   # breakaway: the default
