@@ -69,9 +69,12 @@ void bind_shape(py::module_& m) {
 void def_kinematics(py::class_<HandModel>& hand) {
   hand      .def_property_readonly("spread_default", &HandModel::spread_default, "Default spread (rad).")
       .def_property_readonly(
-          "closing", [](const HandModel& h) { return h.closing() == Closing::Linkage ? "linkage" : "breakaway"; },
-          "The closing scheme: 'breakaway' (a stopped phalanx freezes itself and those before it) or 'linkage' "
-          "(a contact stops the whole finger; couplings of either sign).")
+          "closing",
+          [](const HandModel& h) {
+            return h.closing() == Closing::Linkage ? "linkage" : h.closing() == Closing::Independent ? "independent" : "breakaway";
+          },
+          "The closing scheme: 'breakaway' (a stopped phalanx freezes itself and those before it), 'linkage' "
+          "(a contact stops the whole finger; couplings of either sign) or 'independent' (one motor per joint).")
       .def_property_readonly(
           "prismatic_joints",
           [](const HandModel& h) {

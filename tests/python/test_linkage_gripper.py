@@ -141,5 +141,5 @@ def test_refusals_name_what_the_linkage_needs(tmp_path):
     with pytest.raises(ValueError, match=r"fingers\[0\]\.phalanges\[1\]: ratio must be >= 0 with closing 'breakaway'"):
         Hand.from_json(json.dumps(doc))
     doc["closing"] = "sideways"
-    with pytest.raises(ValueError, match=r"closing: must be 'breakaway' or 'linkage'"):
+    with pytest.raises(ValueError, match=r"closing: must be 'breakaway', 'linkage' or 'independent'"):
         Hand.from_json(json.dumps(doc))

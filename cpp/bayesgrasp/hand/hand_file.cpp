@@ -29,7 +29,8 @@ const json& need(const json& j, const char* key, const std::string& where) {
 }
 
 /// A strict object: every key one of `known`, none missing from `known` (every key is required:
-/// nothing takes a default), except the documentation keys `docs`, which may be absent.
+/// nothing takes a default), except the keys `docs`, which may be absent: documentation, and the
+/// few with a stated default (the top level's closing, a finger's roll_deg).
 void exactly(const json& j, std::initializer_list<const char*> known, const std::string& where,
              std::initializer_list<const char*> docs = {}) {
   if (!j.is_object()) fail(where, "must be an object");
@@ -200,6 +201,8 @@ void check_ratios(const Finger& finger, Closing closing, const std::string& wher
               "kept parallel, needs \"closing\": \"linkage\")");
     if (closing == Closing::Linkage && p == 0 && !(r > 0))
       fail(w, "ratio must be > 0 for a finger's first phalanx (its driver) with closing 'linkage'");
+    if (closing == Closing::Independent && !(r > 0))
+      fail(w, "ratio must be > 0 with closing 'independent' (every joint closes, at its ratio's speed)");
   }
 }
 
@@ -239,7 +242,8 @@ HandModel HandModel::from_json(const std::string& json_text) {
   if (root.contains("closing")) {
     const std::string c = text(root, "closing", "top level");
     if (c == "linkage") h.closing_ = Closing::Linkage;
-    else if (c != "breakaway") fail("closing", "must be 'breakaway' or 'linkage', got '" + c + "'");
+    else if (c == "independent") h.closing_ = Closing::Independent;
+    else if (c != "breakaway") fail("closing", "must be 'breakaway', 'linkage' or 'independent', got '" + c + "'");
   }
   h.name_ = text(root, "name", "top level");
   if (!root.at("actuation").is_object()) fail("actuation", "must be an object (the strength's figures and sources)");
@@ -263,12 +267,16 @@ HandModel HandModel::from_json(const std::string& json_text) {
   for (size_t f = 0; f < fingers.size(); ++f) {
     const std::string w = "fingers[" + std::to_string(f) + "]";
     const json& jf = fingers[f];
-    exactly(jf, {"name", "base", "base_yaw_deg", "spread_sign", "knuckle", "phalanges"}, w);
+    exactly(jf, {"name", "base", "base_yaw_deg", "spread_sign", "knuckle", "phalanges"}, w, {"roll_deg"});
     Finger finger;
     finger.name = text(jf, "name", w);
     finger.base = vec3(jf, "base", w);
     finger.base_yaw = number(jf, "base_yaw_deg", w) * kDeg;
     finger.spread_sign = number(jf, "spread_sign", w);
+    if (jf.contains("roll_deg")) {
+      finger.roll = number(jf, "roll_deg", w) * kDeg;
+      if (std::abs(finger.roll) >= M_PI / 2) fail(w, "roll_deg must lie in (-90, 90)");
+    }
     {
       const json& k = jf.at("knuckle");
       exactly(k, {"length", "shapes"}, w + ".knuckle");
@@ -303,6 +311,7 @@ HandModel HandModel::from_json(const std::string& json_text) {
       if (p.prismatic && finger.phalanges.size() != 1)
         fail(w, "a prismatic phalanx must be its finger's only phalanx (a jaw)");
     check_ratios(finger, h.closing_, w);
+    if (finger.roll != 0.0 && finger.phalanges.front().prismatic) fail(w, "a jaw has no roll_deg");
     h.fingers_.push_back(finger);
   }
   h.num_joints_ = joint;

@@ -14,9 +14,15 @@ namespace {
 
 /// A link's rotation: its x along the finger direction d turned by theta towards +z (the palm
 /// normal), its y along d x z.
-Eigen::Matrix3d link_rotation(const Vec3& d, double theta) {
-  const Vec3 z = Vec3::UnitZ();
-  const Vec3 a = d.cross(z);
+/// Link frame at cumulative angle theta in the plane of outward direction d (unit, in the palm
+/// plane) turned by roll about d: x = cos(theta) d + sin(theta) z', y = a (the joint axis),
+/// z = x X y, with a = cos(roll) (d x z) - sin(roll) z and z' = Rot(d, roll) z = cos(roll) z +
+/// sin(roll) (d x z).
+Eigen::Matrix3d link_rotation(const Vec3& d, double theta, double roll = 0.0) {
+  const Vec3 zh = Vec3::UnitZ(), a0 = d.cross(zh);
+  const double c = std::cos(roll), s = std::sin(roll);
+  const Vec3 z = c * zh + s * a0;
+  const Vec3 a = c * a0 - s * zh;
   const Vec3 x = std::cos(theta) * d + std::sin(theta) * z;
   Eigen::Matrix3d R;
   R.col(0) = x;
@@ -104,7 +110,7 @@ void HandModel::phalanx_poses(const Iso3& hand_pose, int f, double spread, const
       continue;
     }
     theta += angles[p];
-    local.linear() = link_rotation(d, theta);
+    local.linear() = link_rotation(d, theta, finger.roll);
     local.translation() = joint;
     out[p] = hand_pose * local;
     joint += finger.phalanges[p].length * local.linear().col(0);
@@ -118,7 +124,7 @@ std::vector<Iso3> HandModel::link_poses(const Iso3& hand_pose, const Eigen::Vect
     const Finger& finger = fingers_[f];
     if (finger.knuckle_link >= 0) {
       Iso3 local = Iso3::Identity();
-      local.linear() = link_rotation(finger_direction(static_cast<int>(f), q[0]), 0.0);
+      local.linear() = link_rotation(finger_direction(static_cast<int>(f), q[0]), 0.0, finger.roll);
       local.translation() = finger.base;
       poses[finger.knuckle_link] = hand_pose * local;
     }

@@ -8,7 +8,10 @@
 // where s is the spread joint. Its first phalanx joint sits at b_f + knuckle_length * d_f.
 // Every phalanx joint axis is a_f = d_f x z, so a cumulative phalanx angle Theta turns the
 // link direction from d_f (Theta = 0, flat in the palm plane, pointing outwards) towards +z
-// (Theta = 90 deg) and then inwards.
+// (Theta = 90 deg) and then inwards. A finger with a roll psi_f (a thumb whose flexion axis is
+// not in the palm plane) has its whole plane turned about d_f by psi_f: axis
+// Rot(d_f, psi_f) a_f = cos(psi_f) a_f - sin(psi_f) z, and Theta = 90 deg points along
+// Rot(d_f, psi_f) z.
 //
 // Link frames. Link 0 is the palm (frame = hand frame). Then, per finger, its knuckle (frame:
 // origin at b_f, x = d_f, y = a_f, z = x X y = -z_hand) and its phalanges (frame: origin at the
@@ -27,6 +30,10 @@
 //  * linkage (a four-bar or a mimic chain, e.g. a 2F-85's pads kept parallel): the first ratio
 //    > 0, the others of any sign (a negative ratio turns the phalanx back as the finger closes:
 //    -1 keeps it at a constant absolute angle); a contact on any phalanx stops the whole finger.
+//  * independent (a dexterous hand, one motor per joint; every ratio > 0, the closing
+//    controller's relative joint speeds): closes as breakaway does (a contact on phalanx k stops
+//    the joints that would push k into it, 0..k), and in the lift test every joint presses with
+//    its own motor's torque (no coupling, no worm lock).
 // A phalanx that reaches the limit it moves towards (upper for ratio > 0, lower for ratio < 0)
 // stops alone. The finger is done when every phalanx is frozen or at that limit.
 //
@@ -83,6 +90,7 @@ struct Finger {
   std::string name;
   Vec3 base = Vec3::Zero();  // spread axis (hand frame)
   double base_yaw = 0.0;     // outward direction at spread 0 (rad, about +z)
+  double roll = 0.0;         // the finger plane's turn about its outward direction (rad; 0: axes in the palm plane)
   double spread_sign = 0.0;  // d(yaw)/d(spread): +1, -1, or 0 for a fixed finger
   double knuckle_length = 0.0;
   std::vector<Shape> knuckle_shapes;
@@ -93,7 +101,7 @@ struct Finger {
   double t_max() const;
 };
 
-enum class Closing { Breakaway, Linkage };
+enum class Closing { Breakaway, Linkage, Independent };
 
 struct Link {
   std::string name;

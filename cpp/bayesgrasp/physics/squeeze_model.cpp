@@ -84,6 +84,14 @@ void SqueezeModel::set_commands() {
       c = JointCommand{};
       c.upper = ph.upper;
       const double lever = ph.prismatic ? kJawLever : 1.0;  // a jaw's metres per radian
+      if (hand_.closing() == Closing::Independent) {
+        // One motor per joint: each presses with its own torque; backdrivable (no worm lock).
+        c.driven = true;
+        c.velocity = lever * speed_;
+        c.max_torque = torque_ > 0 ? torque_ / lever : ph.torque;
+        c.lower = ph.lower;
+        continue;
+      }
       // The worm: never opens by more than its backlash below the largest angle reached.
       c.lower = std::max(ph.lower, std::min(reached_[k], ph.upper) - lever * backlash_);
       if (j < a) {

@@ -1,5 +1,9 @@
 // The squeeze of the lift test as the Barrett BH8 drives it: the per-step motor law of every
 // finger, free of Bullet (hand_bodies applies it to the hinges, lift_script calls it).
+// Other closing schemes (HandModel::closing): a linkage keeps its first phalanx driven and the
+// others coupled by (S1) (a negative ratio turns a pad back), with no breakaway; a hand with one
+// motor per joint (independent) drives every joint with its own torque, nothing coupled, no
+// worm lock. What follows is the BH8's breakaway scheme.
 //
 // One motor per finger. It drives one phalanx at a time, the finger's *driven* phalanx a
 // (initially 0, the proximal): a velocity servo towards `closing_speed` with at most the

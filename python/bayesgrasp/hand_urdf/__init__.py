@@ -10,7 +10,8 @@ format of ``barrett_bh8.json``), so a URDF hand runs through the same C++ model 
 What the conversion needs of the URDF (each is checked and refused in one line naming it):
 
 * every finger is a planar chain: its phalanx joints are revolute with parallel axes lying in
-  the palm plane; a positive angle closes the finger (turns it towards the approach axis); or
+  the palm plane, or (a thumb) in a plane rolled about the finger's outward direction; a
+  positive angle closes the finger (turns it towards the approach axis); or
   it is a jaw: one prismatic joint in the palm plane that opens with a positive value (the
   convention of two-finger grippers' URDFs); a mimic between two fingers' first joints (a
   gripper's second jaw) is dropped: each finger closes on its own;
@@ -21,7 +22,9 @@ What the conversion needs of the URDF (each is checked and refused in one line n
   first joint): those links' collision geometry is left out;
 * the closing scheme: ``breakaway`` (the BH8) needs every coupling's multiplier >= 0;
   ``linkage`` takes any sign (a 2F-85's pad joint, multiplier -1, stays parallel) and a contact
-  stops the whole finger;
+  stops the whole finger; ``independent`` (one motor per joint) takes no mimics;
+* the sidecar's ``held_joints`` are read as fixed joints at their values (abduction, a thumb's
+  opposition at a preshape);
 * the tree has no loop (a link that is the child of two joints).
 
 Collision shapes: boxes (axis-aligned with the link after the conversion, else their 8 corners
@@ -133,6 +136,7 @@ def hand_json_from_urdf(urdf: str | Path, sidecar: Optional[str | Path] = None, 
     tree = _Tree(_load_urdf(urdf), str(urdf))
     if side.get("root") is not None:
         tree = tree.below(side["root"], f"{side_path}: root")
+    tree.hold(side.get("held_joints", {}), f"{side_path}: held_joints")
     conv = _Converter(tree, side, str(side_path), urdf.parent)
     text = json.dumps(conv.hand(), indent=1)
     return text if not with_joint_map else (text, conv.joint_map)
@@ -183,7 +187,7 @@ class _Converter:
                 self._fail(f"{w}.phalanges[{k}]: a revolute joint's motor is given as torque_nm")
         # the chain from the palm to the first joint: fixed joints and at most a spread joint
         above = self.tree.chain(joints[0].parent)
-        spread_here = [j for j in above if j.type != "fixed"]
+        spread_here = [j for j in above if self.tree.moves(j)]
         palm_chain = self.tree.chain(self.side["palm"]["link"])
         spread_here = [j for j in spread_here if j not in palm_chain]
         if len(spread_here) > 1:
@@ -191,7 +195,7 @@ class _Converter:
         # each phalanx joint's child must hang from the previous one through fixed joints only
         for k in range(1, len(joints)):
             up = self.tree.chain(joints[k].parent)
-            if joints[k - 1] not in up or any(j.type != "fixed" for j in up[up.index(joints[k - 1]) + 1:]):
+            if joints[k - 1] not in up or any(self.tree.moves(j) for j in up[up.index(joints[k - 1]) + 1:]):
                 self._fail(f"{w}: joint '{joints[k].name}' does not follow '{joints[k - 1].name}' through fixed joints")
         z = np.array([0.0, 0.0, 1.0])
         T0 = [self._in_hand(self.tree.zero_pose(j.child)) for j in joints]     # child frames = joint frames at 0
@@ -199,16 +203,23 @@ class _Converter:
         axes = [_unit(T[:3, :3] @ np.asarray(j.axis if j.axis is not None else (1, 0, 0), dtype=float))
                 for T, j in zip(T0, joints)]
         a = axes[0]
+        roll = 0.0
         if abs(a @ z) > _AXIS_TOL:
-            self._fail(f"{w}: joint '{joints[0].name}' axis is not in the palm plane (its z in the hand frame is "
-                       f"{a @ z:.3g}; up to {_AXIS_TOL:g} is taken as in it)")
-        if abs(a @ z) > _TOL:                # within the tolerance: put in the plane
-            a = _unit(a - (a @ z) * z)
+            # a flexion axis out of the palm plane (a thumb): the finger's plane turned about its
+            # outward direction d by roll, a = cos(roll) (d x z) - sin(roll) z
+            horizontal = np.linalg.norm(a - (a @ z) * z)
+            if horizontal < 0.1:
+                self._fail(f"{w}: joint '{joints[0].name}' turns about the approach axis (a spread or abduction joint; "
+                           "name it as the spread, or hold it with held_joints)")
+            roll = math.atan2(-(a @ z), horizontal)
+        a0 = _unit(a - (a @ z) * z)          # in the palm plane (within the tolerance: a itself, projected)
+        a = a0 if roll == 0.0 else a
         for k, ak in enumerate(axes[1:], 1):
             if ak @ a < 1.0 - _AXIS_TOL:
                 self._fail(f"{w}: joint '{joints[k].name}' axis is not parallel to '{joints[0].name}''s "
                            "(a finger is a planar chain; a positive angle closes every joint)")
-        d = np.cross(z, a)  # outward direction: a positive angle turns d towards +z (a = d x z)
+        d = np.cross(z, a0)  # outward direction: a positive angle turns d towards +z (a0 = d x z)
+        up = math.cos(roll) * z + math.sin(roll) * a0   # the finger plane's "up" (Theta = 90 deg)
         # the finger's base and spread
         if spread_here:
             sj = spread_here[0]
@@ -254,14 +265,24 @@ class _Converter:
                 self._fail(f"{w}.phalanges[{k}]: link '{j.child}' does not lie in the finger's plane")
             if abs(x @ a) > _TOL:
                 x = _unit(x - (x @ a) * a)
-            theta = math.atan2(x @ z, x @ d)
+            theta = math.atan2(x @ up, x @ d)
             phi = theta - theta_prev  # our relative angle at the URDF's zero
             theta_prev = theta
             if j.limit is None or j.type == "continuous":
                 self._fail(f"{w}.phalanges[{k}]: joint '{j.name}' needs limits")
             lo, hi = j.limit.lower + phi, j.limit.upper + phi
             # coupling while free: the driver runs from its lower limit at t = 0 with ratio 1
-            if k == 0:
+            if "ratio" in p and self.side["closing"] != "independent":
+                self._fail(f"{w}.phalanges[{k}]: a ratio is given only with closing 'independent' (otherwise the "
+                           "URDF's <mimic> couples the joint)")
+            if self.side["closing"] == "independent":
+                if j.mimic is not None:
+                    self._fail(f"{w}.phalanges[{k}]: joint '{j.name}' mimics '{j.mimic.joint}'; with closing "
+                               "'independent' every phalanx has its own motor")
+                # its own motor: open at the URDF's zero (within the limits), closing at the sidecar's speed
+                ratio = float(p.get("ratio", 1.0))
+                offset = phi + min(max(0.0, j.limit.lower), j.limit.upper)
+            elif k == 0:
                 ratio, offset = 1.0, lo
             elif (coupling := self._coupling(j, driver)) is not None:
                 m, o = coupling
@@ -283,6 +304,7 @@ class _Converter:
         knuckle_frame = np.eye(4)
         knuckle_frame[:3, 0], knuckle_frame[:3, 1], knuckle_frame[:3, 2], knuckle_frame[:3, 3] = d, a, np.cross(d, a), base
         return {"spec": spec, "joints": joints, "base": base, "base_yaw": base_yaw, "spread_sign": spread_sign,
+                "roll": roll,
                 "knuckle": max(knuckle, 0.0), "knuckle_frame": knuckle_frame, "phalanges": phalanges, "frames": frames,
                 "spread_joint": spread_here[0] if spread_here else None, "first_q": joint0, "urdf_map": urdf_map}
 
@@ -306,7 +328,7 @@ class _Converter:
         if abs(d @ z) > _TOL:
             d = _unit(d - (d @ z) * z)
         for above in self.tree.chain(j.parent):
-            if above.type != "fixed" and above not in self.tree.chain(self.side["palm"]["link"]):
+            if self.tree.moves(above) and above not in self.tree.chain(self.side["palm"]["link"]):
                 self._fail(f"{w}: joint '{above.name}' moves the jaw's base; a jaw hangs from the palm by fixed joints")
         pos = T0[:3, 3]
         tip = _transform(T0, np.asarray(spec["fingertip"], dtype=float)[None])[0]
@@ -354,6 +376,8 @@ class _Converter:
         for f in fingers:
             for name, index, scale, offset in f["urdf_map"]:
                 entries.setdefault(name, (index, scale, offset))
+        for name, value in self.tree.held.items():
+            entries.setdefault(name, (0, 0.0, value))      # held: reported at its value, reads nothing
         for name, (f, m, o) in self._passive(fingers).items():
             # URDF passive = m * URDF driver + o, URDF driver = scale * ours + offset (the driver's map)
             _, index, scale, offset = next(e for e in f["urdf_map"] if e[0] == f["joints"][0].name)
@@ -369,8 +393,8 @@ class _Converter:
         out = {}
         for k, name in enumerate(self.side.get("passive_joints", [])):
             j = self.tree.joint(name, f"passive_joints[{k}]")
-            if j.type == "fixed":
-                self._fail(f"passive_joints[{k}]: joint '{name}' is fixed (only moving joints are passive)")
+            if not self.tree.moves(j):
+                self._fail(f"passive_joints[{k}]: joint '{name}' is fixed or held (only moving joints are passive)")
             for f in fingers:
                 if j in f["joints"]:
                     self._fail(f"passive_joints[{k}]: joint '{name}' closes {f['spec']['name']}/"
@@ -391,7 +415,7 @@ class _Converter:
         """Our link name -> (frame in hand, [URDF links]) by following fixed joints from each moving one."""
         owner = {}  # the joint (or None: the palm) that moves each URDF link
         for name in self.tree.links:
-            moving = [j for j in self.tree.chain(name) if j.type != "fixed"]
+            moving = [j for j in self.tree.chain(name) if self.tree.moves(j)]
             owner[name] = moving[-1].name if moving else None
         ours: dict[str, tuple] = {}
         by_joint = {None: "palm"}
@@ -461,7 +485,7 @@ class _Converter:
             kn = bodies.get(f"{fname}/knuckle")
             out_fingers.append({
                 "name": fname, "base": [float(x) for x in f["base"]], "base_yaw_deg": f["base_yaw"],
-                "spread_sign": f["spread_sign"],
+                "spread_sign": f["spread_sign"], **({"roll_deg": math.degrees(f["roll"])} if f.get("roll") else {}),
                 "knuckle": {"length": f["knuckle"], "shapes": self._link_shapes(*kn) if kn else []},
                 "phalanges": [{k: v for k, v in p.items() if k != "link"} |
                               {"shapes": self._link_shapes(*bodies[f"{fname}/{p['name']}"])}
@@ -471,4 +495,4 @@ class _Converter:
                 "face (the sidecar's palm frame); +z is the approach direction",
                 "palm": {"shapes": self._link_shapes(*bodies["palm"])}, "spread": spread,
                 "fingers": out_fingers, "measured_joints": measured} | (
-                    {"closing": "linkage"} if self.side["closing"] == "linkage" else {})   # breakaway: the default
+                    {"closing": self.side["closing"]} if self.side["closing"] != "breakaway" else {})   # the default

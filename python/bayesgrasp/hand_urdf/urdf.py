@@ -52,6 +52,7 @@ class _Tree:
 
     def __init__(self, robot, where: str):
         self.where = where
+        self.held: dict[str, float] = {}   # joints held at a value (the sidecar's held_joints): fixed there
         self.links = {l.name: l for l in robot.links}
         self.joints = {j.name: j for j in robot.joints}
         self.parent_joint: dict[str, object] = {}
@@ -104,11 +105,37 @@ class _Tree:
             link = j.parent
         return out[::-1]
 
+    def hold(self, values: dict, what: str) -> None:
+        """Holds each named revolute or prismatic joint at its value (rad or m; within its limits):
+        from then on it is a fixed joint there."""
+        for name, v in values.items():
+            j = self.joint(name, f"{what} '{name}'")
+            if j.type not in ("revolute", "prismatic", "continuous"):
+                raise HandFileError(f"{self.where}: {what}: joint '{name}' is {j.type}; only a moving joint can be held")
+            if j.limit is not None and j.type != "continuous" and not (j.limit.lower - 1e-9 <= v <= j.limit.upper + 1e-9):
+                raise HandFileError(f"{self.where}: {what}: joint '{name}' held at {v:g}, outside its limits "
+                                    f"[{j.limit.lower:g}, {j.limit.upper:g}]")
+            self.held[name] = float(v)
+
+    def moves(self, j) -> bool:
+        """Whether joint j moves (not fixed, not held)."""
+        return j.type != "fixed" and j.name not in self.held
+
     def zero_pose(self, link: str) -> np.ndarray:
-        """The link's frame in the root's frame at every joint 0 (a joint at 0 is its origin)."""
+        """The link's frame in the root's frame at every joint 0 (a joint at 0 is its origin) and
+        every held joint at its value."""
         T = np.eye(4)
         for j in self.chain(link):
             T = T @ _origin(j.origin)
+            if j.name in self.held:
+                axis = _unit(j.axis if j.axis is not None else (1, 0, 0))
+                M = np.eye(4)
+                if j.type == "prismatic":
+                    M[:3, 3] = axis * self.held[j.name]
+                else:
+                    from scipy.spatial.transform import Rotation
+                    M[:3, :3] = Rotation.from_rotvec(axis * self.held[j.name]).as_matrix()
+                T = T @ M
         return T
 
 
