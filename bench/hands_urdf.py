@@ -1,8 +1,10 @@
 """Top grasps per second with hands from URDF (issue 31), one core: the BH8 from its hand file and
 from its URDF + sidecar (the same model after conversion), and the parallel-jaw gripper (prismatic
 jaws, convex mesh fingers), on the built-in mug (2,322 triangles), the same grasp set for every
-hand. Also the Robotiq 3F both ways, and the jaw with the hand offset along its pads' width
-about the mug's axis (0, 5, 15, 30 mm). Medians of repeated batches, ratios in the same run.
+hand. Also the Robotiq 3F both ways, the 2F-85-like four-bar gripper (issue 55: a linkage) and the
+Allegro-like hand (four fingers of three joints, one motor each, a rolled thumb), and the jaw
+with the hand offset along its pads' width about the mug's axis (0, 5, 15, 30 mm). Medians of
+repeated batches, ratios in the same run.
 
     OMP_NUM_THREADS=1 python bench/hands_urdf.py [--grasps 256] [--repeats 7] [--out bench/results/hands_urdf.json]
 """
@@ -19,7 +21,8 @@ from bayesgrasp.objects import load_object
 from bayesgrasp.sim import GraspSimulator
 
 HANDS = {"bh8_json": "barrett_bh8", "bh8_urdf": "barrett_bh8.urdf", "robotiq_json": "robotiq_3f",
-         "robotiq_urdf": "robotiq_3f.urdf", "parallel_jaw_urdf": "parallel_jaw.urdf"}
+         "robotiq_urdf": "robotiq_3f.urdf", "parallel_jaw_urdf": "parallel_jaw.urdf",
+         "robotiq_2f85_urdf": "robotiq_2f85.urdf", "allegro_like_urdf": "allegro_like.urdf"}
 
 
 def rate(hand: Hand, mug, xyyaw: np.ndarray, repeats: int) -> dict:

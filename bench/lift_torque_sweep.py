@@ -32,10 +32,20 @@ SETTINGS = {"before": {"solver_iterations": 20, "worm_backlash": 0.0, "drive_ine
 BEFORE_HAND_TORQUE = 0.5  # N m, the old LiftOptions default
 
 
-def grasp_set(world: World, n: int):
+def top_grid() -> np.ndarray:
+    """(968, 3) top grasps (x, y, yaw): x, y in +-5 cm (11 each), 8 yaws."""
     g = np.linspace(-0.05, 0.05, 11)
     X, Y, T = np.meshgrid(g, g, np.linspace(-np.pi / 2, np.pi / 2, 8, endpoint=False), indexing="ij")
-    b = world.grasp_batch(np.c_[X.ravel(), Y.ravel(), T.ravel()], threads=0)
+    return np.c_[X.ravel(), Y.ravel(), T.ravel()]
+
+
+def grid_grasps(world: World, threads: int = 0):
+    """The top_grid() grasps, closed."""
+    return world.grasp_batch(top_grid(), threads=threads)
+
+
+def grasp_set(world: World, n: int):
+    b = grid_grasps(world)
     idx = np.flatnonzero(b.epsilon > 0)[:n]
     return b.hand_pose[idx], b.joint_angles[idx]
 
