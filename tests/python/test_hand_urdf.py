@@ -11,7 +11,7 @@ from bayesgrasp.hand import HANDS_DIR, Hand, builtin_hands
 from bayesgrasp.hand_urdf import HandFileError, hand_json_from_urdf
 from bayesgrasp.objects import load_object
 from bayesgrasp.sim import GraspSimulator
-from testkit import urdf_fk
+from testkit import cli_json, urdf_fk
 
 
 def _grasp_set(obj, n_top, n_side, seed):
@@ -273,10 +273,11 @@ def test_a_simulator_s_namespaced_extension_is_skipped(tmp_path):
         Hand.load(broken)
 
 
-def test_a_hand_inside_an_arm_urdf_is_read_from_its_root_link(tmp_path):
+def test_a_hand_inside_an_arm_urdf_is_read_from_its_root_link(tmp_path, capsys):
     """The BH8 mounted on a two-joint arm in one URDF: refused while the arm's joints are unnamed;
     with the sidecar's root naming the hand's base link everything above it is ignored and the hand
-    is the BH8 (the same fingertips at the same joints)."""
+    is the BH8 (the same fingertips at the same joints), and it grasps through the CLI: the cube
+    and the mug from the top, the cylinder from the side, each lifted, joints named as the URDF's."""
     arm = ('<link name="world"/><link name="arm_1"/><link name="arm_2"/>'
            '<joint name="arm_j1" type="revolute"><parent link="world"/><child link="arm_1"/><origin xyz="0 0 0.3"/>'
            '<axis xyz="0 0 1"/><limit lower="-3" upper="3" effort="10" velocity="1"/></joint>'
@@ -293,6 +294,11 @@ def test_a_hand_inside_an_arm_urdf_is_read_from_its_root_link(tmp_path):
     hand, exact = Hand.load(rooted), Hand.load(_copy_bh8(tmp_path / "e"))
     q = np.array([0.4, 1.0, 1.1, 0.8, 1.0, 1.2, 0.9])
     np.testing.assert_allclose(hand.fingertips(q), exact.fingertips(q), atol=1e-12)
+    for args in (["--object", "cube", "--top", "0,0,0"], ["--object", "mug", "--top", "0,0,0.5"],
+                 ["--object", "cylinder", "--approach", "-1,0,0"]):
+        doc = cli_json(capsys, "grasp", *args, "--hand", str(rooted), "--json")
+        assert doc["lifted"] is True, args
+        assert "arm_j1" not in doc["grasp"]["urdf"]["joint_names"] and "bh_j12" in doc["grasp"]["urdf"]["joint_names"]
     (tmp_path / "x").mkdir()
     with pytest.raises(HandFileError, match=r"root names link 'bh_wrist', which the URDF does not have"):
         Hand.load(_copy_bh8(tmp_path / "x", lambda u: u.replace("</robot>", arm), lambda s: s.update(root="bh_wrist")))
