@@ -79,7 +79,7 @@ def test_plan_json_on_a_user_mesh_file(tmp_path):
     assert (tmp_path / "belief.png").stat().st_size > 1000
     # the values, not only the keys: each attempt's recorded grasp, closed again on the mesh at the
     # true pose, closes to the recorded joints, whose fingers (the spread is not read) are the
-    # reading (no noise), and gets the recorded lift verdict
+    # reading (no noise), gets the recorded lift verdict and touches where the attempt's contacts say
     from bayesgrasp.objects.library import load_object
 
     world = World.single(load_object(str(path)), pose=(0.02, -0.01, 0.4))
@@ -89,6 +89,11 @@ def test_plan_json_on_a_user_mesh_file(tmp_path):
         np.testing.assert_allclose(np.asarray(b.joint_angles[0]), g["joint_positions"], atol=1e-6)
         np.testing.assert_allclose(g["joint_positions"][1:], a["joint_angles"], atol=1e-9)
         assert bool(b.lifted[0]) == a["lifted"]
+        fresh = [c for c in b.contact_records(0, world.hand.links) if not c.on_table]
+        assert [c["link_name"] for c in a["contacts"]] == [c.link_name for c in fresh]
+        if fresh:
+            np.testing.assert_allclose([c["point"] for c in a["contacts"]], [c.point for c in fresh], atol=1e-5)
+    assert any(a["contacts"] for a in r["attempts"])
     f = r["final_belief"]
     assert np.isclose(f["position_error"], np.hypot(f["mean"][0] - 0.02, f["mean"][1] + 0.01))
 

@@ -120,7 +120,7 @@ def demo(args) -> int:
     print(f"{'success' if r['success'] else 'no successful grasp'} after {len(r['attempts'])} attempt(s); "
           f"final belief error {100 * f['position_error']:.1f} cm, {np.degrees(f['yaw_error']):.0f} deg")
     png = _belief_png(r, out / "belief_evolution.png")
-    doc = _plan_json(args, ctx, pose, r, None if isinstance(obj, str) else obj)
+    doc = _plan_json(args, ctx, pose, r)
     (out / "demo.json").write_text(json.dumps(doc, indent=1))
     pictures = _attempt_pictures(doc, out)
     print(f"saved {png}, {out / 'demo.json'} (see it in 3D: bayesgrasp view {out / 'demo.json'}) and "
@@ -180,23 +180,12 @@ def _attempt_grasps(r: dict, hand_name: str) -> list:
     return [hand_grasp_record(hand, a["hand_pose"], a["joint_positions"], a["variant"]["spread"]) for a in r["attempts"]]
 
 
-def _contacts(ctx, pose, r: dict, obj) -> list:
-    """Each attempt's contacts (with their parts): its grasp simulated again without the lift
-    (the same world, grasp and spread, so the same closing; checked against the attempt's pose)."""
-    from ..world import World
-
-    from ..models import Variant
-
-    world = World.single(obj, pose=pose, hand=ctx.hand)
-    out = []
-    for a in r["attempts"]:
-        g = Variant(**a["variant"]).grasp(world, a["relative_grasp"], lift=False)
-        same = np.allclose(g.hand_pose, a["hand_pose"], atol=1e-9)
-        out.append([c for c in g.to_dict()["contacts"] if not c["on_table"]] if same else [])
-    return out
+def _contacts(r: dict) -> list:
+    """Each attempt's object contacts (with their parts), as the episode's execution found them."""
+    return [[c.to_dict() for c in ex.contacts if not c.on_table] for ex in r["executions"]]
 
 
-def _plan_json(args, ctx, pose, r: dict, obj=None) -> dict:
+def _plan_json(args, ctx, pose, r: dict) -> dict:
     """plan's JSON; each attempt carries the belief it was planned from (its heaviest particles)."""
     from ..io.view_fields import belief_json
 
@@ -212,7 +201,7 @@ def _plan_json(args, ctx, pose, r: dict, obj=None) -> dict:
                           "success": a["success"], "outcome": "success" if a["success"] else "failure",
                           "plan_seconds": a["plan_seconds"],
                           "joint_angles": a["joint_angles"], "belief": belief_json(*r["snapshots"][k]),
-                          "contacts": c} for k, (a, g, c) in enumerate(zip(r["attempts"], grasps, _contacts(ctx, pose, r, obj or args.object)))],
+                          "contacts": c} for k, (a, g, c) in enumerate(zip(r["attempts"], grasps, _contacts(r)))],
             "final_belief": {"mean": f["mean"], "std": f["std"], "entropy": f["kde_entropy"], "ess": f["ess"],
                              "position_error": f["position_error"], "yaw_error": f["yaw_error"],
                              **belief_json(*r["snapshots"][-1])}}
@@ -242,21 +231,21 @@ def plan(args) -> int:
         print(json.dumps({"attempts": [to_ros(g, grasp_id=f"attempt-{a['attempt']}", quality=a["predicted_stability"])
                                        for a, g in zip(r["attempts"], _attempt_grasps(r, ctx.hand))]}))
     elif fmt == "json":
-        print(json.dumps(_plan_doc(args, ctx, pose, r, start, view, obj)))
+        print(json.dumps(_plan_doc(args, ctx, pose, r, start, view)))
     else:
         print(f"{'success' if r['success'] else 'no successful grasp'} after {len(r['attempts'])} attempt(s)")
     if args.view is not None:
         from .view import show_result
 
-        show_result(args, _plan_doc(args, ctx, pose, r, start, view, obj))
+        show_result(args, _plan_doc(args, ctx, pose, r, start, view))
     return 0
 
 
-def _plan_doc(args, ctx, pose, r: dict, start, view, obj=None) -> dict:
+def _plan_doc(args, ctx, pose, r: dict, start, view) -> dict:
     """plan's JSON, with the vision start (and its cloud) when the belief came from camera data."""
     from ..io.view_fields import cloud_json
 
-    doc = _plan_json(args, ctx, pose, r, obj)
+    doc = _plan_json(args, ctx, pose, r)
     if start is not None:
         doc["vision"] = {"scene": args.cloud or args.depth, "estimate": start.estimate.tolist(),
                          "half_width": start.half_width.tolist(), "registration": start.registration.as_dict(),

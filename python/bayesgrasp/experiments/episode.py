@@ -10,14 +10,14 @@ steps: :func:`plan` is the planner's, then :func:`execute` (the grasp at the tru
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Callable, Optional, Sequence, Union
+from typing import Callable, Optional, Sequence, Tuple, Union
 
 import numpy as np
 
 from ..models import GraspModels, relative_top_grasps
 from ..objects import ObjectModel, load_object
 from ..planners import Planner, PlannerSettings, Reading, make_planner
-from ..world import World
+from ..world import ContactRecord, World
 from .context import RunContext
 
 
@@ -54,6 +54,7 @@ class Execution:
     collision_at_start: bool
     joint_angles: np.ndarray
     hand_pose: Optional[np.ndarray] = None   # (4, 4) world pose of the hand where it closed
+    contacts: Tuple[ContactRecord, ...] = ()  # where the hand touched (object and table), with parts
 
 
 def initial_estimate(true_pose: np.ndarray, settings: PlannerSettings, rng: np.random.Generator) -> np.ndarray:
@@ -80,7 +81,7 @@ def execute(world: World, models: GraspModels, action: np.ndarray, true_pose: np
         lifted = bool(variant.simulate(world, rel[None, :], lift=True).lifted[0])
     return Execution(rel, eps, bool(stable), lifted, bool(lifted) if by_lift else bool(stable),
                      bool(g.collision_at_start[0]), np.asarray(g.joint_angles[0], dtype=float),
-                     np.asarray(g.hand_pose[0], dtype=float))
+                     np.asarray(g.hand_pose[0], dtype=float), tuple(g.contact_records(0, world.hand.links)))
 
 
 def read_fingers(execution: Execution, models: GraspModels, noise: float, rng: np.random.Generator) -> np.ndarray:
@@ -121,8 +122,9 @@ def run_episode(obj: Union[str, ObjectModel], true_pose: Sequence[float], episod
     families, :meth:`RunContext.family_models`). The estimate defaults to
     :func:`initial_estimate`. Returns a JSON-ready dict: success,
     attempts (one dict per attempt), the initial and final belief summaries; with ``keep_planner``
-    also "planner" (the Planner object, not JSON) and "snapshots" (the particles and weights
-    before each attempt and at the end).
+    also "planner" (the Planner object, not JSON), "snapshots" (the particles and weights
+    before each attempt and at the end) and "executions" (each attempt's :class:`Execution`, with
+    its contacts).
     """
     episode = episode or EpisodeSettings()
     ctx = ctx or RunContext()
@@ -136,7 +138,7 @@ def run_episode(obj: Union[str, ObjectModel], true_pose: Sequence[float], episod
     estimate = np.asarray(estimate, dtype=float)
     planner = make_planner(episode.method, models, estimate, settings, seed=int(rng.integers(2**31)))
     initial = planner.summary(true_pose)
-    snapshots, attempts = [], []
+    snapshots, attempts, executions = [], [], []
     for k in range(episode.attempts):
         before = planner.summary(true_pose)
         if keep_planner:
@@ -146,6 +148,7 @@ def run_episode(obj: Union[str, ObjectModel], true_pose: Sequence[float], episod
         ex = execute(world, executed, plan.action, true_pose, ctx)
         q = read_fingers(ex, executed, ctx.measurement_noise, rng)
         rec = _attempt_record(k, plan, ex, q, before, executed)
+        executions.append(ex)
         stop = ex.success and episode.stop_when_stable
         if not stop:
             planner.observe(plan, Reading(q, held=ex.success))
@@ -155,8 +158,11 @@ def run_episode(obj: Union[str, ObjectModel], true_pose: Sequence[float], episod
             on_attempt(rec)
         if stop:
             break
-    return _episode_result(obj_model.name, episode.method, true_pose, estimate, seed, attempts, initial,
-                           planner, true_pose, snapshots if keep_planner else None)
+    result = _episode_result(obj_model.name, episode.method, true_pose, estimate, seed, attempts, initial,
+                             planner, true_pose, snapshots if keep_planner else None)
+    if keep_planner:
+        result["executions"] = executions
+    return result
 
 
 def _episode_result(name: str, method: str, true_pose, estimate, seed: int, attempts: list, initial: dict,

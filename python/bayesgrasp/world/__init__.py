@@ -274,13 +274,7 @@ class World:
 
     def _one(self, b: WorldGraspBatch) -> WorldGrasp:
         """Grasp 0 of a batch of one as a WorldGrasp."""
-        names = self.hand.links
-        c = b.contacts
-        part = (lambda k: None) if b.contact_part is None else (lambda k: b.contact_part[k])
-        contacts = [ContactRecord(c.point[k].tolist(), c.normal[k].tolist(), int(c.link[k]), names[int(c.link[k])],
-                                  float(c.penetration[k]), bool(c.on_table[k]), int(c.triangle[k]), part(k))
-                    for k in range(len(c.link))]
-        return WorldGrasp(b.joint_angles[0], contacts, float(b.epsilon[0]), float(b.volume[0]),
+        return WorldGrasp(b.joint_angles[0], b.contact_records(0, self.hand.links), float(b.epsilon[0]), float(b.volume[0]),
                           bool(b.collision_at_start[0]), b.hand_pose[0],
                           None if b.lifted is None else bool(b.lifted[0]),
                           None if b.lifted is None else float(b.lift_displacement[0]),

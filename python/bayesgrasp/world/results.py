@@ -77,3 +77,13 @@ class WorldGraspBatch:
 
     def __len__(self) -> int:
         return len(self.epsilon)
+
+    def contact_records(self, i: int, link_names) -> List[ContactRecord]:
+        """Grasp i's contacts as records (``link_names``: the hand's links, for their names)."""
+        c = self.contacts
+        offsets = getattr(c, "offsets", None)     # a single grasp's contacts have none: all are grasp 0's
+        lo, hi = (0, len(c.link)) if offsets is None else (int(offsets[i]), int(offsets[i + 1]))
+        part = (lambda k: None) if self.contact_part is None else (lambda k: self.contact_part[k])
+        return [ContactRecord(c.point[k].tolist(), c.normal[k].tolist(), int(c.link[k]), link_names[int(c.link[k])],
+                              float(c.penetration[k]), bool(c.on_table[k]), int(c.triangle[k]), part(k))
+                for k in range(lo, hi)]
