@@ -72,6 +72,18 @@ def test_result_settings_cover_what_changes_a_result():
     assert robotiq["hand_file_sha256"] != s["hand_file_sha256"]
 
 
+def test_the_context_carries_its_loaded_hand_and_still_goes_to_workers():
+    """RunContext.hand_model: the context's hand loaded once per process (the same object on every
+    call, the named hand); the context itself stays picklable for spawned workers (by name)."""
+    import pickle
+
+    ctx = RunContext(hand="parallel_jaw.urdf")
+    assert ctx.hand_model is ctx.hand_model and ctx.hand_model.name.startswith("Parallel-jaw")
+    assert RunContext().hand_model.name.startswith("Barrett")
+    back = pickle.loads(pickle.dumps(ctx.for_workers()))
+    assert back.hand == "parallel_jaw.urdf" and back.hand_model is ctx.hand_model
+
+
 def test_the_cli_refuses_to_resume_a_no_lift_run_with_the_lift_test(tmp_path):
     base = ["experiment", "pub2", "--objects", "cube", "--runs", "1", "--out", str(tmp_path / "e"),
             "--cache", str(tmp_path / "cache"), "--success", "epsilon"]

@@ -92,12 +92,11 @@ def run(args) -> int:
 def _grasp_record(out: dict, ctx):
     """The plan in the grasp schema (world = the table frame): executed, where the hand closed and
     its closed fingers; planned only, the planned pose with the open preshape (None: no grasp)."""
-    from ..hand import Hand
     from ..io.grasp_schema import hand_grasp_record
 
     if out["pose"] is None:
         return None
-    hand = Hand.load(ctx.hand)
+    hand = ctx.hand_model
     if out["executed"]:
         return hand_grasp_record(hand, out["hand_pose"], out["joint_angles"], out["spread"])
     return hand_grasp_record(hand, out["pose"], hand.open_joints(out["spread"]), out["spread"])
@@ -126,12 +125,11 @@ def _print(doc: dict) -> None:
 
 
 def _png(ep, out: dict, ctx, png, doc: dict) -> None:
-    from ..hand import Hand
     from ..objects import load_object
     from ..viz import plot_category_grasp
 
     plot_category_grasp(ep.observation.cloud, [load_object(m) for m in ep.models],
                         [r.transform for r in ep.registrations], [out["weights"][m] for m in ep.models],
-                        Hand.load(ctx.hand), np.asarray(out["joint_angles"]), np.asarray(out["hand_pose"]), png,
+                        ctx.hand_model, np.asarray(out["joint_angles"]), np.asarray(out["hand_pose"]), png,
                         title=f"{doc['scene_object']}, {doc['task']}, {doc['method']}: "
                               f"{'success' if doc['success'] else doc['failure']}")

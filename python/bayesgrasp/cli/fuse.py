@@ -59,10 +59,9 @@ def run(args) -> int:
                         exclude=args.exclude if args.exclude is not None else [args.scene_object], seed=ctx.seed,
                         category=args.category, grasps=grasps,
                         observation=None if view is None else camera_input.observation(view))
-    from ..hand import Hand
     from ..io.grasp_schema import hand_grasp_record
 
-    hand = Hand.load(ctx.hand)
+    hand = ctx.hand_model
     rounds = []
     fmt = output_format(args)
     r = trial.run(args.start, rounds=args.rounds, on_round=None if fmt != "text" else _print_round(trial.names),

@@ -2,6 +2,7 @@
 CLI or the experiment driver) and passed down instead of threading each setting by hand."""
 from __future__ import annotations
 
+import functools
 import math
 import sys
 import time
@@ -24,6 +25,14 @@ def _plain(v):
     """A settings value as JSON would give it back (tuples as lists, numpy scalars as numbers)."""
     import json
     return json.loads(json.dumps(v, default=lambda o: o.tolist() if hasattr(o, "tolist") else str(o)))
+
+
+@functools.lru_cache(maxsize=8)
+def _loaded_hand(name: str):
+    """The hand ``name`` loaded once per process (a context is sent to worker processes by its
+    name; the loaded model is not picklable)."""
+    from ..hand import Hand
+    return Hand.load(name)
 
 
 def stderr_progress(message: str) -> None:
@@ -79,6 +88,11 @@ class RunContext:
                              "the lift test")
         if self.cache_dir is not None:
             object.__setattr__(self, "cache_dir", str(self.cache_dir))
+
+    @property
+    def hand_model(self):
+        """This context's hand, loaded (once per process): a :class:`~bayesgrasp.hand.Hand`."""
+        return _loaded_hand(str(self.hand))
 
     def say(self, message: str) -> None:
         if self.progress is not None:
@@ -137,10 +151,9 @@ class RunContext:
         from pathlib import Path
 
         from .. import __version__
-        from ..hand import Hand
         from ..models.settings import CACHE_VERSION
 
-        hand = Hand.load(self.hand)
+        hand = self.hand_model
         text = Path(hand.path).read_bytes() if getattr(hand, "path", None) else hand.name.encode()
         models = self.model_settings or ModelSettings(success=self.success)
         return {"bayesgrasp": __version__, "cache_version": CACHE_VERSION, "hand": hand.name,

@@ -129,7 +129,7 @@ class DiskEpisode:
 
     def __init__(self, directory: Path, state: dict, ctx: RunContext):
         self.directory, self.state, self.ctx = Path(directory), state, ctx
-        self.hand = Hand.load(ctx.hand)
+        self.hand = ctx.hand_model
 
     @staticmethod
     def _base_state(kind: str, ctx: RunContext, attempts: int, seed: int) -> dict:

@@ -103,10 +103,9 @@ class FusionTrial:
     def part_check(self, grasps: np.ndarray, belief: ModelMixtureBelief):
         """The part check of top grasps (K, 3) over the models at the belief's poses and weights
         (held left to compute lazily)."""
-        from ..hand import Hand
         from ..planners.part_check import check_top_grasps
 
-        hand = Hand.load(self.ctx.hand)
+        hand = self.ctx.hand_model
         return check_top_grasps(hand, self.rule, grasps, self.names, belief.poses, belief.weights, self.spread,
                                 resolve=False)
 
