@@ -142,3 +142,10 @@ def test_documentation_keys_may_be_left_out():
     h = Hand.from_json(_edited(lambda s: (s.pop("description"), s.pop("frame"))))
     ref = Hand.load()
     np.testing.assert_array_equal(h.link_poses(ref.open_joints()), ref.link_poses(ref.open_joints()))
+
+
+def test_every_built_in_hand_names_each_link_once():
+    """Link names label contacts, joints and the viewer's meshes: no two links of a hand share one."""
+    for name in builtin_hands():
+        links = Hand.load(name).links
+        assert len(set(links)) == len(links), (name, links)

@@ -136,7 +136,18 @@ def test_refusals_name_what_the_linkage_needs(tmp_path):
         Hand.load(_copy(tmp_path / "b", lambda s: s | {"passive_joints": pad_too}))
     with pytest.raises(HandFileError, match=r"joint 'r2f_left_inner_knuckle_joint' moves link 'r2f_left_inner_knuckle'"):
         Hand.load(_copy(tmp_path / "c", lambda s: {k: v for k, v in s.items() if k != "passive_joints"}))
+    (tmp_path / "d").mkdir()
+
+    def knuckle(s):
+        s["fingers"][0]["phalanges"][0]["name"] = "knuckle"
+        return s
+    with pytest.raises(HandFileError, match=r"fingers\[0\]\.phalanges\[0\]: name 'knuckle' is the finger's knuckle link"):
+        Hand.load(_copy(tmp_path / "d", knuckle))
     doc = json.loads(Hand.load(GRIPPER).text)
+    twice = json.loads(json.dumps(doc))
+    twice["fingers"][0]["phalanges"][1]["name"] = "outer"
+    with pytest.raises(ValueError, match=r"fingers\[0\]\.phalanges\[1\]: its link name 'left/outer' is taken"):
+        Hand.from_json(json.dumps(twice))
     doc.pop("closing")
     with pytest.raises(ValueError, match=r"fingers\[0\]\.phalanges\[1\]: ratio must be >= 0 with closing 'breakaway'"):
         Hand.from_json(json.dumps(doc))

@@ -296,9 +296,14 @@ HandModel HandModel::from_json(const std::string& json_text) {
     if (!ph.is_array() || ph.empty()) fail(w, "'phalanges' must be a non-empty list");
     finger.first_joint = joint;
     for (size_t p = 0; p < ph.size(); ++p) {
-      Phalanx phalanx = parse_phalanx(ph[p], p, w + ".phalanges[" + std::to_string(p) + "]");
+      const std::string wp = w + ".phalanges[" + std::to_string(p) + "]";
+      Phalanx phalanx = parse_phalanx(ph[p], p, wp);
       Link link;
       link.name = finger.name + "/" + phalanx.name;
+      for (const Link& other : h.links_)  // link names are how results and the viewer name links
+        if (other.name == link.name)
+          fail(wp, "its link name '" + link.name + "' is taken (a finger's knuckle is '<finger>/knuckle'; phalanx "
+                   "names must differ from it and from each other)");
       link.finger = static_cast<int>(f);
       link.phalanx = static_cast<int>(p);
       link.shapes = phalanx.shapes;

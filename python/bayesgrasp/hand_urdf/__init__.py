@@ -272,6 +272,9 @@ class _Converter:
                 self._fail(f"{w}.phalanges[{k}]: joint '{j.name}' needs limits")
             lo, hi = j.limit.lower + phi, j.limit.upper + phi
             # coupling while free: the driver runs from its lower limit at t = 0 with ratio 1
+            if p["name"] == "knuckle":
+                self._fail(f"{w}.phalanges[{k}]: name 'knuckle' is the finger's knuckle link (the body its spread "
+                           "joint moves); name the phalanx otherwise")
             if "ratio" in p and self.side["closing"] != "independent":
                 self._fail(f"{w}.phalanges[{k}]: a ratio is given only with closing 'independent' (otherwise the "
                            "URDF's <mimic> couples the joint)")
