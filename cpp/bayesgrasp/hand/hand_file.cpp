@@ -190,7 +190,8 @@ Phalanx parse_phalanx(const json& j, size_t p, const std::string& where) {
 }
 
 /// The couplings' signs against the closing scheme: breakaway needs every ratio >= 0; a linkage
-/// a first ratio > 0 (the driver closes the finger) and any finite ratio after it.
+/// a first ratio > 0 (the driver closes the finger) and any finite ratio after it; independent
+/// every ratio > 0 (each joint's closing speed).
 void check_ratios(const Finger& finger, Closing closing, const std::string& where) {
   for (size_t p = 0; p < finger.phalanges.size(); ++p) {
     const double r = finger.phalanges[p].ratio;

@@ -22,7 +22,7 @@
 // phalanx angles are relative to the previous phalanx (or to the palm plane for phalanx 0).
 //
 // Closing. Each finger has one actuator parameter t >= 0; while free, phalanx j follows
-// q_j(t) = offset_j + ratio_j * t, clamped to [lower_j, upper_j]. Two schemes (the hand file's
+// q_j(t) = offset_j + ratio_j * t, clamped to [lower_j, upper_j]. Three schemes (the hand file's
 // "closing"):
 //  * breakaway (the BH8's TorqueSwitch; every ratio >= 0): when phalanx k is stopped by a contact,
 //    phalanges 0..k freeze, and phalanges after k keep closing; a phalanx that reaches its upper

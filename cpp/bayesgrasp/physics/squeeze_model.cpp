@@ -23,7 +23,8 @@ SqueezeModel::SqueezeModel(const HandModel& hand, const Eigen::VectorXd& joints,
       cmd_(static_cast<size_t>(hand.num_joints())) {
   // The breakaway state of the closed grasp: phalanx a has broken away when it is at its limit
   // or a later phalanx is past the closing law at a's actuator value t_a = (q_a - offset_a) / ratio_a.
-  // A linkage has no breakaway: its driver (phalanx 0) stays driven.
+  // Only the breakaway scheme breaks away: a linkage's driver (phalanx 0) stays driven, and an
+  // independent hand drives every joint (set_commands).
   for (size_t f = 0; f < hand.fingers().size() && hand.closing() == Closing::Breakaway; ++f) {
     const Finger& fi = hand.fingers()[f];
     const int n = static_cast<int>(fi.phalanges.size());

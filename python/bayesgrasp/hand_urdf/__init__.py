@@ -381,7 +381,7 @@ class _Converter:
                 entries.setdefault(name, (index, scale, offset))
         for name, value in self.tree.held.items():
             entries.setdefault(name, (0, 0.0, value))      # held: reported at its value, reads nothing
-        for name, (f, m, o) in self._passive(fingers).items():
+        for name, (f, m, o) in self.passive.items():
             # URDF passive = m * URDF driver + o, URDF driver = scale * ours + offset (the driver's map)
             _, index, scale, offset = next(e for e in f["urdf_map"] if e[0] == f["joints"][0].name)
             entries.setdefault(name, (index, m * scale, m * offset + o))
@@ -431,9 +431,8 @@ class _Converter:
             for p, j, frame in zip(f["phalanges"], f["joints"], f["frames"]):
                 by_joint[j.name] = f"{fname}/{p['name']}"
                 ours[f"{fname}/{p['name']}"] = (frame, [])
-        passive = set(self._passive(fingers))
         for name, j in owner.items():
-            if j in passive:
+            if j in self.passive:
                 continue   # a linkage's other bar: its geometry is left out
             if j not in by_joint:
                 self._fail(f"joint '{j}' moves link '{name}', but the sidecar names it nowhere "
@@ -474,6 +473,7 @@ class _Converter:
                 if j.name in joint_names:
                     self._fail(f"joint '{j.name}' closes two phalanges ({joint_names[j.name]} and {f['spec']['name']}/{p['name']})")
                 joint_names[j.name] = f"{f['spec']['name']}/{p['name']}"
+        self.passive = self._passive(fingers)
         self.joint_map = self._joint_map(fingers, spread_joint)
         bodies = self._bodies(fingers)
         measured = []

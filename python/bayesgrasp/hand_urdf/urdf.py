@@ -124,6 +124,8 @@ class _Tree:
     def zero_pose(self, link: str) -> np.ndarray:
         """The link's frame in the root's frame at every joint 0 (a joint at 0 is its origin) and
         every held joint at its value."""
+        from scipy.spatial.transform import Rotation
+
         T = np.eye(4)
         for j in self.chain(link):
             T = T @ _origin(j.origin)
@@ -133,7 +135,6 @@ class _Tree:
                 if j.type == "prismatic":
                     M[:3, 3] = axis * self.held[j.name]
                 else:
-                    from scipy.spatial.transform import Rotation
                     M[:3, :3] = Rotation.from_rotvec(axis * self.held[j.name]).as_matrix()
                 T = T @ M
         return T
