@@ -11,7 +11,8 @@ from bayesgrasp.hand import Hand
 from bayesgrasp.models.tasks import task_rule
 from bayesgrasp.vision import RegistrationResult
 from bayesgrasp.planners.category import CategoryPlanner, CategorySettings, TaskGrasp
-from bayesgrasp.planners.part_check import PartCheck, check_candidates, choose, choose_lazily, model_world
+from bayesgrasp.planners.part_check import (PartCheck, best_passing, check_candidates, choose, choose_by_lift,
+                                            choose_lazily, model_world)
 
 HAND = Hand.load("barrett_bh8")
 MUG = "mug/1"     # handle along +x, labelled "handle"; the body "body", the rim "rim"
@@ -105,6 +106,47 @@ def test_the_lazy_choice_is_the_full_choice(K, M, seed, product):
     lazy = PartCheck(rule, np.zeros((K, M), bool), w, [[[]] * M] * K, np.zeros(K, bool),
                      lambda rows: held[rows] & rule[rows])
     assert choose_lazily(lazy, J, 0.1, product, batch=3) == full
+
+
+def _random_check(K, M, seed):
+    """A PartCheck of random rule / held / lifted verdicts (held and lifted computed on demand) and
+    the full truth: (check, J, P(rule, held), P(rule, held, lifted), weights)."""
+    rng = np.random.default_rng(seed)
+    rule, held, lifted = (rng.random((K, M)) < 0.5), (rng.random((K, M)) < 0.6), (rng.random((K, M)) < 0.4)
+    w = rng.dirichlet(np.ones(M))
+    J = np.round(rng.random(K), 1) * (rng.random(K) < 0.9)          # ties and zeros on purpose
+    check = PartCheck(rule, np.zeros((K, M), bool), w, [[[]] * M] * K, np.zeros(K, bool),
+                      lambda rows: held[rows] & rule[rows], lambda rows, need: lifted[rows] & need)
+    return check, J, (rule & held).astype(float) @ w, (rule & held & lifted).astype(float) @ w
+
+
+@settings(max_examples=200, deadline=None)
+@given(st.integers(1, 40), st.integers(1, 4), st.integers(0, 2**31 - 1), st.integers(1, 6))
+def test_the_best_passing_candidates_are_the_top_of_the_full_ranking(K, M, seed, n):
+    """Held computed lazily, the n best passing candidates score as the n best with held known
+    everywhere (ties may swap rows of equal score)."""
+    check, J, p, _ = _random_check(K, M, seed)
+    score = p + 0.1 * J / (J.max() if J.max() > 0 else 1.0)
+    expected = np.sort(score[p > 0])[::-1][:n]
+    got = best_passing(check, J, n, 0.1, batch=3)
+    assert (p[got] > 0).all()
+    np.testing.assert_allclose(score[got], expected)
+
+
+@settings(max_examples=200, deadline=None)
+@given(st.integers(1, 40), st.integers(1, 4), st.integers(0, 2**31 - 1), st.integers(1, 6))
+def test_the_lift_decides_among_the_best_and_never_takes_one_that_drops_on_every_model(K, M, seed, n):
+    check, J, _, p_lift = _random_check(K, M, seed)
+    rows = best_passing(_random_check(K, M, seed)[0], J, n, 0.1)
+    chosen, tested, p = choose_by_lift(check, J, n, 0.1)
+    assert tested == len(rows)
+    if not (p_lift[rows] > 0).any():
+        assert chosen is None and p == 0.0
+        return
+    top = J.max() if J.max() > 0 else 1.0
+    assert chosen in rows and p_lift[chosen] > 0 and p == pytest.approx(p_lift[chosen])
+    lifting = rows[p_lift[rows] > 0]
+    assert p_lift[chosen] + 0.1 * J[chosen] / top >= (p_lift[lifting] + 0.1 * J[lifting] / top).max() - 1e-12
 
 
 def test_the_part_aware_plan_returns_a_checked_candidate():
@@ -240,6 +282,13 @@ def test_the_warped_method_checks_its_candidates_on_the_models_warped_onto_the_c
     assert shape.part_names == S.part_names and np.array_equal(shape.parts, S.parts)
     plan = planner.plan()
     assert plan.ok and plan.method == "warped" and plan.extra["p_rule"] == 1.0
+    # the lift test on the warped shape decided among the best candidates, and the chosen one lifts there
+    assert plan.extra["lift_checked"] >= 1 and plan.extra["p_lifted"] == 1.0
+    from bayesgrasp.world import World
+    direct = World.single(shape, pose=(0.0, 0.03, -0.5), hand=HAND, keep_origin=True)
+    g = direct.approach(plan.pose[:3, 2], plan.pose[:3, 3], Hand.approach_roll(plan.pose), spread=plan.spread,
+                        frame="world", lift=True)
+    assert g.lifted
     # another task on the same view reuses the warped models: the same plan, no warp recomputed
     again = CategoryPlanner(HAND, grasps, regs, cloud=cloud, rule=task_rule("mug", "handle"), warped=[shape],
                             settings=CategorySettings(method="warped", part_candidates=16), seed=1)
@@ -248,3 +297,66 @@ def test_the_warped_method_checks_its_candidates_on_the_models_warped_onto_the_c
     with pytest.raises(ValueError, match="warped: one per registration"):
         CategoryPlanner(HAND, grasps, regs, cloud=cloud, rule=task_rule("mug", "handle"), warped=[shape, shape],
                         settings=CategorySettings(method="warped"))
+
+
+def test_a_warped_models_lift_pieces_are_its_own_moved_by_the_warp():
+    """mug/1 warped onto its own 1.1x copy: the lift test's convex pieces of the warped model are
+    mug/1's pieces scaled by 1.1 (the scale within 2%, every point within 12 mm: CPD lets points slide
+    along the surface), so the lift test sees the warped shape without decomposing it again."""
+    from bayesgrasp.decomposition import convex_decomposition
+    from bayesgrasp.objects import load_object
+    from bayesgrasp.vision import model_samples
+
+    m = load_object(MUG)
+    T = placed(0.3, (0.02, -0.01, 0.0))
+    P, _ = model_samples((1.1 * m.vertices, m.faces), samples=2500, seed=4)
+    planner = CategoryPlanner(HAND, [TaskGrasp(model=MUG, task="handle", pose=HANDLE, spread=0.0, epsilon=0.2,
+                                               lifted=True)],
+                              [RegistrationResult.known(MUG, T, phi=1.0)], cloud=P @ T[:3, :3].T + T[:3, 3],
+                              rule=task_rule("mug", "handle"), settings=CategorySettings(method="warped"), seed=1)
+    (shape,) = planner.warped_models()
+    own = convex_decomposition(m.vertices, m.faces, name=m.name)
+    assert len(shape.convex_pieces) == len(own)
+    W, O = np.concatenate(shape.convex_pieces), np.concatenate(own)
+    scale = float(np.sum(W * O) / np.sum(O * O))                  # least squares W ~ scale * O
+    assert scale == pytest.approx(1.1, rel=0.02)
+    assert np.linalg.norm(W - 1.1 * O, axis=1).max() < 0.012       # CPD lets points slide along the surface
+    assert shape.transformed(np.eye(4)).convex_pieces is not None   # a copy keeps them
+
+
+def test_the_warps_weigh_by_how_well_each_fits_the_view():
+    """Two models registered on a view of the first stretched: each model's weight is phi times
+    exp(-(r - min r) / scale) of its warp's residual r, normalised; the better fit weighs more."""
+    S = _stretched(sx=1.15)
+    T = placed(0.2, (0.0, 0.0, 0.0))
+    from bayesgrasp.vision import model_samples
+    P, _ = model_samples(S, samples=2000, seed=5)
+    regs = [RegistrationResult.known(MUG, T, phi=0.5), RegistrationResult.known("mug/4", T, phi=0.5)]
+    planner = CategoryPlanner(HAND, [TaskGrasp(model=MUG, task="handle", pose=HANDLE, spread=0.0, epsilon=0.2,
+                                               lifted=True)], regs, cloud=P @ T[:3, :3].T + T[:3, 3],
+                              rule=task_rule("mug", "handle"), settings=CategorySettings(method="warped"), seed=1)
+    r = np.array([m.params["warp_residual"] for m in planner.warped_models()])
+    w = planner.warp_weights()
+    expected = 0.5 * np.exp(-(r - r.min()) / planner.settings.warp_residual_scale)
+    np.testing.assert_allclose(w, expected / expected.sum())
+    assert w[np.argmin(r)] > w[np.argmax(r)] or r[0] == r[1]
+    with pytest.raises(ValueError, match="warp_residual_scale"):
+        CategorySettings(method="warped", warp_residual_scale=0.0)
+
+
+def test_the_lift_test_takes_a_models_own_pieces_without_decomposing(monkeypatch):
+    """An ObjectModel given convex pieces (here one: its hull's points) is lift-tested on those: the
+    decomposition is never called and the tester holds exactly that one piece."""
+    from bayesgrasp import physics
+    from bayesgrasp.objects import load_object
+    from bayesgrasp.world import World
+
+    m = load_object(MUG)
+    hulled = m.transformed(np.eye(4))
+    hulled.convex_pieces = [m.vertices.copy()]
+
+    def refuse(*a, **k):
+        raise AssertionError("decomposed although the model has its own pieces")
+    monkeypatch.setattr(physics, "convex_decomposition", refuse)
+    tester = World.single(hulled, pose=(0.0, 0.0, 0.0), hand=HAND).lift_tester()
+    assert tester.concave and tester.num_pieces == 1

@@ -74,6 +74,10 @@ class ObjectModel:
     given_mass: Optional[float] = None
     #: (mass properties in this frame or None, their method, watertight) already known: a copy's
     known_mass: Optional[tuple] = field(default=None, repr=False, compare=False)
+    #: the convex pieces ((K_i, 3) arrays, this frame) the lift test uses, when known without a
+    #: decomposition (a warped model's: its training model's pieces moved by the same warp); None:
+    #: the lift test decomposes the mesh (CoACD, cached)
+    convex_pieces: Optional[list] = field(default=None, repr=False, compare=False)
 
     def __post_init__(self):
         V = np.ascontiguousarray(np.asarray(self.vertices, dtype=np.float64))
@@ -117,6 +121,13 @@ class ObjectModel:
                               f"properties are those of {how}; pass mass= (--mass) to give its weight",
                               MeshWarning, stacklevel=3)
         self.known_mass = None
+        if self.convex_pieces is not None:
+            pieces = [np.asarray(p, dtype=np.float64) for p in self.convex_pieces]
+            if not pieces or any(p.ndim != 2 or p.shape[1] != 3 or len(p) < 4 or not np.all(np.isfinite(p))
+                                 for p in pieces):
+                raise ValueError(f"convex_pieces of '{self.name}': expected a non-empty list of finite (K, 3) "
+                                 "arrays with K >= 4")
+            self.convex_pieces = pieces
         if self.given_mass is not None:
             if not (np.isfinite(self.given_mass) and self.given_mass > 0):
                 raise ValueError(f"mass must be finite and > 0 kg, got {self.given_mass}")
@@ -190,14 +201,17 @@ class ObjectModel:
         return ObjectModel(name or self.name, V, self.faces.copy(), self.density, self.source,
                            dict(self.params), warn_if_open=False,
                            parts=None if self.parts is None else self.parts.copy(), part_names=self.part_names,
-                           given_mass=self.given_mass if rigid else None, known_mass=known)
+                           given_mass=self.given_mass if rigid else None, known_mass=known,
+                           convex_pieces=None if self.convex_pieces is None
+                           else [p @ T[:3, :3].T + T[:3, 3] for p in self.convex_pieces])
 
     def with_mass(self, mass: float) -> "ObjectModel":
         """A copy weighing ``mass`` kg (a scale's reading): same shape, density = mass / volume."""
         return ObjectModel(self.name, self.vertices.copy(), self.faces.copy(), self.density, self.source,
                            dict(self.params), warn_if_open=False,
                            parts=None if self.parts is None else self.parts.copy(), part_names=self.part_names,
-                           given_mass=mass, known_mass=(self._mp, self.mass_method, self._watertight))
+                           given_mass=mass, known_mass=(self._mp, self.mass_method, self._watertight),
+                           convex_pieces=self.convex_pieces)
 
     @property
     def mass_properties_core(self):

@@ -45,7 +45,7 @@ from ..hand import Hand
 from ..models.tasks import TaskGrasp, TaskRule
 from ..vision import RegistrationResult
 from .category_results import CategoryPlan, CategoryUpdate
-from .part_check import check_candidates, choose_lazily
+from .part_check import check_candidates, choose_by_lift, choose_lazily
 from .protocol import as_reading
 
 _task = _core.task
@@ -91,6 +91,11 @@ class CategorySettings:
     part_tiebreak: float = 0.1
     part_jitter_yaw: Sequence[float] = ()   # rad: the models also closed turned by these (see part_check)
     warp_samples: int = 800                 # warped: surface points of each model warped onto the cloud (CPD)
+    # warped: the best candidates (by P(rule, held)) whose choice the lift test on the warped models
+    # decides (0: force closure decides), and the residual scale (m) weighing the warps: a model
+    # whose warp fits the cloud r m worse than the best one weighs exp(-r / scale) times its phi
+    warp_lift_top: int = 4
+    warp_residual_scale: float = 0.002
 
     def __post_init__(self):
         if self.method not in METHODS:
@@ -112,6 +117,11 @@ class CategorySettings:
             v = getattr(self, name)
             if not (np.isfinite(v) and v >= 0):
                 raise ValueError(f"{name}: must be >= 0, got {v}")
+        if self.warp_samples < 10 or self.warp_lift_top < 0:
+            raise ValueError(f"warp_samples: at least 10, warp_lift_top: at least 0; got {self.warp_samples}, "
+                             f"{self.warp_lift_top}")
+        if not (np.isfinite(self.warp_residual_scale) and self.warp_residual_scale > 0):
+            raise ValueError(f"warp_residual_scale: must be positive, got {self.warp_residual_scale}")
 
     def density(self):
         d = _task.PoseDensity()
@@ -329,17 +339,40 @@ class CategoryPlanner:
         comp = np.asarray(v.dominant, int)
         spreads = np.array([self.grasps[c].spread if c >= 0 else self.grasps[0].spread for c in comp], float)
         J = np.asarray(v.value, float) * np.exp(-self._intrusions(A, spreads) / s.clearance_scale)
-        shapes = self.warped_models() if s.method == "warped" else None
-        check = check_candidates(self.hand, self.rule, A, spreads, self.registrations, self.weights, s.threads,
+        warped = s.method == "warped"
+        shapes = self.warped_models() if warped else None
+        weights = self.warp_weights() if warped else self.weights
+        check = check_candidates(self.hand, self.rule, A, spreads, self.registrations, weights, s.threads,
                                  resolve=False, jitter_yaw=tuple(s.part_jitter_yaw), shapes=shapes)
         k = choose_lazily(check, J, s.part_tiebreak)
-        plan = self._result(A[k], float(J[k]), None, nfev + len(A) * int(np.count_nonzero(self.weights > 0)))
+        lift = {}
+        if warped and s.warp_lift_top > 0:
+            k, lift = self._decide_by_lift(check, J, k)
+        plan = self._result(A[k], float(J[k]), None, nfev + len(A) * int(np.count_nonzero(weights > 0)))
         plan.extra.update({"p_rule": float(check.p_rule[k]), "p_success": float(check.p_success[k]),
                            "candidates": int(len(A)), "passing_rule": int(np.count_nonzero(check.p_rule > 0)),
-                           "held_checked": int(np.count_nonzero(check.known)),
+                           "held_checked": int(np.count_nonzero(check.known)), **lift,
                            "contact_parts_on_models": {r.model: check.parts[k][i]
-                                                       for i, r in enumerate(self.registrations) if self.weights[i] > 0}})
+                                                       for i, r in enumerate(self.registrations) if weights[i] > 0}})
         return plan
+
+    def _decide_by_lift(self, check, J: np.ndarray, k: int) -> tuple:
+        """:func:`~.part_check.choose_by_lift` over the ``warp_lift_top`` best candidates; ``k``
+        (force closure's choice) when none of them lifts on any warped model."""
+        chosen, tested, p = choose_by_lift(check, J, self.settings.warp_lift_top, self.settings.part_tiebreak)
+        return (k if chosen is None else chosen), {"lift_checked": tested, "p_lifted": p}
+
+    def warp_weights(self) -> np.ndarray:
+        """The models' weights for the warped check: phi times exp(-(r_i - min r) / scale), r_i
+        the RMS distance of the observed points to model i's warp (the better a warp fits the view,
+        the more its shape counts), normalised; models without a warp keep phi."""
+        r = np.array([np.nan if m is None else m.params.get("warp_residual", np.nan) for m in self.warped_models()])
+        w = self.weights.copy()
+        have = np.isfinite(r) & (w > 0)
+        if have.any():
+            w[have] *= np.exp(-(r[have] - r[have].min()) / self.settings.warp_residual_scale)
+        total = w.sum()
+        return w / total if total > 0 else w
 
     def warped_models(self) -> list:
         """Per registration: its training model warped onto the observed cloud (an ObjectModel in
@@ -347,6 +380,7 @@ class CategoryPlanner:
         shape), or None (weight 0, not registered, or no cloud: the model as registered)."""
         if self._warped is not None:
             return self._warped
+        from ..decomposition import convex_decomposition
         from ..objects import ObjectModel, load_object
         from ..vision.deform import warp_mesh
 
@@ -357,9 +391,12 @@ class CategoryPlanner:
                 continue
             m = load_object(r.model)
             warp = warp_mesh(m, r.transform, self.cloud, samples=self.settings.warp_samples, seed=self.seed)
+            # the lift test's convex pieces: the model's own (cached) moved by the same warp
+            pieces = [warp.warp_points(p) for p in convex_decomposition(m.vertices, m.faces, name=m.name)]
             out.append(ObjectModel(f"{m.name}~warped", warp.vertices, m.faces, density=m.density,
                                    source=f"{m.source} warped onto the cloud", parts=m.parts,
-                                   part_names=m.part_names))
+                                   part_names=m.part_names, params={"warp_residual": float(warp.result.residual)},
+                                   convex_pieces=pieces))
         self._warped = out
         return out
 

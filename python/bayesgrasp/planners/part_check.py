@@ -22,6 +22,12 @@ candidate is closed and its rule read (:func:`check_candidates`); held is then c
 needed (:meth:`PartCheck.resolve`): :func:`choose_lazily` visits the candidates in the order of an
 upper bound of their score (P(rule, held) <= P(rule)) and stops once no unvisited one can win, so it
 returns what :func:`choose` would return with held known everywhere.
+
+Force closure does not see a grasp that slips when lifted (a mug taken from the top by its rim).
+Where the models are shapes warped onto the view, :func:`choose_by_lift` lets the lift test on
+them decide among the few best candidates that pass:
+
+    P(rule, held, lifted | A) = sum_i w_i 1[rule_i(A) and held_i(A) and lifted_i(A)]
 """
 from __future__ import annotations
 
@@ -46,6 +52,7 @@ class PartCheck:
     parts: list
     known: np.ndarray = None
     held_of: Callable = field(default=None, repr=False)
+    lifted_of: Callable = field(default=None, repr=False)
 
     def __post_init__(self):
         if self.known is None:
@@ -62,6 +69,14 @@ class PartCheck:
         p = (np.asarray(self.rule_ok, float) * self.held) @ self.weights
         return np.where(self.known, p, np.nan)
 
+    def p_lifted(self, rows) -> np.ndarray:
+        """P(rule, held, lifted | A) for candidates ``rows`` (held resolved first): the lift test
+        run on each model where the rule holds and the hand is in force closure."""
+        rows = np.asarray(rows, np.int64).ravel()
+        self.resolve(rows)
+        ok = np.asarray(self.rule_ok, float)[rows] * self.held[rows]
+        return (ok * self.lifted_of(rows, ok > 0)) @ self.weights
+
     def resolve(self, rows=None) -> "PartCheck":
         """Compute held for ``rows`` (default: all) where not known yet; returns self."""
         rows = np.arange(len(self.rule_ok)) if rows is None else np.asarray(rows, np.int64).ravel()
@@ -70,6 +85,42 @@ class PartCheck:
             self.held[todo] = self.held_of(todo)
             self.known[todo] = True
         return self
+
+
+def best_passing(check: PartCheck, J, n: int, tiebreak: float = 0.1, batch: int = 4) -> np.ndarray:
+    """Up to ``n`` candidates that pass on some model (P(rule, held | A) > 0), best first by
+    :func:`choose`'s score, held computed only as far as needed (the bound of :func:`choose_lazily`)."""
+    J = np.asarray(J, float)
+    top = J.max() if len(J) and J.max() > 0 else 1.0
+    bound = _scores(check.p_rule, J, top, tiebreak, False)
+    order = [int(k) for k in np.argsort(-bound, kind="stable") if check.p_rule[k] > 0]
+    for start in range(0, len(order), batch):
+        known = np.flatnonzero(check.known & (np.nan_to_num(check.p_success) > 0))
+        if len(known) >= n:
+            s = np.sort(_scores(check.p_success[known], J[known], top, tiebreak, False))[::-1]
+            if s[n - 1] >= bound[order[start]]:
+                break
+        check.resolve(order[start:start + batch])
+    known = np.flatnonzero(check.known & (np.nan_to_num(check.p_success) > 0))
+    s = _scores(check.p_success[known], J[known], top, tiebreak, False)
+    return known[np.argsort(-s, kind="stable")[:n]]
+
+
+def choose_by_lift(check: PartCheck, J, n: int, tiebreak: float = 0.1) -> tuple:
+    """The lift test decides among the ``n`` best passing candidates (:func:`best_passing`): the
+    one of highest P(rule, held, lifted | A) + tiebreak * J / max J, a grasp in force closure may
+    still slip when lifted. Returns (candidate or None when none of them lifts on any model, the
+    number of candidates lift-tested, P(rule, held, lifted) of the choice)."""
+    J = np.asarray(J, float)
+    rows = best_passing(check, J, n, tiebreak)
+    if not len(rows):
+        return None, 0, 0.0
+    p = check.p_lifted(rows)
+    if p.max() <= 0:
+        return None, len(rows), 0.0
+    top = J.max() if J.max() > 0 else 1.0
+    j = int(np.argmax(np.where(p > 0, p + tiebreak * J[rows] / top, -np.inf)))
+    return int(rows[j]), len(rows), float(p[j])
 
 
 def _scores(p, J, top: float, tiebreak: float, product: bool) -> np.ndarray:
@@ -147,6 +198,18 @@ class _Closings:
                 out[sel] = self.world.epsilon_of(b, self.where[rows[sel], 1], threads) > 0.0
         return out
 
+    def lifted(self, rows, threads: int = 1) -> np.ndarray:
+        """The lift test of the closed hands ``rows`` on this model (False where not closed or
+        started in collision)."""
+        out = np.zeros(len(rows), bool)
+        for j, b in enumerate(self.batches):
+            sel = np.flatnonzero(self.where[rows, 0] == j)
+            if len(sel):
+                r = self.where[rows[sel], 1]
+                test = self.world.lift_tester().run_batch(b.hand_pose[r], b.joint_angles[r], threads=threads)
+                out[sel] = np.asarray(test.lifted, bool) & ~np.asarray(b.collision_at_start, bool)[r]
+        return out
+
 
 def _read(rule: TaskRule, batches, where, K: int, from_ok) -> tuple:
     rule_ok, parts = np.zeros(K, bool), [[] for _ in range(K)]
@@ -196,7 +259,16 @@ def _combine(K: int, M: int, weights, per_model: dict, threads: int, resolve: bo
                 h[need, i] = closings.held(rows[need], threads)
         return h
 
-    check = PartCheck(rule_ok, np.zeros((K, M), bool), np.asarray(weights, float), parts, np.zeros(K, bool), held_of)
+    def lifted_of(rows, need):
+        lifted = np.zeros((len(rows), M), bool)
+        for i, (_, _, closings) in per_model.items():
+            sel = np.flatnonzero(need[:, i])
+            if len(sel):
+                lifted[sel, i] = closings.lifted(rows[sel], threads)
+        return lifted
+
+    check = PartCheck(rule_ok, np.zeros((K, M), bool), np.asarray(weights, float), parts, np.zeros(K, bool), held_of,
+                      lifted_of)
     return check.resolve() if resolve else check
 
 

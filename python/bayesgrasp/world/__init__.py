@@ -290,8 +290,10 @@ class World:
             mass = moved(obj.mass_properties_core, T) if given else None
 
             def pieces():   # when a grasp first needs them: the object-frame mesh's (cached across poses), placed
-                return [p @ T[:3, :3].T + T[:3, 3]
-                        for p in physics.convex_decomposition(obj.vertices, obj.faces, name=obj.name)]
+                own = obj.convex_pieces
+                if own is None:
+                    own = physics.convex_decomposition(obj.vertices, obj.faces, name=obj.name)
+                return [p @ T[:3, :3].T + T[:3, 3] for p in own]
             self._lift = physics.LiftTester(self.hand.core, self.vertices, self.faces, convex_pieces=pieces,
                                             mass_properties=mass, mu=self.mu, density=self.object.density,
                                             table=self.table)
