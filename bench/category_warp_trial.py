@@ -17,7 +17,6 @@ import os
 import sys
 import time
 
-import numpy as np
 
 from bayesgrasp.experiments.category import plan_and_execute, see
 from bayesgrasp.experiments.category_grasping import view

@@ -360,3 +360,29 @@ def test_the_lift_test_takes_a_models_own_pieces_without_decomposing(monkeypatch
     monkeypatch.setattr(physics, "convex_decomposition", refuse)
     tester = World.single(hulled, pose=(0.0, 0.0, 0.0), hand=HAND).lift_tester()
     assert tester.concave and tester.num_pieces == 1
+
+
+def test_the_top_grasp_check_on_a_given_shape_closes_on_that_shape_at_the_models_pose():
+    """check_top_grasps(shapes=[S]): the parts each top grasp touches are those on S itself placed
+    at the belief's planar pose (S keeps the model's xy origin); the task term "warped" of the
+    fusion planner uses it with the models warped onto the view."""
+    from bayesgrasp.belief import relative_planar_pose
+    from bayesgrasp.planners.part_check import check_top_grasps
+    from bayesgrasp.world import World
+
+    S = _stretched(sx=1.25)
+    pose = np.array([0.03, -0.02, 0.9])
+    G = np.array([[pose[0] + dx, pose[1] + dy, yaw] for dx in (-0.03, 0.0, 0.03) for dy in (-0.01, 0.01)
+                  for yaw in (0.0, 1.2)])
+    check = check_top_grasps(HAND, task_rule("mug", "top"), G, [MUG], pose[None], [1.0], 0.0, resolve=False,
+                             shapes=[S])
+    direct = World.single(S, pose=(0.0, 0.0, 0.0), hand=HAND, keep_origin=True)
+    b = direct.grasp_batch(relative_planar_pose(G, pose[None, :]), spread=0.0)
+    for k in range(len(G)):
+        lo, hi = b.contacts.offsets[k], b.contacts.offsets[k + 1]
+        assert sorted(check.parts[k][0]) == sorted(p for p in b.contact_part[lo:hi] if p is not None)
+    assert any(check.parts[k][0] for k in range(len(G)))
+    plain = check_top_grasps(HAND, task_rule("mug", "top"), G, [MUG], pose[None], [1.0], 0.0, resolve=False)
+    assert [sorted(p[0]) for p in plain.parts] != [sorted(p[0]) for p in check.parts]   # the shape mattered
+    with pytest.raises(ValueError, match="shapes: one per model"):
+        check_top_grasps(HAND, task_rule("mug", "top"), G, [MUG], pose[None], [1.0], 0.0, shapes=[S, S])

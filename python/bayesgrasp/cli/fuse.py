@@ -10,6 +10,7 @@ import json
 import numpy as np
 
 from . import camera_input
+from ..planners.fusion import TASK_TERMS
 from .args import (CliError, Renamed, add_category_options, add_context_options, bounded_int, context, floats, output_file,
                    output_format, task_grasps_arg)
 
@@ -28,9 +29,12 @@ def add(sub) -> None:
                    help="G(0): planned from the view (Eq. 4.6's task term) or at random above the object")
     f.add_argument("--belief", choices=["map", "particles"], default="map",
                    help="per-model MAP poses (the thesis) or a joint particle belief over (model, pose)")
-    f.add_argument("--task-term", choices=["laplace", "part-aware"], default="laplace",
-                   help="P(T | G): the thesis's Laplace densities at the placed task grasps, or part-aware (also "
-                        "the share of models on which the grasp obeys the task's rule and holds)")
+    f.add_argument("--task-term", choices=list(TASK_TERMS), default="laplace",
+                   help="P(T | G): the thesis's Laplace densities at the placed task grasps, part-aware (also "
+                        "the share of models on which the grasp obeys the task's rule and holds) or warped (that "
+                        "check on the models warped onto the view)")
+    f.add_argument("--avoid-failed", action="store_true",
+                   help="lower Eq. 4.6 near a grasp that did not hold until the belief's object moves away")
     f.add_argument("--recursive", action="store_true", help="Eq. 4.5 recursive: w_i ~ w_i(t-1) L_i")
     f.add_argument("--noise", type=float, default=0.0, help="joint-angle noise sd (rad) in the likelihood")
     add_category_options(f, "the weights and the models' poses per round")
@@ -53,7 +57,7 @@ def run(args) -> int:
     view = camera_input.observe(args)
     ctx = context(args, reads=("success", "models"))     # the training models' P(S) and GPs
     settings = FusionSettings(belief=args.belief, recursive=args.recursive, measurement_noise=args.noise,
-                              task_term=args.task_term)
+                              task_term=args.task_term, avoid_failed=args.avoid_failed)
     grasps = task_grasps_arg(args)
     trial = FusionTrial(args.scene_object, pose, ctx, task=args.task, settings=settings,
                         exclude=args.exclude if args.exclude is not None else [args.scene_object], seed=ctx.seed,
@@ -75,7 +79,8 @@ def run(args) -> int:
                        **({"part": rec["part"]} if "part" in rec else {})})
     success = bool(rounds[-1]["lifted"])       # it stops at the first lift: the last grasp's outcome
     doc = {"scene_object": args.scene_object, "units": args.units, "object_pose": pose, "category": args.category, "task": args.task,
-           "start": args.start, "belief": args.belief, "task_term": args.task_term, "rounds": rounds, "success": success,
+           "start": args.start, "belief": args.belief, "task_term": args.task_term,
+           "avoid_failed": args.avoid_failed, "rounds": rounds, "success": success,
            "scene": (args.cloud or args.depth) if view is not None else "simulated view",
            "cloud": cloud_json(trial.episode.observation.cloud)}
     if fmt == "ros":

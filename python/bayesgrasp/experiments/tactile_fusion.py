@@ -26,7 +26,8 @@ import numpy as np
 from ..models import ModelSettings, relative_top_grasps
 from ..models.tasks import task_rule
 from ..belief.model_mixture import ModelMixtureBelief
-from ..planners.fusion import FusionPlanner, FusionSettings
+from ..planners.fusion import PART_TERMS, FusionPlanner, FusionSettings
+from ..planners.protocol import Reading
 from ..world import World
 from . import report
 from .category import demonstrated, see, training_models
@@ -97,7 +98,7 @@ class FusionTrial:
         """The trial's random stream and the planner on the vision belief (seeded from the stream;
         the belief is its ``belief``)."""
         rng = np.random.default_rng(self.seed)
-        part = self.part_check if self.settings.task_term == "part-aware" else None
+        part = self.part_check if self.settings.task_term in PART_TERMS else None
         return rng, FusionPlanner(self.belief(), self.task_grasps, seed=int(rng.integers(2**31)), part_check=part)
 
     def part_check(self, grasps: np.ndarray, belief: ModelMixtureBelief):
@@ -106,8 +107,21 @@ class FusionTrial:
         from ..planners.part_check import check_top_grasps
 
         hand = self.ctx.hand_model
+        shapes = self.warped_models() if self.settings.task_term == "warped" else None
         return check_top_grasps(hand, self.rule, grasps, self.names, belief.poses, belief.weights, self.spread,
-                                resolve=False)
+                                resolve=False, shapes=shapes)
+
+    def warped_models(self) -> list:
+        """The training models warped onto the view (task term "warped"), once per trial: each
+        from its registration, the cloud reduced to one point per 5 mm voxel as the category
+        planner reduces it."""
+        if getattr(self, "_warped", None) is None:
+            from ..planners.category import CategorySettings, voxel_points, warp_models
+
+            s = CategorySettings()
+            cloud = voxel_points(np.asarray(self.episode.observation.cloud, float), s.clearance_voxel)
+            self._warped = warp_models(self.episode.registrations, self.w0, cloud, s.warp_samples, self.seed)
+        return self._warped
 
     def random_grasp(self, rng: np.random.Generator) -> np.ndarray:
         """G(0) at random in the area above the object: its centre +-3 cm, any yaw."""
@@ -130,7 +144,7 @@ class FusionTrial:
             last = records[-1]
             if (t > 1 or stop_at_lift) and any(r["lifted"] for r in records):
                 break
-            up = planner.observe(last["action"], last["measurement"])
+            up = planner.observe(last["action"], Reading(last["measurement"], held=bool(last["lifted"])))
             plan = planner.plan()
             rec = self._record(t, self._execute(plan.action), belief, plan, up.underflow)
             records.append(rec)
@@ -155,19 +169,20 @@ class FusionTrial:
 
 # ---- the experiment ------------------------------------------------------------------------------------
 def fusion_run(experiment: str, obj: str, run_index: int, seed: int, *, ctx: RunContext, mode: str,
-               belief: str, task_term: str = "laplace") -> dict:
+               belief: str, task_term: str = "laplace", avoid_failed: bool = False) -> dict:
     pose, eye = view(seed)
-    trial = FusionTrial(obj, pose, ctx, settings=FusionSettings(belief=belief, task_term=task_term), eye_offset=eye,
-                        seed=seed % (2**31))
+    trial = FusionTrial(obj, pose, ctx, eye_offset=eye, seed=seed % (2**31),
+                        settings=FusionSettings(belief=belief, task_term=task_term, avoid_failed=avoid_failed))
     out = trial.run(mode)
     baseline = trial.run("vision", rounds=0) if mode == "random" else None
     out.update({"object": obj, "pose": list(pose), "vision_only": baseline["rounds"][0] if baseline else out["rounds"][0]})
     return out
 
 
-def _make(mode: str, belief: str = "map", task_term: str = "laplace"):
+def _make(mode: str, belief: str = "map", task_term: str = "laplace", avoid_failed: bool = False):
     def make(exp: Experiment, method: str, ctx: RunContext):
-        return exp.name, partial(fusion_run, ctx=ctx, mode=mode, belief=belief, task_term=task_term)
+        return exp.name, partial(fusion_run, ctx=ctx, mode=mode, belief=belief, task_term=task_term,
+                                 avoid_failed=avoid_failed)
     return make
 
 
@@ -214,5 +229,10 @@ register(Experiment("pub6_vision", MUGS, 15, "pub6 with G(0) planned from the ca
                     _make("vision"), write_report, ("all",), **PUB6))
 register(Experiment("pub6_part_aware", MUGS, 15, "pub6 with the part-aware task term (Eq. 4.6 x P(rule, held | G))",
                     _make("random", task_term="part-aware"), write_report, ("all",), **PUB6))
+register(Experiment("pub6_part_aware_avoid", MUGS, 15, "pub6_part_aware, a failed grasp's neighbourhood avoided",
+                    _make("random", task_term="part-aware", avoid_failed=True), write_report, ("all",), **PUB6))
+register(Experiment("pub6_warped", MUGS, 15, "pub6 with the part check on the models warped onto the view, a failed "
+                    "grasp's neighbourhood avoided", _make("random", task_term="warped", avoid_failed=True),
+                    write_report, ("all",), **PUB6))
 register(Experiment("pub6_particles", MUGS, 15, "pub6 with a joint particle belief over (model, pose)",
                     _make("random", "particles"), write_report, ("all",), **PUB6))

@@ -155,6 +155,32 @@ def normalised_weights(registrations: Sequence[RegistrationResult]) -> np.ndarra
     return phi / s if s > 0 else phi
 
 
+def warp_models(registrations: Sequence[RegistrationResult], weights, cloud, samples: int = 800,
+                seed: int = 0) -> list:
+    """Per registration: its training model warped onto ``cloud`` (N, 3) by CPD from the
+    registration's transform (an ObjectModel in the model's own frame, the same triangles and part
+    labels: an estimate of the new object's shape; ``params["warp_residual"]`` the RMS distance (m)
+    of the cloud to it; its lift-test pieces the model's own moved by the same warp), or None
+    (weight 0, not registered, or fewer than 10 points: the model as registered)."""
+    from ..decomposition import convex_decomposition
+    from ..objects import ObjectModel, load_object
+    from ..vision.deform import warp_mesh
+
+    cloud = np.asarray(cloud, float).reshape(-1, 3)
+    out = []
+    for r, w in zip(registrations, weights):
+        if w <= 0 or not r.success or len(cloud) < 10:
+            out.append(None)
+            continue
+        m = load_object(r.model)
+        warp = warp_mesh(m, r.transform, cloud, samples=samples, seed=seed)
+        pieces = [warp.warp_points(p) for p in convex_decomposition(m.vertices, m.faces, name=m.name)]
+        out.append(ObjectModel(f"{m.name}~warped", warp.vertices, m.faces, density=m.density,
+                               source=f"{m.source} warped onto the cloud", parts=m.parts, part_names=m.part_names,
+                               params={"warp_residual": float(warp.result.residual)}, convex_pieces=pieces))
+    return out
+
+
 class CategoryPlanner:
     """Eq. 4.1 for one scene: the mixture of the mapped task grasps, searched in C++ batches."""
 
@@ -375,30 +401,12 @@ class CategoryPlanner:
         return w / total if total > 0 else w
 
     def warped_models(self) -> list:
-        """Per registration: its training model warped onto the observed cloud (an ObjectModel in
-        the model's own frame, the same triangles and part labels: an estimate of the new object's
-        shape), or None (weight 0, not registered, or no cloud: the model as registered)."""
-        if self._warped is not None:
-            return self._warped
-        from ..decomposition import convex_decomposition
-        from ..objects import ObjectModel, load_object
-        from ..vision.deform import warp_mesh
-
-        out = []
-        for r, w in zip(self.registrations, self.weights):
-            if w <= 0 or not r.success or len(self.cloud) < 10:
-                out.append(None)
-                continue
-            m = load_object(r.model)
-            warp = warp_mesh(m, r.transform, self.cloud, samples=self.settings.warp_samples, seed=self.seed)
-            # the lift test's convex pieces: the model's own (cached) moved by the same warp
-            pieces = [warp.warp_points(p) for p in convex_decomposition(m.vertices, m.faces, name=m.name)]
-            out.append(ObjectModel(f"{m.name}~warped", warp.vertices, m.faces, density=m.density,
-                                   source=f"{m.source} warped onto the cloud", parts=m.parts,
-                                   part_names=m.part_names, params={"warp_residual": float(warp.result.residual)},
-                                   convex_pieces=pieces))
-        self._warped = out
-        return out
+        """Per registration: its training model warped onto the observed cloud (:func:`warp_models`),
+        computed once."""
+        if self._warped is None:
+            self._warped = warp_models(self.registrations, self.weights, self.cloud, self.settings.warp_samples,
+                                       self.seed)
+        return self._warped
 
     def _intrusions(self, poses: np.ndarray, spreads: np.ndarray) -> np.ndarray:
         d = np.zeros(len(poses))

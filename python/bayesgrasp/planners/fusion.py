@@ -42,7 +42,8 @@ from ..belief.model_mixture import MixtureSettings, ModelMixtureBelief, wrap
 from .part_check import choose_lazily
 from .protocol import as_reading
 
-TASK_TERMS = ("laplace", "part-aware")
+TASK_TERMS = ("laplace", "part-aware", "warped")
+PART_TERMS = ("part-aware", "warped")
 
 
 @dataclass(frozen=True)
@@ -62,10 +63,18 @@ class FusionSettings(MixtureSettings):
     # perturbations of them (half-widths m, rad) up to part_candidates, closed on every model at its
     # pose; the chosen one maximises P(S | G) P(T | G) x P(rule, held | G) (stability counts from
     # round 1 on) and passes the task's rule on some model whenever one does (planners.part_check.choose)
+    # task_term "warped" (issue 53): the same check on the training models warped onto the view
+    # (planners.category.warp_models), the shapes placed by the belief's poses
     task_term: str = "laplace"
     part_candidates: int = 48
     part_translation: float = 0.01
     part_rotation: float = float(np.radians(20.0))
+    # avoid_failed: a grasp that did not hold lowers Eq. 4.6 near it, x (1 - Laplace(G; failed)) with
+    # the scales failed_translation (m) and failed_rotation (rad), until the belief moves: the
+    # heaviest model's pose more than failed_translation away from where it was when the grasp was chosen
+    avoid_failed: bool = False
+    failed_translation: float = 0.01
+    failed_rotation: float = float(np.radians(20.0))
 
     def __post_init__(self):
         super().__post_init__()
@@ -76,7 +85,8 @@ class FusionSettings(MixtureSettings):
         for name in ("part_translation", "part_rotation"):
             if not (np.isfinite(getattr(self, name)) and getattr(self, name) >= 0):
                 raise ValueError(f"{name}: must be >= 0, got {getattr(self, name)}")
-        for name in ("laplace_translation", "laplace_rotation", "search_margin"):
+        for name in ("laplace_translation", "laplace_rotation", "search_margin", "failed_translation",
+                     "failed_rotation"):
             if not getattr(self, name) > 0:
                 raise ValueError(f"{name}: must be positive, got {getattr(self, name)}")
 
@@ -109,8 +119,9 @@ class FusionPlanner:
         (held may be left to compute lazily): needed by task_term part-aware. The planner's settings
         are the belief's when it was made with FusionSettings, else the defaults."""
         self.settings = belief.settings if isinstance(belief.settings, FusionSettings) else FusionSettings()
-        if self.settings.task_term == "part-aware" and part_check is None:
-            raise ValueError("task_term part-aware: needs a part check (see planners.part_check.check_top_grasps)")
+        if self.settings.task_term in PART_TERMS and part_check is None:
+            raise ValueError(f"task_term {self.settings.task_term}: needs a part check "
+                             "(see planners.part_check.check_top_grasps)")
         self.part_check = part_check
         if len(task_grasps) != len(belief.names):
             raise ValueError("task_grasps: need one (K_i, 3) array of planar top task grasps per model")
@@ -122,6 +133,8 @@ class FusionPlanner:
         self.round = 0
         self.observations = 0
         self.previous: Optional[np.ndarray] = None
+        #: grasps that did not hold (x, y, yaw), each with the heaviest model's pose when it was chosen
+        self.failed: List[tuple] = []
 
     def observe(self, grasp, measurement):
         """Eqs. 4.4-4.5 after executing ``grasp`` (the :class:`FusionPlan` executed or its top grasp
@@ -129,9 +142,35 @@ class FusionPlanner:
         angles the models predict); the next plan weighs stability in. Returns the belief's
         UpdateResult; nothing changes when an argument is rejected."""
         action = grasp.action if isinstance(grasp, FusionPlan) else grasp
-        update = self.belief.update(action, as_reading(measurement).joints)
+        reading = as_reading(measurement)
+        anchor = self._anchor()                  # where the belief put the object when the grasp was chosen
+        update = self.belief.update(action, reading.joints)
         self.observations += 1
+        if reading.held is False:
+            self.failed.append((np.asarray(action, float).copy(), anchor))
         return update
+
+    def _anchor(self) -> np.ndarray:
+        """The heaviest model's pose: where the belief puts the object."""
+        return self.belief.poses[int(np.argmax(self.belief.weights))].copy()
+
+    def failure_factor(self, grasps) -> np.ndarray:
+        """prod over the remembered failures of 1 - Laplace(G; failed grasp) (1 without
+        ``avoid_failed``); a failure is forgotten once the belief's object has moved by more than
+        failed_translation from where it was when the failed grasp was chosen."""
+        G = np.atleast_2d(np.asarray(grasps, dtype=float))
+        f = np.ones(len(G))
+        s = self.settings
+        if not s.avoid_failed:
+            return f
+        here = self._anchor()
+        for F, anchor in self.failed:
+            if np.hypot(*(here[:2] - anchor[:2])) > s.failed_translation:
+                continue
+            d = np.hypot(G[:, 0] - F[0], G[:, 1] - F[1]) / s.failed_translation \
+                + np.abs(wrap(G[:, 2] - F[2])) / s.failed_rotation
+            f *= 1.0 - np.exp(-d)
+        return f
 
     def mapped_task_grasps(self) -> List[np.ndarray]:
         """Every model's top task grasps placed by its current pose: per model a (K_i, 3) array."""
@@ -152,7 +191,8 @@ class FusionPlanner:
         return out
 
     def objective(self, grasps, with_stability: bool) -> np.ndarray:
-        t = self.task(grasps)
+        """Eq. 4.6 (the task term alone in round 1), x :meth:`failure_factor`."""
+        t = self.task(grasps) * self.failure_factor(grasps)
         return t * self.belief.stability(grasps) if with_stability else t
 
     def plan(self) -> FusionPlan:
@@ -175,7 +215,7 @@ class FusionPlanner:
         a = np.asarray(r.x, dtype=float)
         a[2] = wrap(a[2])
         objective, part, nfev = float(-r.fun), None, int(r.nfev)
-        if s.task_term == "part-aware":
+        if s.task_term in PART_TERMS:
             C = self._candidates(a, seeds, low, high)
             J = self.objective(C, True)          # the re-ranking weighs stability from round 1 on
             check = self.part_check(C, self.belief)

@@ -330,10 +330,12 @@ def check_candidates(hand: Hand, rule: TaskRule, poses, spreads, registrations: 
 
 
 def check_top_grasps(hand: Hand, rule: TaskRule, grasps, names: Sequence[str], poses, weights,
-                     spread: float, threads: int = 1, resolve: bool = True) -> PartCheck:
+                     spread: float, threads: int = 1, resolve: bool = True, shapes: Sequence = None) -> PartCheck:
     """Planar top grasps ``grasps`` (K, 3: x, y, yaw, world) closed on every model ``names[i]`` of
     weight > 0 placed at its planar pose ``poses[i]`` (x, y, yaw): a :class:`PartCheck` (the
-    vision-then-touch belief's version of :func:`check_candidates`)."""
+    vision-then-touch belief's version of :func:`check_candidates`). ``shapes``: per model an
+    ObjectModel in its frame to close on instead (a warped model resting on the table; None
+    entries: the model)."""
     from ..belief import relative_planar_pose
 
     G = np.atleast_2d(np.asarray(grasps, float))
@@ -341,13 +343,17 @@ def check_top_grasps(hand: Hand, rule: TaskRule, grasps, names: Sequence[str], p
     w = np.asarray(weights, float)
     if not (len(names) == len(P) == len(w)):
         raise ValueError(f"names, poses, weights: one of each per model, got {len(names)}, {len(P)}, {len(w)}")
+    if shapes is not None and len(shapes) != len(names):
+        raise ValueError(f"shapes: one per model ({len(names)}) or None, got {len(shapes)}")
     K = len(G)
     from_above = bool(rule.approach_ok(np.array([[0.0, 0.0, -1.0]]))[0])
     per_model = {}
     for i, name in enumerate(names):
         if w[i] <= 0 or not K:
             continue
-        world = model_world(name, hand, bool(rule.table))
+        shape = None if shapes is None else shapes[i]
+        # a shape keeps the model's xy origin (shape_world): the planar grasps relative to it are the same
+        world = model_world(name, hand, bool(rule.table)) if shape is None else shape_world(shape, hand, rule.table)[0]
         b = world.grasp_batch(relative_planar_pose(G, P[i][None, :]), spread=spread, threads=threads, quality=False)
         where = np.c_[np.zeros(K, np.int64), np.arange(K)]
         r, p = _read(rule, [b], where, K, np.full(K, from_above))
