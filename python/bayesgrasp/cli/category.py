@@ -114,6 +114,12 @@ def _print(doc: dict) -> None:
         print(f"  part check: the rule holds on models of weight {pc['p_rule']:.2f} (and the grasp holds: "
               f"{pc['p_success']:.2f}); {pc['passing_rule']} of {pc['candidates']} candidates obeyed the rule on "
               "some model")
+        if "warps" in pc:
+            print("  warped onto the view: " + ", ".join(f"{n} weight {w['weight']:.2f} ({1000 * w['residual']:.1f} mm)"
+                                                       for n, w in pc["warps"].items()))
+        if pc.get("lift_checked"):
+            print(f"  lift test on the warped shapes decided among the {pc['lift_checked']} best: the chosen grasp "
+                  f"lifts on models of weight {pc['p_lifted']:.2f}")
     if not doc["executed"]:
         x, y, z = (doc["grasp"]["pose"][i][3] for i in range(3))
         print(f"  planned grasp at ({100 * x:.1f}, {100 * y:.1f}, {100 * z:.1f}) cm in the table frame, spread "

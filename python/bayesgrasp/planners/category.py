@@ -372,8 +372,13 @@ class CategoryPlanner:
                                  resolve=False, jitter_yaw=tuple(s.part_jitter_yaw), shapes=shapes)
         k = choose_lazily(check, J, s.part_tiebreak)
         lift = {}
+        if warped:
+            names = [r.model for r in self.registrations]
+            lift["warps"] = {n: {"weight": float(w), "residual": m.params["warp_residual"]}
+                             for n, w, m in zip(names, weights, self.warped_models()) if m is not None}
         if warped and s.warp_lift_top > 0:
-            k, lift = self._decide_by_lift(check, J, k)
+            k, decided = self._decide_by_lift(check, J, k)
+            lift.update(decided)
         plan = self._result(A[k], float(J[k]), None, nfev + len(A) * int(np.count_nonzero(weights > 0)))
         plan.extra.update({"p_rule": float(check.p_rule[k]), "p_success": float(check.p_success[k]),
                            "candidates": int(len(A)), "passing_rule": int(np.count_nonzero(check.p_rule > 0)),
