@@ -229,6 +229,8 @@ register(Experiment("pub6_vision", MUGS, 15, "pub6 with G(0) planned from the ca
                     _make("vision"), write_report, ("all",), **PUB6))
 register(Experiment("pub6_part_aware", MUGS, 15, "pub6 with the part-aware task term (Eq. 4.6 x P(rule, held | G))",
                     _make("random", task_term="part-aware"), write_report, ("all",), **PUB6))
+register(Experiment("pub6_avoid", MUGS, 15, "pub6, a failed grasp's neighbourhood avoided (Eq. 4.6 x 1 - Laplace)",
+                    _make("random", avoid_failed=True), write_report, ("all",), **PUB6))
 register(Experiment("pub6_part_aware_avoid", MUGS, 15, "pub6_part_aware, a failed grasp's neighbourhood avoided",
                     _make("random", task_term="part-aware", avoid_failed=True), write_report, ("all",), **PUB6))
 register(Experiment("pub6_warped", MUGS, 15, "pub6 with the part check on the models warped onto the view, a failed "
