@@ -49,8 +49,9 @@ def test_each_stored_seed_is_the_one_the_run_was_given_and_shared_by_the_seed_na
 
 def test_variants_share_their_base_experiments_seeds():
     assert get_experiment("pub1_variants").seeds == "pub1"
-    assert {get_experiment(n).seeds for n in ("pub6", "pub6_vision", "pub6_part_aware", "pub6_avoid", "pub6_part_aware_avoid",
-                                                "pub6_warped", "pub6_particles")} == {"pub6"}
+    pub6 = ("pub6", "pub6_vision", "pub6_part_aware", "pub6_avoid", "pub6_part_aware_avoid", "pub6_warped",
+            "pub6_particles")
+    assert {get_experiment(n).seeds for n in pub6} == {"pub6"}
     assert get_experiment("pub2").seeds == "pub2"
 
 
