@@ -17,10 +17,10 @@ import time
 
 import numpy as np
 
-from bayesgrasp.experiments.category import demonstrated, observe, register_models, training_models
 from bayesgrasp.experiments.category_grasping import view
-from bayesgrasp.experiments.context import RunContext
-from bayesgrasp.experiments.tactile_fusion import FusionTrial
+from bayesgrasp.loop.category import demonstrated, observe, register_models, training_models
+from bayesgrasp.loop.context import RunContext
+from bayesgrasp.loop.fusion_trial import FusionTrial
 from bayesgrasp.models.tasks import task_rule
 from bayesgrasp.planners.category import CategoryPlanner, CategorySettings
 from bayesgrasp.planners.fusion import FusionSettings

@@ -18,10 +18,10 @@ import sys
 import time
 
 
-from bayesgrasp.experiments.category import plan_and_execute, see
 from bayesgrasp.experiments.category_grasping import view
 from bayesgrasp.experiments.category_stats import wilson
-from bayesgrasp.experiments.context import RunContext
+from bayesgrasp.loop.category import plan_and_execute, see
+from bayesgrasp.loop.context import RunContext
 from bayesgrasp.planners.category import CategorySettings
 
 BIG = 1e9    # a residual scale under which every warp weighs its phi

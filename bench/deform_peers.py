@@ -36,7 +36,7 @@ def rms_radius(Y):
 def data(out: Path, cases: int = 6) -> None:
     """Case k: mug/k seen from view 1000 + k, mug/(k+1) mod 7 registered onto it, its 800 surface
     samples moved there."""
-    from bayesgrasp.experiments.category import observe
+    from bayesgrasp.loop.category import observe
     from bayesgrasp.experiments.category_grasping import view
     from bayesgrasp.objects import load_object
     from bayesgrasp.planners.category import voxel_points

@@ -339,7 +339,7 @@ def test_the_mm_cloud_registers_with_units_mm(mug_scan, capsys):
 def test_the_yaw_profile_of_the_fit_is_lowest_at_the_true_yaw_and_spreads_when_the_yaw_is_ambiguous():
     """A box seen from a camera: its fit over turns about the vertical is lowest at the truth and
     again 180 degrees away (the box's symmetry), so the belief's yaw spread covers both."""
-    from bayesgrasp.experiments.vision_start import vision_start
+    from bayesgrasp.loop.vision_start import vision_start
 
     o = load_object(box_mesh(extent=(0.05, 0.12, 0.08)))
     T = look_at((0.45, -0.35, 0.45), (0.0, 0.0, 0.04))

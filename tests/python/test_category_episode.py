@@ -6,10 +6,10 @@ import numpy as np
 import pytest
 
 from bayesgrasp.cli import main
-from bayesgrasp.experiments.category import (observe, plan_and_execute, register_models, see,
-                                             training_models)
-from bayesgrasp.experiments.context import RunContext
 from bayesgrasp.hand import Hand
+from bayesgrasp.loop.category import (observe, plan_and_execute, register_models, see,
+                                      training_models)
+from bayesgrasp.loop.context import RunContext
 from bayesgrasp.models.task_grasps import (TaskGraspSettings, generate_task_grasps, grasp_to_json,
                                            load_task_grasp_file)
 from bayesgrasp.models.tasks import task_rule

@@ -295,7 +295,7 @@ def test_the_demo_hides_the_mug_where_its_first_grasp_misses(tmp_path):
 
     from bayesgrasp.cli.plan import DEMO_DRAWS, _demo_pose
     from bayesgrasp.experiments import RunContext
-    from bayesgrasp.experiments.episode import EpisodeSettings, run_episode
+    from bayesgrasp.loop.episode import EpisodeSettings, run_episode
     from bayesgrasp.models import ModelSettings
 
     tiny = ModelSettings(n_samples=200, n_inducing=30, max_iter=20, seed=5, n_lift_samples=60, n_calibration=0,
@@ -316,8 +316,8 @@ def test_the_demo_hides_the_mug_where_its_first_grasp_misses(tmp_path):
 def test_episode_new_offers_only_the_methods_an_episode_runs(capsys):
     """The parser's --method choices come from the episodes' own lists: part-aware (which no
     episode runs) is refused by the parser, not accepted and refused later."""
-    from bayesgrasp.experiments.outside_loop import METHODS
-    from bayesgrasp.experiments.outside_loop_category import CATEGORY_METHODS
+    from bayesgrasp.loop.outside_loop import METHODS
+    from bayesgrasp.loop.outside_loop_category import CATEGORY_METHODS
 
     with pytest.raises(SystemExit):
         main(["episode", "new", "--category", "mug", "--task", "side", "--method", "part-aware", "--dir", "x"])

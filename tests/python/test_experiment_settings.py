@@ -6,8 +6,8 @@ import sqlite3
 
 import pytest
 
-from bayesgrasp.experiments.context import RunContext
 from bayesgrasp.experiments.runner import ResultStore, RunKey, run_experiment, settings_difference
+from bayesgrasp.loop.context import RunContext
 
 from testkit import run_cli
 

@@ -5,8 +5,9 @@ import numpy as np
 import pytest
 
 from bayesgrasp.cli import main
-from bayesgrasp.experiments.context import RunContext
-from bayesgrasp.experiments.tactile_fusion import FusionTrial, planar_top_grasps, transitions
+from bayesgrasp.experiments.tactile_fusion import transitions
+from bayesgrasp.loop.context import RunContext
+from bayesgrasp.loop.fusion_trial import FusionTrial, planar_top_grasps
 from bayesgrasp.models import ModelSettings
 from bayesgrasp.models.task_grasps import TaskGraspSettings, generate_task_grasps, grasp_to_json
 from bayesgrasp.models.tasks import task_rule

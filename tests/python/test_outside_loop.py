@@ -10,9 +10,9 @@ import pytest
 
 from bayesgrasp.cli import main
 from bayesgrasp.cli.args import model_settings
-from bayesgrasp.experiments.context import RunContext
-from bayesgrasp.experiments.episode import EpisodeSettings, execute, run_episode
-from bayesgrasp.experiments.outside_loop import PoseEpisode
+from bayesgrasp.loop.context import RunContext
+from bayesgrasp.loop.episode import EpisodeSettings, execute, run_episode
+from bayesgrasp.loop.outside_loop import PoseEpisode
 from bayesgrasp.world import World
 from testkit import cli_json
 
@@ -158,7 +158,7 @@ def test_python_api_resumes_in_a_new_object(tmp_path, cache):
 def test_a_urdf_hand_s_episode_reads_joints_in_the_urdf_s_terms(capsys, tmp_path, cache):
     """With a URDF hand the printed joints are the URDF's, and --joints takes a reading in them: it
     updates the belief exactly as the same reading in our terms does (the Python API's observe)."""
-    from bayesgrasp.experiments.outside_loop_category import open_episode
+    from bayesgrasp.loop.outside_loop_category import open_episode
     from bayesgrasp.hand import Hand
 
     hand = Hand.load("barrett_bh8.urdf")

@@ -8,9 +8,9 @@ import numpy as np
 import pytest
 
 from bayesgrasp.cli import main
-from bayesgrasp.experiments.outside_loop import STATE_FILE
-from bayesgrasp.experiments.outside_loop_category import VIEW_FILE, CategoryTaskEpisode, FusionEpisode, open_episode
-from bayesgrasp.experiments.tactile_fusion import top_grasp
+from bayesgrasp.loop.outside_loop import STATE_FILE
+from bayesgrasp.loop.fusion_trial import top_grasp
+from bayesgrasp.loop.outside_loop_category import VIEW_FILE, CategoryTaskEpisode, FusionEpisode, open_episode
 from bayesgrasp.hand import Hand
 from bayesgrasp.io.grasp_schema import validate
 from testkit import task_grasp_options, without_set

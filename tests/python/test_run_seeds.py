@@ -9,9 +9,9 @@ import numpy as np
 import pytest
 
 from bayesgrasp.experiments import driver, pose_uncertainty, tactile_fusion
-from bayesgrasp.experiments.context import RUN_SEEDS, RunContext
 from bayesgrasp.experiments.registry import EXPERIMENTS, Experiment, get_experiment
 from bayesgrasp.experiments.runner import run_seed
+from bayesgrasp.loop.context import RUN_SEEDS, RunContext
 
 
 def _echo(experiment, obj, run_index, seed, *, method):

@@ -10,8 +10,8 @@ import pytest
 pytest.importorskip("viser")
 
 from bayesgrasp.cli import main  # noqa: E402
-from bayesgrasp.experiments.context import RunContext  # noqa: E402
 from bayesgrasp.experiments.runner import ResultStore, RunKey  # noqa: E402
+from bayesgrasp.loop.context import RunContext  # noqa: E402
 from bayesgrasp.models.settings import ModelSettings  # noqa: E402
 from bayesgrasp.models.task_grasps import TaskGraspSettings, generate_task_grasps  # noqa: E402
 from bayesgrasp.models.tasks import task_rule  # noqa: E402
@@ -28,9 +28,9 @@ KEEP = ("mug/1", "mug/2")
 @pytest.fixture(scope="module")
 def store(tmp_path_factory):
     """A results.sqlite holding one run of each kind, made by the experiments' run code."""
-    from bayesgrasp.experiments.category import plan_and_execute, see
-    from bayesgrasp.experiments.episode import EpisodeSettings, run_episode
-    from bayesgrasp.experiments.tactile_fusion import FusionTrial
+    from bayesgrasp.loop.category import plan_and_execute, see
+    from bayesgrasp.loop.episode import EpisodeSettings, run_episode
+    from bayesgrasp.loop.fusion_trial import FusionTrial
 
     d = tmp_path_factory.mktemp("runs")
     ctx = RunContext(cache_dir=str(d / "models"), model_settings=SMALL)

@@ -190,7 +190,7 @@ def given_settings(args: argparse.Namespace) -> dict:
     """The run-context settings the command line gives: {setting: the option that gives it} for an
     option set to another value than the context's default, and for any --set or --sweep of a
     setting's group (given is given, even at the default value)."""
-    from ..experiments.context import RunContext
+    from ..loop.context import RunContext
 
     values = {"success": getattr(args, "success", RunContext.success), "lift": not getattr(args, "no_lift", False),
               "families": families_arg(getattr(args, "families", ",".join(RunContext.families)))}
@@ -212,9 +212,9 @@ def refuse_unread(args: argparse.Namespace, reads, what: str) -> None:
 
 
 def context(args: argparse.Namespace, progress: bool = True, reads: Optional[Sequence[str]] = None):
-    """The :class:`~bayesgrasp.experiments.context.RunContext` of a command, built once from its
+    """The :class:`~bayesgrasp.loop.context.RunContext` of a command, built once from its
     options; ``reads``: the run settings the command reads (None: all), the others are refused."""
-    from ..experiments.context import RunContext, stderr_progress
+    from ..loop.context import RunContext, stderr_progress
 
     if reads is not None:
         refuse_unread(args, reads, f"`{args.command}`" if getattr(args, "command", None) else "this command")
@@ -249,7 +249,7 @@ SET_BY_OPTION = {"models.success": "--success", "models.family": "--families"}
 
 
 def _set_classes():
-    from ..experiments.context import EpisodeOverrides
+    from ..loop.context import EpisodeOverrides
     from ..models import ModelSettings
     from ..planners import PlannerSettings
 

@@ -79,7 +79,7 @@ def _named(option: str, f, *a, **kw):
 
 
 def observation(view):
-    """A TableView as the category pipeline's :class:`~bayesgrasp.experiments.category.Observation`."""
-    from ..experiments.category import Observation
+    """A TableView as the category pipeline's :class:`~bayesgrasp.loop.category.Observation`."""
+    from ..loop.category import Observation
 
     return Observation(view.object_points, view.viewpoint)

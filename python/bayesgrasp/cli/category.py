@@ -37,7 +37,7 @@ def add(sub) -> None:
 
 
 def run(args) -> int:
-    from ..experiments.category import plan_and_execute, see
+    from ..loop.category import plan_and_execute, see
     from ..io.view_fields import cloud_json
     from ..models.tasks import task_rule
 

@@ -13,9 +13,9 @@ import json
 
 import numpy as np
 
-from ..experiments.episode import EpisodeSettings
-from ..experiments.outside_loop import METHODS as POSE_METHODS          # the episodes' own lists
-from ..experiments.outside_loop_category import CATEGORY_METHODS as _PLANNED_ONCE
+from ..loop.episode import EpisodeSettings
+from ..loop.outside_loop import METHODS as POSE_METHODS          # the episodes' own lists
+from ..loop.outside_loop_category import CATEGORY_METHODS as _PLANNED_ONCE
 from . import camera_input
 from .args import (CliError, add_context_options, add_format_options, bounded_int, context, floats, output_format,
                    task_grasps_arg)
@@ -75,7 +75,7 @@ def add(sub) -> None:
 
 
 def new(args) -> int:
-    from ..experiments.outside_loop import PoseEpisode
+    from ..loop.outside_loop import PoseEpisode
     from .plan import _vision_start, started
 
     fmt = output_format(args)
@@ -110,8 +110,8 @@ def new(args) -> int:
 
 def _new_category(args, fmt: str) -> int:
     """A category task (Pub. V) or vision-then-touch (Pub. VI) episode from one view."""
-    from ..experiments.category import observe
-    from ..experiments.outside_loop_category import CategoryTaskEpisode, FusionEpisode
+    from ..loop.category import observe
+    from ..loop.outside_loop_category import CategoryTaskEpisode, FusionEpisode
     from ..objects import load_object
 
     if not (args.category and args.task):
@@ -142,8 +142,8 @@ def _new_category(args, fmt: str) -> int:
 
 
 def _open(args):
-    from ..experiments.context import stderr_progress
-    from ..experiments.outside_loop_category import open_episode
+    from ..loop.context import stderr_progress
+    from ..loop.outside_loop_category import open_episode
 
     return open_episode(args.dir, cache_dir=args.cache, progress=stderr_progress)
 

@@ -44,7 +44,7 @@ def add(sub) -> None:
 
 
 def run(args) -> int:
-    from ..experiments.tactile_fusion import FusionTrial
+    from ..loop.fusion_trial import FusionTrial
     from ..io.view_fields import cloud_json
     from ..planners.fusion import FusionSettings
 

@@ -7,13 +7,12 @@ from pathlib import Path
 
 import numpy as np
 
+from ..loop.episode import EpisodeSettings
+from ..planners.registry import PLANNERS
 from . import camera_input
 from .args import (CliError, add_context_options, add_families_option, add_format_options, add_object_options,
                    add_view_option, bounded_int, context, floats, object_arg, out_dir, output_file, output_format,
                    parse_set)
-
-from ..experiments.episode import EpisodeSettings
-from ..planners.registry import PLANNERS
 
 METHODS = list(PLANNERS)
 METHOD_HELP = ("stability: the most stable grasp (Eq. 3.1); explore: informative grasps while none is likely to hold "
@@ -76,7 +75,7 @@ def _loop(args, ctx, pose, attempts: int = EpisodeSettings.attempts, estimate=No
     ``start``: the vision start (its spread is the belief's)."""
     from dataclasses import replace
 
-    from ..experiments.episode import EpisodeSettings, run_episode
+    from ..loop.episode import EpisodeSettings, run_episode
     from ..world import World
 
     if attempts < 1:
@@ -137,7 +136,7 @@ def _demo_pose(args, ctx, obj) -> tuple:
     a draw whose first planned grasp already lifts shows nothing of the belief (it never updates),
     so the next is taken, up to DEMO_DRAWS (then the last). The check is the loop's own first
     attempt (the same seed, so the demo repeats it exactly)."""
-    from ..experiments.episode import run_episode
+    from ..loop.episode import run_episode
 
     rng = np.random.default_rng(ctx.seed)
     models = ctx.family_models(obj)
@@ -269,7 +268,7 @@ def _vision_start(args, obj, estimate, quiet: bool, seed: int):
     if "half_width" in parse_set(getattr(args, "set", [])).get("planner", {}):
         raise CliError("--set planner.half_width: not with --cloud or --depth (the belief's spread comes from "
                        "registering to them)")
-    from ..experiments.vision_start import vision_start
+    from ..loop.vision_start import vision_start
 
     start = vision_start(obj, view.object_points, view.viewpoint, seed=seed)
     if not quiet:

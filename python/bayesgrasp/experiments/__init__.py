@@ -1,12 +1,13 @@
 """Experiments that reproduce the thesis's results: each writes tables, plots and per-run results.
 
-:mod:`.context` (what a run needs from its caller), :mod:`.episode` (the closed loop),
 :mod:`.runner` (run by run into SQLite, with resume and workers), :mod:`.registry` (experiments by
 name), :mod:`.driver` (runs one), :mod:`.pose_uncertainty` and :mod:`.report` (the thesis's
-chapter-3 experiments and their tables and plots)."""
-from .context import RunContext
+chapter-3 experiments and their tables and plots). The run context and the closed loop they run
+are a layer below, in :mod:`bayesgrasp.loop`; ``RunContext``, ``EpisodeSettings`` and
+``run_episode`` are re-exported here."""
+from ..loop.context import RunContext
+from ..loop.episode import EpisodeSettings, run_episode
 from .driver import run
-from .episode import EpisodeSettings, run_episode
 from .registry import EXPERIMENTS, Experiment, experiment_names, get_experiment
 from .runner import ResultStore, RunKey, run_experiment, run_seed
 

@@ -17,12 +17,12 @@ from typing import Dict, List
 
 import numpy as np
 
+from ..loop.category import FAILURES, plan_and_execute, see
+from ..loop.context import RunContext
 from ..planners.category import METHODS
 from . import report
-from .category import FAILURES, plan_and_execute, see
 from .category_plots import plot_success
 from .category_stats import orderings, outcome_rows
-from .context import RunContext
 from .registry import Experiment, register
 
 #: The tasks of each held-out category.
@@ -53,8 +53,8 @@ def category_run(experiment: str, obj: str, run_index: int, seed: int, *, ctx: R
 
 def prepare_task_grasps(exp: Experiment, objects: List[str], ctx: RunContext) -> None:
     """The demonstrated grasps of every training model for every task, generated (or loaded) once."""
+    from ..loop.category import demonstrated, training_models
     from ..models.tasks import task_rule
-    from .category import demonstrated, training_models
 
     for cat in sorted({o.split("/")[0] for o in objects}):
         for task in TASKS[cat]:

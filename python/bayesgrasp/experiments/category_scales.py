@@ -16,13 +16,13 @@ from typing import Dict
 
 import numpy as np
 
+from ..loop.category import plan_and_execute, see
+from ..loop.context import RunContext
 from ..planners.category import CategorySettings
 from . import report
-from .category import plan_and_execute, see
-from .category_plots import plot_scale_grid
 from .category_grasping import TASKS, prepare_task_grasps, view
+from .category_plots import plot_scale_grid
 from .category_stats import grid_rows, nested_rows
-from .context import RunContext
 from .registry import Experiment, register
 
 MUGS = tuple(f"mug/{i}" for i in range(7))

@@ -8,7 +8,7 @@ from typing import Dict, List, Mapping, Sequence
 
 import numpy as np
 
-from .category import FAILURES
+from ..loop.category import FAILURES
 
 
 def wilson(k: int, n: int, z: float = 1.96):

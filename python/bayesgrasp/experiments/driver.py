@@ -8,7 +8,7 @@ from functools import partial
 from pathlib import Path
 from typing import Dict, Optional, Sequence
 
-from .context import RunContext
+from ..loop.context import RunContext
 from .engines import LocalEngine
 from .registry import get_experiment
 from .runner import ResultStore, Series, run_all

@@ -30,11 +30,11 @@ import numpy as np
 from scipy import stats
 
 from ..belief import relative_planar_pose, weight_entropy
+from ..loop.context import RunContext
+from ..loop.episode import EpisodeSettings, run_episode
 from ..models import relative_top_grasps
 from ..planners import PLANNERS, PlannerSettings, make_planner
 from ..world import World
-from .context import RunContext
-from .episode import EpisodeSettings, run_episode
 from .pose_uncertainty_plots import plot_belief_evolution
 from .pose_uncertainty_report import write_entropy_order, write_episodes, write_landscapes
 from .registry import Experiment, register

@@ -10,7 +10,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Callable, Dict, List, Optional, Sequence
 
 if TYPE_CHECKING:
-    from .context import RunContext
+    from ..loop.context import RunContext
 
 #: The run context's settings an experiment's runs may read, besides the hand, the cache and the
 #: seed that every one reads (``--set episode.FIELD`` is measurement_noise).

@@ -27,12 +27,12 @@ from typing import Dict, List, Optional
 
 import numpy as np
 
+from ..loop.context import RunContext
+from ..loop.episode import execute
 from ..planners.touch import (TouchModel, TouchPlanner, TouchSettings, orientation_error, read, symmetry_order,
                               touch_world)
 from ..world import World
 from . import report
-from .context import RunContext
-from .episode import execute
 from .registry import Experiment, register
 from .runner import ResultStore
 from .single_touch_plots import plot_errors

@@ -16,7 +16,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Callable, Dict, List, Sequence
 
-from .context import RunContext
+from ..loop.context import RunContext
 from .driver import prepare
 from .engines import LocalEngine
 from .registry import get_experiment

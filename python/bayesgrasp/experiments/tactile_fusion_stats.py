@@ -5,9 +5,8 @@ from __future__ import annotations
 
 from typing import List
 
+from ..loop.fusion_trial import ROUNDS
 from .category_stats import wilson
-
-ROUNDS = 3   # tactile rounds after G(0)
 
 
 def transitions(results: list) -> dict:

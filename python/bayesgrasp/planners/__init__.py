@@ -2,7 +2,7 @@
 :mod:`.stability` (Eq. 3.1), :mod:`.exploration` (Eq. 3.2), :mod:`.baselines`; :mod:`.registry`
 makes one by name; :mod:`.protocol` is the interface every planner of the package has (these,
 :mod:`.category`, :mod:`.fusion`, :mod:`.touch`). The closed loop that runs them against the
-simulator is :mod:`bayesgrasp.experiments.episode`."""
+simulator is :mod:`bayesgrasp.loop.episode`."""
 from ..models import get_models
 from .base import Planner, PlannerSettings
 from .pose_results import Plan, PoseUpdate

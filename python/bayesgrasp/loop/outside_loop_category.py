@@ -6,7 +6,7 @@
   take the vision-then-touch episode).
 - :class:`FusionEpisode` (Pub. VI, §4.3): the same view gives w_i(0) and p_i(0); each reading of
   the fingers updates every model's pose and weight (Eqs. 4.4-4.5) and the next grasp maximises
-  stability x task (Eq. 4.6), as :class:`~.tactile_fusion.FusionTrial` in ``vision`` mode.
+  stability x task (Eq. 4.6), as :class:`~.fusion_trial.FusionTrial` in ``vision`` mode.
 
 The view (the object's cloud in the table frame and the camera centre) is stored once as
 ``view.npz`` beside ``episode.json``, whose state carries its SHA-256; the demonstrated grasps
@@ -31,7 +31,7 @@ from .category import Observation, demonstrated, plan_and_execute, see, training
 from .context import RunContext
 from .outside_loop import (STATE_FILE, DiskEpisode, EpisodeError, PoseEpisode, open_state, particles_digest,
                            predicted_top_grasp, settings_json)
-from .tactile_fusion import FusionTrial
+from .fusion_trial import FusionTrial
 
 VIEW_FILE = "view.npz"
 CATEGORY_METHODS = THESIS_METHODS   # the planners that plan once from a view (fusion: its own episode)
