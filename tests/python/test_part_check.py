@@ -316,12 +316,16 @@ def test_a_warped_models_lift_pieces_are_its_own_moved_by_the_warp():
                               rule=task_rule("mug", "handle"), settings=CategorySettings(method="warped"), seed=1)
     (shape,) = planner.warped_models()
     own = convex_decomposition(m.vertices, m.faces, name=m.name)
-    assert len(shape.convex_pieces) == len(own)
-    W, O = np.concatenate(shape.convex_pieces), np.concatenate(own)
+    assert callable(shape.convex_pieces)                # made when a lift test first needs them
+    pieces = shape.lift_pieces()
+    assert len(pieces) == len(own)
+    W, O = np.concatenate(pieces), np.concatenate(own)
     scale = float(np.sum(W * O) / np.sum(O * O))                  # least squares W ~ scale * O
     assert scale == pytest.approx(1.1, rel=0.02)
     assert np.linalg.norm(W - 1.1 * O, axis=1).max() < 0.012       # CPD lets points slide along the surface
-    assert shape.transformed(np.eye(4)).convex_pieces is not None   # a copy keeps them
+    T2 = placed(1.0, (0.1, 0.2, 0.0))
+    moved = shape.transformed(T2).lift_pieces()                  # a moved copy moves them
+    np.testing.assert_allclose(np.concatenate(moved), W @ T2[:3, :3].T + T2[:3, 3], atol=1e-12)
 
 
 def test_the_warps_weigh_by_how_well_each_fits_the_view():
@@ -339,6 +343,7 @@ def test_the_warps_weigh_by_how_well_each_fits_the_view():
     w = planner.warp_weights()
     expected = 0.5 * np.exp(-(r - r.min()) / planner.settings.warp_residual_scale)
     np.testing.assert_allclose(w, expected / expected.sum())
+    assert all(callable(m.convex_pieces) for m in planner.warped_models())   # no lift test: not decomposed
     assert w[np.argmin(r)] > w[np.argmax(r)] or r[0] == r[1]
     with pytest.raises(ValueError, match="warp_residual_scale"):
         CategorySettings(method="warped", warp_residual_scale=0.0)

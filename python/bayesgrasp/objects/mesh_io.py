@@ -18,7 +18,7 @@ import sys
 import warnings
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Optional, Tuple, Union
+from typing import Callable, Optional, Tuple, Union
 
 import numpy as np
 
@@ -39,6 +39,13 @@ MESH_EXTENSIONS = (".obj", ".stl", ".ply")
 
 class MeshWarning(UserWarning):
     """A mesh problem that does not stop loading (e.g. it is not watertight)."""
+
+
+def _checked_pieces(pieces, name: str) -> list:
+    out = [np.asarray(p, dtype=np.float64) for p in pieces]
+    if not out or any(p.ndim != 2 or p.shape[1] != 3 or len(p) < 4 or not np.all(np.isfinite(p)) for p in out):
+        raise ValueError(f"convex_pieces of '{name}': expected a non-empty list of finite (K, 3) arrays with K >= 4")
+    return out
 
 
 @dataclass
@@ -75,9 +82,10 @@ class ObjectModel:
     #: (mass properties in this frame or None, their method, watertight) already known: a copy's
     known_mass: Optional[tuple] = field(default=None, repr=False, compare=False)
     #: the convex pieces ((K_i, 3) arrays, this frame) the lift test uses, when known without a
-    #: decomposition (a warped model's: its training model's pieces moved by the same warp); None:
-    #: the lift test decomposes the mesh (CoACD, cached)
-    convex_pieces: Optional[list] = field(default=None, repr=False, compare=False)
+    #: decomposition (a warped model's: its training model's pieces moved by the same warp), or a
+    #: callable returning them when the lift test first needs them; None: the lift test decomposes
+    #: the mesh (CoACD, cached)
+    convex_pieces: Optional[Union[list, Callable[[], list]]] = field(default=None, repr=False, compare=False)
 
     def __post_init__(self):
         V = np.ascontiguousarray(np.asarray(self.vertices, dtype=np.float64))
@@ -121,13 +129,8 @@ class ObjectModel:
                               f"properties are those of {how}; pass mass= (--mass) to give its weight",
                               MeshWarning, stacklevel=3)
         self.known_mass = None
-        if self.convex_pieces is not None:
-            pieces = [np.asarray(p, dtype=np.float64) for p in self.convex_pieces]
-            if not pieces or any(p.ndim != 2 or p.shape[1] != 3 or len(p) < 4 or not np.all(np.isfinite(p))
-                                 for p in pieces):
-                raise ValueError(f"convex_pieces of '{self.name}': expected a non-empty list of finite (K, 3) "
-                                 "arrays with K >= 4")
-            self.convex_pieces = pieces
+        if self.convex_pieces is not None and not callable(self.convex_pieces):
+            self.convex_pieces = _checked_pieces(self.convex_pieces, self.name)
         if self.given_mass is not None:
             if not (np.isfinite(self.given_mass) and self.given_mass > 0):
                 raise ValueError(f"mass must be finite and > 0 kg, got {self.given_mass}")
@@ -184,6 +187,12 @@ class ObjectModel:
     def n_faces(self) -> int:
         return int(len(self.faces))
 
+    def lift_pieces(self) -> Optional[list]:
+        """:attr:`convex_pieces`, computed first if given as a callable (then kept); None: not given."""
+        if callable(self.convex_pieces):
+            self.convex_pieces = _checked_pieces(self.convex_pieces(), self.name)
+        return self.convex_pieces
+
     def transformed(self, T: np.ndarray, name: Optional[str] = None) -> "ObjectModel":
         """A copy with vertices mapped by the 4x4 transform ``T`` (rigid: the same object, its
         mass too; otherwise, e.g. scaled, a new shape at this density)."""
@@ -203,7 +212,7 @@ class ObjectModel:
                            parts=None if self.parts is None else self.parts.copy(), part_names=self.part_names,
                            given_mass=self.given_mass if rigid else None, known_mass=known,
                            convex_pieces=None if self.convex_pieces is None
-                           else [p @ T[:3, :3].T + T[:3, 3] for p in self.convex_pieces])
+                           else (lambda: [p @ T[:3, :3].T + T[:3, 3] for p in self.lift_pieces()]))
 
     def with_mass(self, mass: float) -> "ObjectModel":
         """A copy weighing ``mass`` kg (a scale's reading): same shape, density = mass / volume."""

@@ -36,6 +36,7 @@ weights phi.
 from __future__ import annotations
 
 from dataclasses import dataclass
+from functools import partial
 from typing import List, Optional, Sequence
 
 import numpy as np
@@ -155,14 +156,22 @@ def normalised_weights(registrations: Sequence[RegistrationResult]) -> np.ndarra
     return phi / s if s > 0 else phi
 
 
+def _warped_pieces(model, warp) -> list:
+    """The model's convex pieces (its cached decomposition) moved by the warp: the warped shape's
+    pieces for the lift test, made when a lift test first needs them."""
+    from ..decomposition import convex_decomposition
+
+    return [warp.warp_points(p) for p in convex_decomposition(model.vertices, model.faces, name=model.name)]
+
+
 def warp_models(registrations: Sequence[RegistrationResult], weights, cloud, samples: int = 800,
                 seed: int = 0) -> list:
     """Per registration: its training model warped onto ``cloud`` (N, 3) by CPD from the
     registration's transform (an ObjectModel in the model's own frame, the same triangles and part
     labels: an estimate of the new object's shape; ``params["warp_residual"]`` the RMS distance (m)
-    of the cloud to it; its lift-test pieces the model's own moved by the same warp), or None
+    of the cloud to it; its lift-test pieces the model's own moved by the same warp, made when first
+    needed), or None
     (weight 0, not registered, or fewer than 10 points: the model as registered)."""
-    from ..decomposition import convex_decomposition
     from ..objects import ObjectModel, load_object
     from ..vision.deform import warp_mesh
 
@@ -174,10 +183,10 @@ def warp_models(registrations: Sequence[RegistrationResult], weights, cloud, sam
             continue
         m = load_object(r.model)
         warp = warp_mesh(m, r.transform, cloud, samples=samples, seed=seed)
-        pieces = [warp.warp_points(p) for p in convex_decomposition(m.vertices, m.faces, name=m.name)]
         out.append(ObjectModel(f"{m.name}~warped", warp.vertices, m.faces, density=m.density,
                                source=f"{m.source} warped onto the cloud", parts=m.parts, part_names=m.part_names,
-                               params={"warp_residual": float(warp.result.residual)}, convex_pieces=pieces))
+                               params={"warp_residual": float(warp.result.residual)},
+                               convex_pieces=partial(_warped_pieces, m, warp)))
     return out
 
 

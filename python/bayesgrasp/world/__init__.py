@@ -290,7 +290,7 @@ class World:
             mass = moved(obj.mass_properties_core, T) if given else None
 
             def pieces():   # when a grasp first needs them: the object-frame mesh's (cached across poses), placed
-                own = obj.convex_pieces
+                own = obj.lift_pieces()
                 if own is None:
                     own = physics.convex_decomposition(obj.vertices, obj.faces, name=obj.name)
                 return [p @ T[:3, :3].T + T[:3, 3] for p in own]
