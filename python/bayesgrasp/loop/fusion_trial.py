@@ -77,6 +77,7 @@ class FusionTrial:
         self.settings = settings or FusionSettings()
         self.world = None if obj is None else World.single(obj, pose=pose, hand=ctx.hand)
         self.spread = float(np.median([m.spread for m in self.models]))
+        self._warped: Optional[list] = None     # the models warped onto the view, when first needed
 
     def belief(self) -> ModelMixtureBelief:
         w = self.w0 if self.w0.sum() > 0 else np.ones(len(self.w0))
@@ -103,7 +104,7 @@ class FusionTrial:
         """The training models warped onto the view (task term "warped"), once per trial: each
         from its registration, the cloud reduced to one point per 5 mm voxel as the category
         planner reduces it."""
-        if getattr(self, "_warped", None) is None:
+        if self._warped is None:
             from ..planners.category import CategorySettings, voxel_points, warp_models
 
             s = CategorySettings()

@@ -380,18 +380,17 @@ class CategoryPlanner:
         check = check_candidates(self.hand, self.rule, A, spreads, self.registrations, weights, s.threads,
                                  resolve=False, jitter_yaw=tuple(s.part_jitter_yaw), shapes=shapes)
         k = choose_lazily(check, J, s.part_tiebreak)
-        lift = {}
+        extra = {}
         if warped:
-            names = [r.model for r in self.registrations]
-            lift["warps"] = {n: {"weight": float(w), "residual": m.params["warp_residual"]}
-                             for n, w, m in zip(names, weights, self.warped_models()) if m is not None}
-        if warped and s.warp_lift_top > 0:
-            k, decided = self._decide_by_lift(check, J, k)
-            lift.update(decided)
+            extra["warps"] = {r.model: {"weight": float(w), "residual": m.params["warp_residual"]}
+                              for r, w, m in zip(self.registrations, weights, shapes) if m is not None}
+            if s.warp_lift_top > 0:
+                k, decided = self._decide_by_lift(check, J, k)
+                extra.update(decided)
         plan = self._result(A[k], float(J[k]), None, nfev + len(A) * int(np.count_nonzero(weights > 0)))
         plan.extra.update({"p_rule": float(check.p_rule[k]), "p_success": float(check.p_success[k]),
                            "candidates": int(len(A)), "passing_rule": int(np.count_nonzero(check.p_rule > 0)),
-                           "held_checked": int(np.count_nonzero(check.known)), **lift,
+                           "held_checked": int(np.count_nonzero(check.known)), **extra,
                            "contact_parts_on_models": {r.model: check.parts[k][i]
                                                        for i, r in enumerate(self.registrations) if weights[i] > 0}})
         return plan

@@ -91,7 +91,7 @@ def best_passing(check: PartCheck, J, n: int, tiebreak: float = 0.1, batch: int 
     """Up to ``n`` candidates that pass on some model (P(rule, held | A) > 0), best first by
     :func:`choose`'s score, held computed only as far as needed (the bound of :func:`choose_lazily`)."""
     J = np.asarray(J, float)
-    top = J.max() if len(J) and J.max() > 0 else 1.0
+    top = _top(J)
     bound = _scores(check.p_rule, J, top, tiebreak, False)
     order = [int(k) for k in np.argsort(-bound, kind="stable") if check.p_rule[k] > 0]
     for start in range(0, len(order), batch):
@@ -118,9 +118,14 @@ def choose_by_lift(check: PartCheck, J, n: int, tiebreak: float = 0.1) -> tuple:
     p = check.p_lifted(rows)
     if p.max() <= 0:
         return None, len(rows), 0.0
-    top = J.max() if J.max() > 0 else 1.0
+    top = _top(J)
     j = int(np.argmax(np.where(p > 0, p + tiebreak * J[rows] / top, -np.inf)))
     return int(rows[j]), len(rows), float(p[j])
+
+
+def _top(J: np.ndarray) -> float:
+    """max J, the normaliser of the tie-break (1 when no J is positive)."""
+    return float(J.max()) if len(J) and J.max() > 0 else 1.0
 
 
 def _scores(p, J, top: float, tiebreak: float, product: bool) -> np.ndarray:
@@ -134,7 +139,7 @@ def choose(p_success, J, tiebreak: float = 0.1, product: bool = False) -> int:
     passes, the one of highest J. So a candidate the part check rejects on every model is never
     chosen while one that passes exists."""
     p, J = np.asarray(p_success, float), np.asarray(J, float)
-    top = J.max() if len(J) and J.max() > 0 else 1.0
+    top = _top(J)
     return int(np.argmax(_scores(p, J, top, tiebreak, product)))
 
 
@@ -142,7 +147,7 @@ def choose_lazily(check: PartCheck, J, tiebreak: float = 0.1, product: bool = Fa
     """:func:`choose` on ``check``'s P(rule, held | A), computing held only for the candidates that
     could still win (branch and bound on P(rule, held) <= P(rule)); the same answer, ties included."""
     J = np.asarray(J, float)
-    top = J.max() if len(J) and J.max() > 0 else 1.0
+    top = _top(J)
     bound = _scores(check.p_rule, J, top, tiebreak, product)
     order = np.argsort(-bound, kind="stable")
     for start in range(0, len(order), batch):
@@ -190,25 +195,26 @@ class _Closings:
     batches: list
     where: np.ndarray      # (K, 2): batch index, row
 
-    def held(self, rows, threads: int = 1) -> np.ndarray:
+    def _per_batch(self, rows, verdict: Callable) -> np.ndarray:
+        """``verdict(batch, batch rows)`` -> bool per row, gathered for the candidates ``rows``
+        (False where a candidate was not closed)."""
         out = np.zeros(len(rows), bool)
         for j, b in enumerate(self.batches):
             sel = np.flatnonzero(self.where[rows, 0] == j)
             if len(sel):
-                out[sel] = self.world.epsilon_of(b, self.where[rows[sel], 1], threads) > 0.0
+                out[sel] = verdict(b, self.where[rows[sel], 1])
         return out
+
+    def held(self, rows, threads: int = 1) -> np.ndarray:
+        return self._per_batch(rows, lambda b, r: self.world.epsilon_of(b, r, threads) > 0.0)
 
     def lifted(self, rows, threads: int = 1) -> np.ndarray:
         """The lift test of the closed hands ``rows`` on this model (False where not closed or
         started in collision)."""
-        out = np.zeros(len(rows), bool)
-        for j, b in enumerate(self.batches):
-            sel = np.flatnonzero(self.where[rows, 0] == j)
-            if len(sel):
-                r = self.where[rows[sel], 1]
-                test = self.world.lift_tester().run_batch(b.hand_pose[r], b.joint_angles[r], threads=threads)
-                out[sel] = np.asarray(test.lifted, bool) & ~np.asarray(b.collision_at_start, bool)[r]
-        return out
+        def lift(b, r):
+            test = self.world.lift_tester().run_batch(b.hand_pose[r], b.joint_angles[r], threads=threads)
+            return np.asarray(test.lifted, bool) & ~np.asarray(b.collision_at_start, bool)[r]
+        return self._per_batch(rows, lift)
 
 
 def _read(rule: TaskRule, batches, where, K: int, from_ok) -> tuple:
