@@ -84,6 +84,12 @@ void bind_options(py::module_& m) {
       .field("solver_residual", &LiftOptions::solver_residual, "float",
              "a step's solver iterations end once Bullet's least-squares residual is below this (its units); 0 "
              "(default) runs them all.")
+      .field("warmstart_factor", &LiftOptions::warmstart_factor, "float",
+             "share of a contact's impulses of the last step each step starts from (Bullet's warm start, 0..1; "
+             "default 0.85).")
+      .field("friction_direction_caching", &LiftOptions::friction_direction_caching, "bool",
+             "keep each contact's two friction directions from step to step, so its friction impulses warm-start "
+             "too (default False).")
       .field("squeeze_time", &LiftOptions::squeeze_time, "float", "s, the palm still while the fingers tighten.")
       .field("lift_height", &LiftOptions::lift_height, "float", "m the palm rises.")
       .field("lift_time", &LiftOptions::lift_time, "float", "s the rise takes.")

@@ -71,6 +71,22 @@ def test_the_solver_stop_level_reaches_bullet():
             physics.lift_test(None, POSE, OPEN, V, F, solver_residual=bad)
 
 
+def test_warm_start_and_friction_caching_reach_bullet():
+    # warm start 0 starts every contact's impulse from nothing: a different run from the default's
+    # 0.85 (the held box moves differently); the open hand touches nothing, so no setting changes it
+    base = physics.lift_test(None, POSE, GOOD, V, F, density=400.0)
+    cold = physics.lift_test(None, POSE, GOOD, V, F, density=400.0, warmstart_factor=0.0)
+    cached = physics.lift_test(None, POSE, GOOD, V, F, density=400.0, friction_direction_caching=True)
+    assert cold.displacement != base.displacement and cached.displacement != base.displacement
+    rest = physics.lift_test(None, POSE, OPEN, V, F, density=400.0)
+    for kw in ({"warmstart_factor": 0.0}, {"friction_direction_caching": True}):
+        r = physics.lift_test(None, POSE, OPEN, V, F, density=400.0, **kw)
+        assert r.lifted == rest.lifted and r.height_gain == pytest.approx(rest.height_gain, abs=1e-6)
+    for bad in (-0.1, 1.5, float("nan")):
+        with pytest.raises(ValueError, match="warmstart_factor"):
+            physics.lift_test(None, POSE, OPEN, V, F, warmstart_factor=bad)
+
+
 def test_options_and_shapes():
     assert physics.make_options(shape="decomposition").shape == "decomposition"
     o = physics.make_options(mu=0.3, shape="tetrahedra", table=False)

@@ -22,6 +22,10 @@ BulletWorld::BulletWorld(const LiftOptions& o)
   world_.getSolverInfo().m_numIterations = o.solver_iterations;
   world_.getSolverInfo().m_leastSquaresResidualThreshold = btScalar(o.solver_residual);
   world_.getSolverInfo().m_solverMode |= SOLVER_USE_2_FRICTION_DIRECTIONS;
+  world_.getSolverInfo().m_warmstartingFactor = btScalar(o.warmstart_factor);
+  if (o.friction_direction_caching)
+    world_.getSolverInfo().m_solverMode |=
+        SOLVER_ENABLE_FRICTION_DIRECTION_CACHING | SOLVER_DISABLE_VELOCITY_DEPENDENT_FRICTION_DIRECTION;
 }
 
 BulletWorld::~BulletWorld() {

@@ -30,6 +30,7 @@ void validate(const LiftOptions& o) {
   require_positive(o.time_step, "time_step");
   require_at_least(o.solver_iterations, 1, "solver_iterations");
   require_non_negative(o.solver_residual, "solver_residual");
+  require_in(o.warmstart_factor, 0.0, 1.0, "warmstart_factor");
   require_non_negative(o.squeeze_time, "squeeze_time");
   require_non_negative(o.lift_height, "lift_height");
   require_positive(o.lift_time, "lift_time");

@@ -138,6 +138,12 @@ struct LiftOptions {
   int solver_iterations = 100;
   double solver_residual = 0.0;  // Bullet's m_leastSquaresResidualThreshold (its units): a step's
                                  // iterations end once the residual is below it; 0 = run them all
+  // Warm start (Bullet's m_warmstartingFactor: the share of a contact's last impulses a step starts
+  // from) and friction directions kept from step to step (SOLVER_ENABLE_FRICTION_DIRECTION_CACHING
+  // with SOLVER_DISABLE_VELOCITY_DEPENDENT_FRICTION_DIRECTION): without the cache a contact's two
+  // friction directions are rebuilt every step, so its friction impulses start again from 0.
+  double warmstart_factor = 0.85;
+  bool friction_direction_caching = false;
   double squeeze_time = 0.15;   // s
   double lift_height = 0.10;    // m
   double lift_time = 0.40;      // s
