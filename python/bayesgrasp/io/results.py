@@ -12,6 +12,7 @@ results database read:
     touch_document(trial, ...)    # ``bayesgrasp touch``: one touch and its fit (a TouchTrial)
     fusion_dict(result)           # a vision-then-touch trial (a FusionResult), as stored
     fuse_document(result, ...)    # ``bayesgrasp fuse``: the same for the user and the viewer
+    grasp_document(grasp, ...)    # ``bayesgrasp grasp``: one grasp in a world (a WorldGrasp)
 
 Aliases kept for one release (users read them): in a plan document's attempt, ``plan_type`` is
 the episode record's ``kind``, ``top_grasp`` repeats ``action`` for a top grasp (None for other
@@ -25,6 +26,7 @@ from typing import Optional, Sequence
 
 import numpy as np
 
+from .grasp_schema import hand_grasp_record
 from .view_fields import belief_json, cloud_json
 
 
@@ -206,3 +208,38 @@ def fuse_document(r, rounds: list, episode, settings, *, category: Optional[str]
             "task_term": settings.task_term, "avoid_failed": settings.avoid_failed, "rounds": rounds,
             "success": r.success, "scene": scene, "cloud": cloud_json(episode.observation.cloud)}
 
+
+_MASS_METHODS = {"mesh": "its closed mesh", "fill": "the solid its open mesh bounds (sampled)",
+                 "shell": "its open mesh as a thin shell"}
+
+
+def mass_source(obj) -> str:
+    """Where an object's mass comes from: given (--mass) or how its mesh was weighed."""
+    return "given (--mass)" if obj.given_mass is not None else _MASS_METHODS[obj.mass_method]
+
+
+def mass_dict(obj) -> dict:
+    """The mass the lift test uses (kg), where it comes from, and the density."""
+    return {"kg": float(obj.mass), "from": mass_source(obj), "density": float(obj.density)}
+
+
+def _approach_dict(a) -> Optional[dict]:
+    return None if a is None else {"direction": a.direction, "roll": a.roll, "target": a.target}
+
+
+def grasp_document(g, request, world, *, object_name: str, object_pose, frame: str, units: Optional[str],
+                   spread: float) -> dict:
+    """``bayesgrasp grasp``'s JSON of a :class:`~bayesgrasp.world.WorldGrasp` made in ``world``
+    for ``request`` (its ``mode`` and the one input: ``top``, ``approach`` or ``pose``, in
+    ``frame``); ``grasp`` is the same grasp in the grasp schema."""
+    return {
+        "object": object_name, "object_pose": object_pose, "top": request.top, "hand": world.hand.name,
+        "joint_angles": [float(v) for v in g.joint_angles], "joint_names": list(world.hand.core.joint_names),
+        "contacts": [c.to_dict() for c in g.contacts], "epsilon": g.epsilon, "volume": g.volume,
+        "lifted": g.lifted, "lift_displacement": g.lift_displacement, "collision_at_start": g.collision_at_start,
+        "hand_pose": _list(g.hand_pose), "mode": request.mode, "input_frame": frame,
+        "approach": _approach_dict(request.approach), "pose": request.pose,
+        "stopped_by_table": g.stopped_by_table, "hand_pose_object": _list(g.hand_pose_object),
+        "mass": mass_dict(world.object), "units": units,
+        "grasp": hand_grasp_record(world.hand, g.hand_pose, g.joint_angles, spread),
+    }
