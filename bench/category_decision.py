@@ -20,7 +20,7 @@ import numpy as np
 from bayesgrasp.experiments.category_grasping import view
 from bayesgrasp.loop.category import demonstrated, observe, register_models, training_models
 from bayesgrasp.loop.context import RunContext
-from bayesgrasp.loop.fusion_trial import FusionTrial
+from bayesgrasp.loop.fusion_trial import FusionTrial, top_grasp
 from bayesgrasp.models.tasks import task_rule
 from bayesgrasp.planners.category import CategoryPlanner, CategorySettings
 from bayesgrasp.planners.fusion import FusionSettings
@@ -63,7 +63,7 @@ def main():
             trial = FusionTrial(obj, pose, ctx, eye_offset=eye, seed=k, settings=FusionSettings(task_term=term))
             _, planner = trial.start()
             g0 = planner.plan().action
-            m = trial._execute(g0)["measurement"]
+            m = trial.measurement(top_grasp(trial.world, np.asarray(g0, float), trial.pose, trial.spread))
             t3 = time.perf_counter()
             planner.observe(g0, m)
             t4 = time.perf_counter()

@@ -43,7 +43,7 @@ def run_view(obj: str, k: int, ctx: RunContext) -> dict:
     for task in TASKS:
         for name, s in VARIANTS.items():
             t0 = time.perf_counter()
-            r = plan_and_execute(ep, "mug", task, s.method, ctx, settings=s, seed=seed)
+            r = plan_and_execute(ep, "mug", task, s.method, ctx, settings=s, seed=seed).to_dict()
             out[f"{task}/{name}"] = {"success": bool(r["success"]), "lifted": bool(r.get("lifted")),
                                      "task_ok": bool(r.get("task_ok")), "failure": r.get("failure"),
                                      "seconds": time.perf_counter() - t0}

@@ -56,7 +56,7 @@ def main():
         ep = CategoryEpisode(mug, tuple(pose), models, o, register_models(o, models, seed))
         for task in TASKS:
             for method in METHODS:
-                r = plan_and_execute(ep, "mug", task, method, ctx, seed=seed)
+                r = plan_and_execute(ep, "mug", task, method, ctx, seed=seed).to_dict()
                 rows.append({"view": k, "seed": seed, "task": task, "method": method, "success": bool(r["success"]),
                              "lifted": bool(r.get("lifted")), "task_ok": bool(r.get("task_ok")),
                              "failure": r.get("failure"), "contact_parts": r.get("contact_parts")})

@@ -57,7 +57,7 @@ def problem(obj, models, rng, seed):
     est = pose + rng.uniform(-1, 1, 3) * np.array([0.04, 0.04, np.radians(45)])
     ep = run_episode(obj, pose, EpisodeSettings(method="stability", attempts=1, stop_when_stable=False),
                      RunContext(success="epsilon", lift=False), seed=seed, estimate=est, models=models)
-    a0 = ep["attempts"][0]     # a top grasp: the executed Plan names its family for the two-family planners
+    a0 = ep.to_dict()["attempts"][0]     # a top grasp: the executed Plan names its family for the two-family planners
     plan = Plan(np.array(a0["action"]), a0["kind"], a0["predicted_stability"], a0["predicted_stability"], family="top")
     return est, (plan, Reading(a0["joint_angles"], held=a0["stable"]))
 

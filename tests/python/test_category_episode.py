@@ -93,14 +93,14 @@ def test_a_held_out_mug_is_registered_planned_and_executed(grasp_file):
     assert len(ep.registrations) == 6 and any(r.success for r in ep.registrations)
     ctx = RunContext()
     for method in ("laplace", "baseline"):
-        out = plan_and_execute(ep, "mug", "top", method, ctx, seed=1, grasps=grasps)
+        out = plan_and_execute(ep, "mug", "top", method, ctx, seed=1, grasps=grasps).to_dict()
         assert out["plan_ok"] and out["executed"]
         assert out["dominant_model"] in ("mug/1", "mug/2")
         assert sum(out["weights"].values()) == pytest.approx(1.0)
         assert out["success"] == (out["lifted"] and out["task_ok"])
         assert (out["failure"] is None) == out["success"]
     # models without demonstrated grasps: an explicit no-grasp result, never a silent grasp
-    none = plan_and_execute(ep, "mug", "top", "laplace", ctx, grasps=[g for g in grasps if g.model == "mug/9"])
+    none = plan_and_execute(ep, "mug", "top", "laplace", ctx, grasps=[g for g in grasps if g.model == "mug/9"]).to_dict()
     assert not none["executed"] and "no demonstrated grasps" in none["reason"]
 
 

@@ -308,9 +308,9 @@ def test_the_demo_hides_the_mug_where_its_first_grasp_misses(tmp_path):
     draws = [[rng.uniform(-0.08, 0.08), rng.uniform(-0.08, 0.08), rng.uniform(-np.pi, np.pi)] for _ in range(DEMO_DRAWS)]
     assert pose == [float(v) for v in draws[skipped]]
     first = lambda p, n: run_episode("mug", p, EpisodeSettings(method="explore", attempts=n), ctx, seed=ctx.seed)  # noqa: E731
-    assert all(first(draws[k], 1)["attempts"][0]["success"] for k in range(skipped))
+    assert all(first(draws[k], 1).attempts[0].success for k in range(skipped))
     full = first(pose, 4)
-    assert not full["attempts"][0]["success"] and len(full["attempts"]) >= 2
+    assert not full.attempts[0].success and len(full.attempts) >= 2
 
 
 def test_episode_new_offers_only_the_methods_an_episode_runs(capsys):

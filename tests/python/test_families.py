@@ -120,7 +120,7 @@ def test_episode_executes_the_planned_family(cylinder):
     ctx = RunContext(families="top,side")
     r = run_episode("cylinder", (0.02, -0.01, 0.4), EpisodeSettings(method="stability", attempts=2), ctx, seed=0,
                     models=cylinder)
-    for a in r["attempts"]:
+    for a in r.to_dict()["attempts"]:
         assert a["family"] in FAMILIES and a["variant"]["family"] == a["family"]
         assert a["lifted"] is not None and a["success"] == a["lifted"]
 
@@ -166,5 +166,5 @@ def test_side_grasp_is_planned_when_no_top_grasp_can_lift(tmp_path):
     models = {f: get_models(obj, settings=ModelSettings(**SMALL, family=f), cache_dir=str(tmp_path)) for f in FAMILIES}
     ctx = RunContext(families="top,side")
     r = run_episode(obj, (0.01, 0.02, 0.3), EpisodeSettings(method="stability"), ctx, seed=0, models=models)
-    assert all(a["family"] == "side" for a in r["attempts"])
-    assert r["success"] and r["attempts"][-1]["lifted"]
+    assert all(a.plan.family == "side" for a in r.attempts)
+    assert r.success and r.attempts[-1].lifted

@@ -48,7 +48,8 @@ def test_a_trial_runs_rounds_until_a_lift_with_normalised_weights(grasps, cache,
     trial = FusionTrial("mug/3", (0.01, 0.02, 0.7), ctx, exclude=EXCLUDE, seed=3, grasps=grasps)
     assert trial.names == list(KEEP)
     r = trial.run(mode)
-    rounds = r["rounds"]
+    rounds = r.to_dict()["rounds"]
+    assert r.success == rounds[-1]["lifted"]
     assert 2 <= len(rounds) <= 4                    # round 1 is always made (the thesis's accounting)
     for k, x in enumerate(rounds):
         assert x["round"] == k and sum(x["weights"]) == pytest.approx(1.0)

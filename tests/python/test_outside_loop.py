@@ -60,12 +60,13 @@ def test_outside_loop_equals_the_in_process_loop_bit_for_bit(capsys, tmp_path, c
     r = run_episode(OBJ, TRUTH, EpisodeSettings(method=method, attempts=attempts), ctx_for(cache), seed=SEED,
                     estimate=EST, keep_planner=True)
     grasps, last = drive(capsys, tmp_path / "ep", cache, method, attempts)
-    assert grasps == [a["action"] for a in r["attempts"]]
-    assert last["status"] == ("success" if r["success"] else "failed")
+    d = r.to_dict()
+    assert grasps == [a["action"] for a in d["attempts"]]
+    assert last["status"] == ("success" if d["success"] else "failed")
     shown = cli_json(capsys, "episode", "show", tmp_path / "ep", "--json")
-    assert shown["belief"]["particles_sha256"] == belief_sha(r["planner"])
-    assert shown["belief"]["mean"] == r["final_belief"]["mean"] and shown["belief"]["std"] == r["final_belief"]["std"]
-    for step, a in zip(shown["steps"], r["attempts"]):
+    assert shown["belief"]["particles_sha256"] == belief_sha(r.planner)
+    assert shown["belief"]["mean"] == d["final_belief"]["mean"] and shown["belief"]["std"] == d["final_belief"]["std"]
+    for step, a in zip(shown["steps"], d["attempts"]):
         assert step["lifted"] == a["lifted"]
         if "belief_after" in a:
             assert step["belief_after"]["mean"] == a["belief_after"]["mean"]

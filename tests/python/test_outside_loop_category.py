@@ -72,8 +72,8 @@ def test_fusion_episode_equals_the_fuse_command(capsys, tmp_path, options):
         grasps.append(nxt["top_grasp"])
         beliefs.append(nxt["belief"])
         ex = top_grasp(world, np.array(nxt["top_grasp"]), np.array(POSE), nxt["grasp"]["spread"])
-        doc = cli_json(capsys, "episode", "observe", d, "--joints", ",".join(map(repr, ex["joint_angles"].tolist())),
-                       "--lifted", "yes" if ex["lifted"] else "no", "--json")
+        doc = cli_json(capsys, "episode", "observe", d, "--joints", ",".join(map(repr, ex.joint_angles.tolist())),
+                       "--lifted", "yes" if ex.lifted else "no", "--json")
     # fuse and an episode both end at the first lift (the experiment, as the thesis ran it, makes
     # round 1 even after a lifted round 0)
     rounds = inproc["rounds"]

@@ -138,7 +138,7 @@ def test_same_seed_same_episode(cube):
     a = run_episode("cube", (0.03, -0.02, 0.7), EpisodeSettings(method="explore"), NO_LIFT, seed=5, models=cube)
     b = run_episode("cube", (0.03, -0.02, 0.7), EpisodeSettings(method="explore"), NO_LIFT, seed=5, models=cube)
     def strip(r):  # wall times differ, nothing else may
-        return json.dumps([{k: v for k, v in x.items() if k != "plan_seconds"} for x in r["attempts"]])
+        return json.dumps([{k: v for k, v in x.items() if k != "plan_seconds"} for x in r.to_dict()["attempts"]])
 
     assert strip(a) == strip(b)
 
@@ -151,8 +151,8 @@ def test_success_rises_over_attempts_on_a_batch(cube):
     for i in range(12):
         pose = (rng.uniform(-0.08, 0.08), rng.uniform(-0.08, 0.08), rng.uniform(-np.pi, np.pi))
         r = run_episode("cube", pose, EpisodeSettings(method="stability"), NO_LIFT, seed=i, models=cube)
-        first.append(r["attempts"][0]["stable"])
-        by_four.append(r["success"])
+        first.append(r.attempts[0].execution.stable)
+        by_four.append(r.success)
     # (cumulative success cannot fall; it has to rise by a margin)
     assert np.mean(by_four) >= np.mean(first) + 0.25
     assert np.mean(by_four) >= 0.75
@@ -163,7 +163,7 @@ def test_success_rises_over_attempts_on_a_batch(cube):
     for i in range(12):
         pose = (rng.uniform(-0.08, 0.08), rng.uniform(-0.08, 0.08), rng.uniform(-np.pi, np.pi))
         r = run_episode("cube", pose, EpisodeSettings(method="open_loop"), NO_LIFT, seed=i, models=cube)
-        open_loop.append(r["success"])
+        open_loop.append(r.success)
     assert np.mean(by_four) > np.mean(open_loop)
 
 
@@ -186,9 +186,10 @@ def test_lift_criterion_loop_stops_at_a_lifted_grasp_and_learns_from_dropped_one
                         models=models) for i in range(4)]
     dropped = 0
     for r in runs:
-        for a in r["attempts"]:
+        attempts = r.to_dict()["attempts"]
+        for a in attempts:
             assert a["lifted"] is not None and a["success"] == a["lifted"]
-        for a, nxt in zip(r["attempts"][:-1], r["attempts"][1:]):   # every attempt before the last was dropped ...
+        for a, nxt in zip(attempts[:-1], attempts[1:]):   # every attempt before the last was dropped ...
             assert not a["success"]
             before, after = a["belief_before"], a["belief_after"]
             # ... and moved the belief (a planner that never updates leaves mean, spread and ESS as
@@ -197,10 +198,10 @@ def test_lift_criterion_loop_stops_at_a_lifted_grasp_and_learns_from_dropped_one
                         and np.isclose(after["ess"], before["ess"]))
             assert nxt["belief_before"]["mean"] == after["mean"]
             dropped += 1
-        last = r["attempts"][-1]
-        assert r["success"] == last["success"]
+        last = attempts[-1]
+        assert r.success == last["success"] and r.to_dict()["success"] == r.success
         assert ("belief_after" in last) == (not last["success"])
-    assert any(r["success"] for r in runs)
+    assert any(r.success for r in runs)
     assert dropped > 0   # the check above ran on at least one dropped grasp
 
 
@@ -210,10 +211,10 @@ def test_an_episode_takes_the_planner_settings_and_the_noise_from_the_context_al
     small = replace(NO_LIFT, planner=PlannerSettings(n_particles=40, plan_particles=0))
     r = run_episode("cube", (0.03, -0.02, 0.7), EpisodeSettings(method="stability", attempts=1), small, seed=5,
                     models=cube, keep_planner=True)
-    assert r["planner"].belief.particles.shape == (40, 3)
+    assert r.planner.belief.particles.shape == (40, 3)
     exact = run_episode("cube", (0.03, -0.02, 0.7), EpisodeSettings(method="stability", attempts=1), small, seed=5,
                         models=cube)
     noisy = run_episode("cube", (0.03, -0.02, 0.7), EpisodeSettings(method="stability", attempts=1),
                         replace(small, measurement_noise=0.05), seed=5, models=cube)
-    a, b = exact["attempts"][0], noisy["attempts"][0]
+    a, b = exact.to_dict()["attempts"][0], noisy.to_dict()["attempts"][0]
     assert a["action"] == b["action"] and a["joint_angles"] != b["joint_angles"]   # same grasp, noisy reading

@@ -40,15 +40,16 @@ def store(tmp_path_factory):
                                        settings=TaskGraspSettings(candidates=150, spreads=(0.0, float(np.radians(60))),
                                                                   lift_tests=6, keep=2))
     s = ResultStore(d / "results.sqlite")
-    pose = run_episode("mug", (0.02, -0.01, 0.4), EpisodeSettings(method="stability", attempts=2, stop_when_stable=False), ctx, seed=5)
-    s.add(RunKey("pub2/stability", "mug", 0, 5), {k: v for k, v in pose.items() if k not in ("planner", "snapshots")})
+    pose = run_episode("mug", (0.02, -0.01, 0.4), EpisodeSettings(method="stability", attempts=2, stop_when_stable=False),
+                       ctx, seed=5).to_dict()
+    s.add(RunKey("pub2/stability", "mug", 0, 5), pose)
     exclude = tuple(f"mug/{i}" for i in range(7) if f"mug/{i}" not in KEEP)
     ep = see("mug/3", (0.01, 0.02, 0.7), "mug", exclude=exclude + ("mug/3",), seed=3)
-    out = plan_and_execute(ep, "mug", "top", "laplace", ctx, seed=3, grasps=grasps)
+    out = plan_and_execute(ep, "mug", "top", "laplace", ctx, seed=3, grasps=grasps).to_dict()
     s.add(RunKey("pub5", "mug/3", 0, 3), {"object": "mug/3", "category": "mug", "pose": [0.01, 0.02, 0.7],
                                           "tasks": {"top": {"laplace": out}}})
     trial = FusionTrial("mug/3", (0.01, 0.02, 0.7), ctx, exclude=exclude + ("mug/3",), seed=3, grasps=grasps)
-    fused = trial.run("vision", rounds=1)
+    fused = trial.run("vision", rounds=1).to_dict()
     fused.update({"object": "mug/3", "pose": [0.01, 0.02, 0.7]})
     s.add(RunKey("pub6", "mug/3", 0, 3), json.loads(json.dumps(fused, default=float)))
     s.close()

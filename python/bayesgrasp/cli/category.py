@@ -37,8 +37,8 @@ def add(sub) -> None:
 
 
 def run(args) -> int:
+    from ..io.results import category_document
     from ..loop.category import plan_and_execute, see
-    from ..io.view_fields import cloud_json
     from ..models.tasks import task_rule
 
     pose = floats(args.object_pose, 3, "--object-pose")
@@ -56,31 +56,22 @@ def run(args) -> int:
     if not any(r.success for r in ep.registrations):
         raise CliError("no training model registered to the cloud (is the object in view, is it of this category?)")
     grasps = task_grasps_arg(args)
-    out = plan_and_execute(ep, args.category, args.task, args.method, ctx, seed=ctx.seed, grasps=grasps)
-    doc = {"grasp": _grasp_record(out, ctx), "planned_pose": out["pose"], "method": args.method,
-           "category": args.category, "task": args.task, "scene_object": args.scene_object, "units": args.units,
-           "object_pose": pose if args.scene_object else None, "executed": out["executed"],
-           "scene": (args.cloud or args.depth) if view is not None else "simulated view",
-           "models": [{"model": m, "weight": out["weights"][m], "contribution": out["contributions"][m],
-                       "success": bool(r.success), "transform": np.asarray(r.transform).tolist()}
-                      for m, r in zip(ep.models, ep.registrations)],
-           "cloud": cloud_json(ep.observation.cloud),
-           "epsilon": out["epsilon"], "lifted": out["lifted"], "task_ok": out["task_ok"], "success": out["success"],
-           "failure": out["failure"], "reason": out["reason"] or None, "contact_parts": out["contact_parts"]}
-    if "part_check" in out:      # part-aware: P(rule | A), P(rule, held | A) and each model's contact parts
-        doc["part_check"] = out["part_check"]
+    r = plan_and_execute(ep, args.category, args.task, args.method, ctx, seed=ctx.seed, grasps=grasps)
+    grasp = r.grasp(ctx.hand_model)
+    scene = (args.cloud or args.depth) if view is not None else "simulated view"
+    doc = category_document(r, grasp, ep, args.category, args.units, scene)
     fmt = output_format(args)
     if fmt == "ros":
         from ..io.grasp_schema import to_ros
 
-        print(json.dumps(None if doc["grasp"] is None else
-                         to_ros(doc["grasp"], grasp_id=f"{args.category}-{args.task}", quality=out["objective"])))
+        print(json.dumps(None if grasp is None else
+                         to_ros(grasp, grasp_id=f"{args.category}-{args.task}", quality=r.plan.objective)))
     elif fmt == "json":
         print(json.dumps(doc))
     else:
-        _print(doc)
-    if png and out["executed"]:
-        _png(ep, out, ctx, png, doc)
+        _print(r, ep, args.category, scene)
+    if png and r.outcome.executed:
+        _png(ep, r, ctx, png)
         if fmt == "text":
             print(f"saved {png}")
     from .view import show_result
@@ -89,53 +80,46 @@ def run(args) -> int:
     return 0
 
 
-def _grasp_record(out: dict, ctx):
-    """The plan in the grasp schema (world = the table frame): executed, where the hand closed and
-    its closed fingers; planned only, the planned pose with the open preshape (None: no grasp)."""
-    from ..io.grasp_schema import hand_grasp_record
+def _print_part_check(pc: dict) -> None:
+    """The part-aware plan's check (the planner's ``extra``): P(rule | A), P(rule, held | A)."""
+    print(f"  part check: the rule holds on models of weight {pc['p_rule']:.2f} (and the grasp holds: "
+          f"{pc['p_success']:.2f}); {pc['passing_rule']} of {pc['candidates']} candidates obeyed the rule on "
+          "some model")
+    if "warps" in pc:
+        print("  warped onto the view: " + ", ".join(f"{n} weight {w['weight']:.2f} ({1000 * w['residual']:.1f} mm)"
+                                                   for n, w in pc["warps"].items()))
+    if pc.get("lift_checked"):
+        print(f"  lift test on the warped shapes decided among the {pc['lift_checked']} best: the chosen grasp "
+              f"lifts on models of weight {pc['p_lifted']:.2f}")
 
-    if out["pose"] is None:
-        return None
-    hand = ctx.hand_model
-    if out["executed"]:
-        return hand_grasp_record(hand, out["hand_pose"], out["joint_angles"], out["spread"])
-    return hand_grasp_record(hand, out["pose"], hand.open_joints(out["spread"]), out["spread"])
 
-
-def _print(doc: dict) -> None:
-    print(f"{doc['scene_object'] or doc['scene']} ({doc['category']}, task {doc['task']}), method {doc['method']}")
-    for m in doc["models"]:
-        print(f"  {m['model']:<10} weight {m['weight']:.3f}  contribution {m['contribution']:.4f}")
-    if doc["reason"]:
-        print(f"  no grasp: {doc['reason']}")
+def _print(r, ep, category: str, scene: str) -> None:
+    """The result in lines: each model's weight and contribution, the part check, the outcome."""
+    plan, o = r.plan, r.outcome
+    print(f"{ep.obj or scene} ({category}, task {r.task}), method {r.method}")
+    for m in ep.models:
+        print(f"  {m:<10} weight {plan.weights[m]:.3f}  contribution {plan.contributions[m]:.4f}")
+    if o.reason:
+        print(f"  no grasp: {o.reason}")
         return
-    pc = doc.get("part_check")
-    if pc:
-        print(f"  part check: the rule holds on models of weight {pc['p_rule']:.2f} (and the grasp holds: "
-              f"{pc['p_success']:.2f}); {pc['passing_rule']} of {pc['candidates']} candidates obeyed the rule on "
-              "some model")
-        if "warps" in pc:
-            print("  warped onto the view: " + ", ".join(f"{n} weight {w['weight']:.2f} ({1000 * w['residual']:.1f} mm)"
-                                                       for n, w in pc["warps"].items()))
-        if pc.get("lift_checked"):
-            print(f"  lift test on the warped shapes decided among the {pc['lift_checked']} best: the chosen grasp "
-                  f"lifts on models of weight {pc['p_lifted']:.2f}")
-    if not doc["executed"]:
-        x, y, z = (doc["grasp"]["pose"][i][3] for i in range(3))
+    if plan.extra:
+        _print_part_check(plan.extra)
+    if not o.executed:
+        x, y, z = plan.pose[:3, 3]
         print(f"  planned grasp at ({100 * x:.1f}, {100 * y:.1f}, {100 * z:.1f}) cm in the table frame, spread "
-              f"{doc['grasp']['spread']:.2f} rad (not executed: no --scene-object)")
+              f"{o.spread:.2f} rad (not executed: no --scene-object)")
         return
-    print(f"  epsilon {doc['epsilon']:.4f}, {'lifted' if doc['lifted'] else 'dropped'}, contacts on "
-          f"{', '.join(doc['contact_parts']) or 'nothing'}: {'task-compatible' if doc['task_ok'] else 'wrong part'}"
-          f" -> {'SUCCESS' if doc['success'] else 'failure (' + str(doc['failure']) + ')'}")
+    print(f"  epsilon {o.epsilon:.4f}, {'lifted' if o.lifted else 'dropped'}, contacts on "
+          f"{', '.join(o.contact_parts) or 'nothing'}: {'task-compatible' if o.task_ok else 'wrong part'}"
+          f" -> {'SUCCESS' if o.success else 'failure (' + str(o.failure) + ')'}")
 
 
-def _png(ep, out: dict, ctx, png, doc: dict) -> None:
+def _png(ep, r, ctx, png) -> None:
     from ..objects import load_object
     from ..viz import plot_category_grasp
 
+    o = r.outcome
     plot_category_grasp(ep.observation.cloud, [load_object(m) for m in ep.models],
-                        [r.transform for r in ep.registrations], [out["weights"][m] for m in ep.models],
-                        ctx.hand_model, np.asarray(out["joint_angles"]), np.asarray(out["hand_pose"]), png,
-                        title=f"{doc['scene_object']}, {doc['task']}, {doc['method']}: "
-                              f"{'success' if doc['success'] else doc['failure']}")
+                        [g.transform for g in ep.registrations], [r.plan.weights[m] for m in ep.models],
+                        ctx.hand_model, np.asarray(o.joint_angles), np.asarray(o.hand_pose), png,
+                        title=f"{ep.obj}, {r.task}, {r.method}: {'success' if o.success else o.failure}")

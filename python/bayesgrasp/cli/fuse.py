@@ -44,8 +44,8 @@ def add(sub) -> None:
 
 
 def run(args) -> int:
+    from ..io.results import fuse_document, fuse_rounds
     from ..loop.fusion_trial import FusionTrial
-    from ..io.view_fields import cloud_json
     from ..planners.fusion import FusionSettings
 
     pose = floats(args.object_pose, 3, "--object-pose")
@@ -63,34 +63,22 @@ def run(args) -> int:
                         exclude=args.exclude if args.exclude is not None else [args.scene_object], seed=ctx.seed,
                         category=args.category, grasps=grasps,
                         observation=None if view is None else camera_input.observation(view))
-    from ..io.grasp_schema import hand_grasp_record
-
-    hand = ctx.hand_model
-    rounds = []
     fmt = output_format(args)
     r = trial.run(args.start, rounds=args.rounds, on_round=None if fmt != "text" else _print_round(trial.names),
                   stop_at_lift=True)
-    for rec in r["rounds"]:
-        rounds.append({"round": rec["round"], "top_grasp": rec["action"],
-                       "grasp": hand_grasp_record(hand, rec["hand_pose"], rec["joint_positions"], trial.spread),
-                       "epsilon": rec["epsilon"], "lifted": rec["lifted"],
-                       "weights": dict(zip(trial.names, rec["weights"])),
-                       "poses": dict(zip(trial.names, rec["poses"])), "underflow": rec["underflow"],
-                       **({"part": rec["part"]} if "part" in rec else {})})
-    success = bool(rounds[-1]["lifted"])       # it stops at the first lift: the last grasp's outcome
-    doc = {"scene_object": args.scene_object, "units": args.units, "object_pose": pose, "category": args.category, "task": args.task,
-           "start": args.start, "belief": args.belief, "task_term": args.task_term,
-           "avoid_failed": args.avoid_failed, "rounds": rounds, "success": success,
-           "scene": (args.cloud or args.depth) if view is not None else "simulated view",
-           "cloud": cloud_json(trial.episode.observation.cloud)}
+    rounds = fuse_rounds(r, [x.grasp(ctx.hand_model, trial.spread) for x in r.rounds])
+    scene = (args.cloud or args.depth) if view is not None else "simulated view"
+    doc = fuse_document(r, rounds, trial.episode, settings, category=args.category, task=args.task, units=args.units,
+                        scene=scene)
     if fmt == "ros":
         from ..io.grasp_schema import to_ros
 
-        print(json.dumps({"rounds": [to_ros(x["grasp"], grasp_id=f"round-{x['round']}") for x in rounds]}))
+        print(json.dumps({"rounds": [to_ros(x.grasp(ctx.hand_model, trial.spread), grasp_id=f"round-{x.number}")
+                                     for x in r.rounds]}))
     elif fmt == "json":
         print(json.dumps(doc))
     else:
-        print(f"{'success' if success else 'no grasp lifted'} after {len(rounds)} grasp(s)")
+        print(f"{'success' if r.success else 'no grasp lifted'} after {len(r.rounds)} grasp(s)")
     if png:
         from ..viz import plot_fusion_rounds
 
@@ -104,9 +92,11 @@ def run(args) -> int:
 
 
 def _print_round(names):
+    """A line per :class:`~bayesgrasp.loop.fusion_result.FusionRound` as it is done."""
     def show(rec):
-        w = ", ".join(f"{n} {v:.2f}" for n, v in zip(names, rec["weights"]))
-        x, y, yaw = rec["action"]
-        print(f"  round {rec['round']}: grasp ({100 * x:.1f} cm, {100 * y:.1f} cm, {np.degrees(yaw):.0f} deg) "
-              f"-> epsilon {rec['epsilon']:.3f}, {'LIFTED' if rec['lifted'] else 'dropped'}; weights {w}", flush=True)
+        e = rec.execution
+        w = ", ".join(f"{n} {v:.2f}" for n, v in zip(names, rec.weights))
+        x, y, yaw = (float(v) for v in e.action)
+        print(f"  round {rec.number}: grasp ({100 * x:.1f} cm, {100 * y:.1f} cm, {np.degrees(yaw):.0f} deg) "
+              f"-> epsilon {e.epsilon:.3f}, {'LIFTED' if e.lifted else 'dropped'}; weights {w}", flush=True)
     return show

@@ -17,10 +17,13 @@ Everything is in the object's frame unless ``--frame world``.
 from __future__ import annotations
 
 import json
+from dataclasses import dataclass
 from pathlib import Path
+from typing import List, Optional
 
 import numpy as np
 
+from ..io.results import mass_source
 from .args import (CliError, Renamed, add_format_options, add_hand_option, add_object_options, add_view_option, floats,
                    object_arg, output_file, output_format)
 
@@ -57,8 +60,29 @@ def add(sub) -> None:
     g.set_defaults(run=run)
 
 
+@dataclass
+class Approach:
+    """--approach: the direction (the hand's +z), the roll about -direction and a point on the
+    palm's line of motion (None: the centre of the object's bounding box, filled in when grasping)."""
+
+    direction: List[float]
+    roll: float
+    target: Optional[List[float]]
+
+
+@dataclass
+class GraspRequest:
+    """What to do, from the options: ``mode`` "top", "approach" or "pose", and its one input."""
+
+    mode: str
+    top: Optional[List[float]] = None
+    approach: Optional[Approach] = None
+    pose: Optional[list] = None
+
+
 def run(args) -> int:
-    from ..io.grasp_schema import hand_grasp_record, to_ros
+    from ..io.results import grasp_document
+    from ..io.grasp_schema import to_ros
 
     if args.approach is None and (args.roll is not None or args.at is not None):
         raise CliError(f"{'--roll' if args.roll is not None else '--at'}: only with --approach")
@@ -67,35 +91,24 @@ def run(args) -> int:
     request = _request(args)
     world = _world(args, pose)
     grasp = _grasp(world, args, request)
-    g = grasp.to_dict()
-    out = {
-        "object": args.object, "object_pose": pose, "top": request.get("top"), "hand": world.hand.name,
-        "joint_angles": [float(v) for v in g["joint_angles"]],
-        "joint_names": list(world.hand.core.joint_names),
-        "contacts": g["contacts"], "epsilon": g["epsilon"], "volume": g["volume"],
-        "lifted": g["lifted"], "lift_displacement": g["lift_displacement"],
-        "collision_at_start": g["collision_at_start"],
-        "hand_pose": np.asarray(g["hand_pose"]).tolist(),
-        "mode": request["mode"], "input_frame": args.frame, "approach": request.get("approach"), "pose": request.get("pose"),
-        "stopped_by_table": g["stopped_by_table"], "hand_pose_object": np.asarray(g["hand_pose_object"]).tolist(),
-        "mass": _mass_used(world.object), "units": args.units,
-    }
-    out["grasp"] = hand_grasp_record(world.hand, g["hand_pose"], g["joint_angles"], world.spread if args.spread is None else args.spread)
+    spread = world.spread if args.spread is None else args.spread
+    out = grasp_document(grasp, request, world, object_name=args.object, object_pose=pose, frame=args.frame,
+                         units=args.units, spread=spread)
     if args.lift_trace:
-        out["lift_trace"] = _lift_trace(world, args, g)
+        out["lift_trace"] = _lift_trace(world, args, grasp)
     fmt = output_format(args)
     if fmt == "ros":
-        print(json.dumps(to_ros(out["grasp"], grasp_id=f"{args.object}-{request['mode']}", quality=out["epsilon"])))
+        print(json.dumps(to_ros(out["grasp"], grasp_id=f"{args.object}-{request.mode}", quality=grasp.epsilon)))
     elif fmt == "json":
         print(json.dumps(out))
     else:
-        _print(out, args.object, pose, world.hand.prismatic_joints)
+        _print(grasp, request, world, args, pose)
     if png:
         from ..viz import plot_grasp
 
-        verdict = {True: "lifted", False: "FAILED: not lifted", None: "lift not tested"}[out["lifted"]]
-        plot_grasp(world, grasp, png, title=f"{world.hand.name} on {args.object}: {_describe(out)}\n{verdict}, "
-                                            f"epsilon {out['epsilon']:.3f}")
+        verdict = {True: "lifted", False: "FAILED: not lifted", None: "lift not tested"}[grasp.lifted]
+        plot_grasp(world, grasp, png, title=f"{world.hand.name} on {args.object}: {_describe(request)}\n{verdict}, "
+                                            f"epsilon {grasp.epsilon:.3f}")
         if fmt == "text":
             print(f"saved {png}")
     from .view import show_result
@@ -104,7 +117,7 @@ def run(args) -> int:
     return 0
 
 
-def _lift_trace(world, args, g: dict) -> dict:
+def _lift_trace(world, args, g) -> dict:
     """The lift test run again with its trace recorded (same hand pose, joints and physics, so the
     same verdict as the grasp's), as the object's path in the hand."""
     from ..io.view_fields import lift_trace_json
@@ -112,22 +125,21 @@ def _lift_trace(world, args, g: dict) -> dict:
 
     if args.no_lift:
         raise CliError("--lift-trace: not with --no-lift")
-    r = world.lift_tester().run(np.asarray(g["hand_pose"]), np.asarray(g["joint_angles"]), trace_every=10)
-    doc = lift_trace_json(LiftTrace.from_core(r.trace), g["hand_pose"])
-    doc["lifted"] = bool(r.lifted) and not g["collision_at_start"]
+    r = world.lift_tester().run(np.asarray(g.hand_pose), np.asarray(g.joint_angles), trace_every=10)
+    doc = lift_trace_json(LiftTrace.from_core(r.trace), g.hand_pose)
+    doc["lifted"] = bool(r.lifted) and not g.collision_at_start
     return doc
 
 
-def _request(args) -> dict:
+def _request(args) -> GraspRequest:
     """What to do, parsed from the options (CliError naming the option)."""
     if args.top is not None:
-        return {"mode": "top", "top": floats(args.top, 3, "--top")}
+        return GraspRequest("top", top=floats(args.top, 3, "--top"))
     if args.approach is not None:
         direction = floats(args.approach, 3, "--approach")
         target = None if args.at is None else floats(args.at, 3, "--at")
-        return {"mode": "approach", "approach": {"direction": direction, "roll": float(args.roll or 0.0),
-                                                 "target": target}}
-    return {"mode": "pose", "pose": _read_pose(args.hand_pose, args.frame)}
+        return GraspRequest("approach", approach=Approach(direction, float(args.roll or 0.0), target))
+    return GraspRequest("pose", pose=_read_pose(args.hand_pose, args.frame))
 
 
 def _read_pose(path: str, frame: str = "object") -> list:
@@ -167,33 +179,24 @@ def _world(args, pose):
     return world
 
 
-def _mass_used(obj) -> dict:
-    """The mass the lift test uses and where it comes from."""
-    how = {"mesh": "its closed mesh", "fill": "the solid its open mesh bounds (sampled)",
-           "shell": "its open mesh as a thin shell"}[obj.mass_method]
-    return {"kg": float(obj.mass), "from": "given (--mass)" if obj.given_mass is not None else how,
-            "density": float(obj.density)}
-
-
 def _grasp(world, args, request):
     """The world's grasp for the request; the world's ValueErrors (direction of zero length,
     target off the table, a pose that is not rigid, ...) are prefixed with the option."""
     lift = not args.no_lift
     try:
-        if request["mode"] == "top":
-            x, y, yaw = request["top"]
+        if request.mode == "top":
+            x, y, yaw = request.top
             if args.frame == "object":
                 return world.grasp(x, y, yaw, spread=args.spread, lift=lift)
             return world.approach([0.0, 0.0, -1.0], [x, y, 0.0], roll=yaw, spread=args.spread, frame="world", lift=lift)
-        if request["mode"] == "approach":
-            a = request["approach"]
-            if a["target"] is None:
-                a["target"] = _box_centre(world, args.frame)
-            return world.approach(a["direction"], a["target"], roll=a["roll"], spread=args.spread, frame=args.frame,
-                                  lift=lift)
-        return world.grasp_pose(request["pose"], spread=args.spread, frame=args.frame, lift=lift)
+        if request.mode == "approach":
+            a = request.approach
+            if a.target is None:
+                a.target = _box_centre(world, args.frame)
+            return world.approach(a.direction, a.target, roll=a.roll, spread=args.spread, frame=args.frame, lift=lift)
+        return world.grasp_pose(request.pose, spread=args.spread, frame=args.frame, lift=lift)
     except ValueError as e:
-        option = {"top": "--top", "approach": "--approach", "pose": "--hand-pose"}[request["mode"]]
+        option = {"top": "--top", "approach": "--approach", "pose": "--hand-pose"}[request.mode]
         raise CliError(f"{option}: {e}") from None
 
 
@@ -203,33 +206,35 @@ def _box_centre(world, frame: str) -> list:
     return ((V.min(axis=0) + V.max(axis=0)) / 2).tolist()
 
 
-def _describe(out: dict) -> str:
-    if out["mode"] == "top":
-        return f"top grasp {out['top']}"
-    if out["mode"] == "approach":
-        a = out["approach"]
+def _describe(request: GraspRequest) -> str:
+    if request.mode == "top":
+        return f"top grasp {request.top}"
+    if request.mode == "approach":
+        a = request.approach
         fmt = lambda v: "(" + ", ".join(f"{x:.3g}" for x in v) + ")"  # noqa: E731
-        return f"approach {fmt(a['direction'])}, roll {a['roll']:.3g}, through {fmt(a['target'])}"
+        return f"approach {fmt(a.direction)}, roll {a.roll:.3g}, through {fmt(a.target)}"
     return "closing at the given pose"
 
 
-def _print(out: dict, name: str, pose, prismatic) -> None:
-    """The text report; ``prismatic`` per joint: a jaw's travel is printed in mm, an angle in degrees."""
-    print(f"{out['hand']} on {name} at object pose {pose}, {_describe(out)} ({out['input_frame']} frame)")
-    print(f"  object mass {out['mass']['kg']:.3f} kg, from {out['mass']['from']}")
-    if out["collision_at_start"]:
+def _print(g, request: GraspRequest, world, args, pose) -> None:
+    """The text report of a WorldGrasp; a jaw's travel is printed in mm, an angle in degrees."""
+    obj = world.object
+    print(f"{world.hand.name} on {args.object} at object pose {pose}, {_describe(request)} ({args.frame} frame)")
+    print(f"  object mass {float(obj.mass):.3f} kg, from {mass_source(obj)}")
+    if g.collision_at_start:
         print("  the open hand starts in collision: no grasp")
-    if out["stopped_by_table"]:
+    if g.stopped_by_table:
         print("  the approach was stopped by the table before it touched the object")
     print("  joints: " + ", ".join(f"{n}={1000 * v:.1f} mm" if jaw else f"{n}={np.degrees(v):.1f} deg"
-                                   for n, v, jaw in zip(out["joint_names"], out["joint_angles"], prismatic)))
-    print(f"  contacts: {len(out['contacts'])}")
-    for c in out["contacts"]:
-        where = "table" if c["on_table"] else (c["part"] or "object")
-        p = ", ".join(f"{v:.4f}" for v in c["point"])
-        n = ", ".join(f"{v:.3f}" for v in c["normal"])
-        print(f"    {c['link_name']:<18} {where:<6} point ({p})  normal ({n})  penetration {c['penetration']:.2e}")
-    print(f"  epsilon {out['epsilon']:.4f}   volume {out['volume']:.3e}")
-    if out["lifted"] is not None:
-        print(f"  lift test: {'lifted' if out['lifted'] else 'dropped'} "
-              f"(moved {100 * out['lift_displacement']:.1f} cm relative to the palm)")
+                                   for n, v, jaw in zip(world.hand.core.joint_names, g.joint_angles,
+                                                        world.hand.prismatic_joints)))
+    print(f"  contacts: {len(g.contacts)}")
+    for c in g.contacts:
+        where = "table" if c.on_table else (c.part or "object")
+        p = ", ".join(f"{v:.4f}" for v in c.point)
+        n = ", ".join(f"{v:.3f}" for v in c.normal)
+        print(f"    {c.link_name:<18} {where:<6} point ({p})  normal ({n})  penetration {c.penetration:.2e}")
+    print(f"  epsilon {g.epsilon:.4f}   volume {g.volume:.3e}")
+    if g.lifted is not None:
+        print(f"  lift test: {'lifted' if g.lifted else 'dropped'} "
+              f"(moved {100 * g.lift_displacement:.1f} cm relative to the palm)")

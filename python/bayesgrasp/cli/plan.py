@@ -56,21 +56,22 @@ def add(sub) -> None:
     p.set_defaults(run=plan)
 
 
-def _print_attempt(a: dict) -> None:
-    lift = "" if a["lifted"] is None else (", lifted" if a["lifted"] else ", dropped in the lift test")
-    ent = "" if a["expected_entropy"] is None else f", expected entropy {a['expected_entropy']:.2f}"
-    verdict = "SUCCESS" if a["success"] else "failed"
-    x, y, yaw = a["action"]
-    b = a["belief_before"]
-    print(f"  attempt {a['attempt']}: {a['kind']:<9} {a['family']} grasp ({100 * x:6.1f} cm, {100 * y:6.1f} cm, "
-          f"{np.degrees(yaw):6.1f} deg)  predicted P(S) {a['predicted_stability']:.2f}{ent}  "
+def _print_attempt(a) -> None:
+    """One line per attempt (an :class:`~bayesgrasp.loop.episode_result.Attempt`) as it is done."""
+    p, ex, b = a.plan, a.execution, a.belief_before
+    lift = "" if ex.lifted is None else (", lifted" if ex.lifted else ", dropped in the lift test")
+    ent = "" if p.expected_entropy is None else f", expected entropy {p.expected_entropy:.2f}"
+    verdict = "SUCCESS" if ex.success else "failed"
+    x, y, yaw = (float(v) for v in p.action)
+    print(f"  attempt {a.number}: {p.kind:<9} {p.family} grasp ({100 * x:6.1f} cm, {100 * y:6.1f} cm, "
+          f"{np.degrees(yaw):6.1f} deg)  predicted P(S) {p.predicted_stability:.2f}{ent}  "
           f"[belief: error {100 * b['position_error']:.1f} cm, entropy {b['kde_entropy']:.2f}]  "
-          f"-> epsilon {a['epsilon']:.3f} ({'stable' if a['stable'] else 'not stable'}){lift}: {verdict}  "
-          f"({1e3 * a['plan_seconds']:.0f} ms to plan)", flush=True)
+          f"-> epsilon {ex.epsilon:.3f} ({'stable' if ex.stable else 'not stable'}){lift}: {verdict}  "
+          f"({1e3 * p.seconds:.0f} ms to plan)", flush=True)
 
 
 def _loop(args, ctx, pose, attempts: int = EpisodeSettings.attempts, estimate=None, noise: float = 0.0,
-          quiet: bool = False, start=None, obj=None) -> dict:
+          quiet: bool = False, start=None, obj=None):
     """The episode on ``obj`` (default: --object by name) in the command's run context ``ctx``;
     ``start``: the vision start (its spread is the belief's)."""
     from dataclasses import replace
@@ -91,18 +92,20 @@ def _loop(args, ctx, pose, attempts: int = EpisodeSettings.attempts, estimate=No
                        keep_planner=True, on_attempt=None if quiet else _print_attempt)
 
 
-def _belief_png(r: dict, path) -> Path:
+def _belief_png(r, path) -> Path:
     from ..experiments.pose_uncertainty_plots import plot_belief_evolution
 
-    return plot_belief_evolution(r["snapshots"], r["true_pose"], Path(path),
-                                 f"{r['object']}, {r['method']}: true pose "
-                                 f"({100 * r['true_pose'][0]:.1f} cm, {100 * r['true_pose'][1]:.1f} cm, "
-                                 f"{np.degrees(r['true_pose'][2]):.0f} deg)", r["attempts"])
+    x, y, yaw = r.true_pose
+    return plot_belief_evolution(r.snapshots, r.true_pose.tolist(), Path(path),
+                                 f"{r.object}, {r.method}: true pose ({100 * x:.1f} cm, {100 * y:.1f} cm, "
+                                 f"{np.degrees(yaw):.0f} deg)", [a.to_dict() for a in r.attempts])
 
 
 def demo(args) -> int:
     """The main job: a mug at a displaced pose the robot knows only to +-4 cm and +-45 deg;
     plan, grasp, read the fingers, update the belief, re-plan until the grasp is stable."""
+    from ..io.results import plan_document
+
     out = out_dir(args.out)
     obj = object_arg(args) if args.units or args.mass is not None else args.object   # a mesh in its unit, weighed
     ctx = context(args)
@@ -115,11 +118,11 @@ def demo(args) -> int:
         print(f"  (the hidden pose is draw {skipped + 1} of seed {ctx.seed}: at the first {skipped}, the first grasp "
               f"lifted and the belief would not have moved)")
     r = _loop(args, ctx, pose, obj=obj)
-    f = r["final_belief"]
-    print(f"{'success' if r['success'] else 'no successful grasp'} after {len(r['attempts'])} attempt(s); "
+    f = r.final_belief
+    print(f"{'success' if r.success else 'no successful grasp'} after {len(r.attempts)} attempt(s); "
           f"final belief error {100 * f['position_error']:.1f} cm, {np.degrees(f['yaw_error']):.0f} deg")
     png = _belief_png(r, out / "belief_evolution.png")
-    doc = _plan_json(args, ctx, pose, r)
+    doc = plan_document(r, args.object, args.units, ctx.success)
     (out / "demo.json").write_text(json.dumps(doc, indent=1))
     pictures = _attempt_pictures(doc, out)
     print(f"saved {png}, {out / 'demo.json'} (see it in 3D: bayesgrasp view {out / 'demo.json'}) and "
@@ -144,7 +147,7 @@ def _demo_pose(args, ctx, obj) -> tuple:
         pose = [float(rng.uniform(-0.08, 0.08)), float(rng.uniform(-0.08, 0.08)), float(rng.uniform(-np.pi, np.pi))]
         first = run_episode(obj, pose, EpisodeSettings(method=args.method, attempts=1), ctx, seed=ctx.seed,
                             models=models)
-        if not first["attempts"][0]["success"]:
+        if not first.attempts[0].success:
             return pose, k
     return pose, DEMO_DRAWS - 1
 
@@ -170,42 +173,6 @@ def _attempt_pictures(doc: dict, out: Path) -> list:
         return render_steps(scene, paths)
 
 
-def _attempt_grasps(r: dict, hand_name: str) -> list:
-    """Each attempt's executed grasp in the schema (world frame, where the hand closed)."""
-    from ..hand import Hand
-    from ..io.grasp_schema import hand_grasp_record
-
-    hand = Hand.load(hand_name)
-    return [hand_grasp_record(hand, a["hand_pose"], a["joint_positions"], a["variant"]["spread"]) for a in r["attempts"]]
-
-
-def _contacts(r: dict) -> list:
-    """Each attempt's object contacts (with their parts), as the episode's execution found them."""
-    return [[c.to_dict() for c in ex.contacts if not c.on_table] for ex in r["executions"]]
-
-
-def _plan_json(args, ctx, pose, r: dict) -> dict:
-    """plan's JSON; each attempt carries the belief it was planned from (its heaviest particles)."""
-    from ..io.view_fields import belief_json
-
-    f = r["final_belief"]
-    grasps = _attempt_grasps(r, ctx.hand)
-    return {"object": args.object, "units": args.units, "method": args.method, "true_pose": pose, "estimate": r["estimate"],
-            "success_criterion": ctx.success, "success": r["success"],
-            "attempts": [{"plan_type": a["kind"], "family": a["family"], "variant": a["variant"],
-                          "top_grasp": a["action"] if a["family"] == "top" else None,
-                          "action": a["action"], "grasp": g, "predicted_stability": a["predicted_stability"],
-                          "expected_entropy": a["expected_entropy"], "entropy": a["belief_before"]["kde_entropy"],
-                          "epsilon": a["epsilon"], "stable": a["stable"], "lifted": a["lifted"],
-                          "success": a["success"], "outcome": "success" if a["success"] else "failure",
-                          "plan_seconds": a["plan_seconds"],
-                          "joint_angles": a["joint_angles"], "belief": belief_json(*r["snapshots"][k]),
-                          "contacts": c} for k, (a, g, c) in enumerate(zip(r["attempts"], grasps, _contacts(r)))],
-            "final_belief": {"mean": f["mean"], "std": f["std"], "entropy": f["kde_entropy"], "ess": f["ess"],
-                             "position_error": f["position_error"], "yaw_error": f["yaw_error"],
-                             **belief_json(*r["snapshots"][-1])}}
-
-
 def plan(args) -> int:
     pose = floats(args.true_pose, 3, "--true-pose")
     fmt = output_format(args)
@@ -227,28 +194,26 @@ def plan(args) -> int:
     if fmt == "ros":
         from ..io.grasp_schema import to_ros
 
-        print(json.dumps({"attempts": [to_ros(g, grasp_id=f"attempt-{a['attempt']}", quality=a["predicted_stability"])
-                                       for a, g in zip(r["attempts"], _attempt_grasps(r, ctx.hand))]}))
+        print(json.dumps({"attempts": [to_ros(a.grasp, grasp_id=f"attempt-{a.number}", quality=a.plan.predicted_stability)
+                                       for a in r.attempts]}))
     elif fmt == "json":
-        print(json.dumps(_plan_doc(args, ctx, pose, r, start, view)))
+        print(json.dumps(_plan_doc(args, ctx, r, start, view)))
     else:
-        print(f"{'success' if r['success'] else 'no successful grasp'} after {len(r['attempts'])} attempt(s)")
+        print(f"{'success' if r.success else 'no successful grasp'} after {len(r.attempts)} attempt(s)")
     if args.view is not None:
         from .view import show_result
 
-        show_result(args, _plan_doc(args, ctx, pose, r, start, view))
+        show_result(args, _plan_doc(args, ctx, r, start, view))
     return 0
 
 
-def _plan_doc(args, ctx, pose, r: dict, start, view) -> dict:
+def _plan_doc(args, ctx, r, start, view) -> dict:
     """plan's JSON, with the vision start (and its cloud) when the belief came from camera data."""
-    from ..io.view_fields import cloud_json
+    from ..io.results import plan_document, vision_dict
 
-    doc = _plan_json(args, ctx, pose, r)
+    doc = plan_document(r, args.object, args.units, ctx.success)
     if start is not None:
-        doc["vision"] = {"scene": args.cloud or args.depth, "estimate": start.estimate.tolist(),
-                         "half_width": start.half_width.tolist(), "registration": start.registration.as_dict(),
-                         "cloud": cloud_json(view.object_points)}
+        doc["vision"] = vision_dict(start, args.cloud or args.depth, view.object_points)
     return doc
 
 

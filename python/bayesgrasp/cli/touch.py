@@ -48,6 +48,8 @@ def _case(args) -> str:
 
 
 def run(args) -> int:
+    from ..io.results import touch_document
+    from ..loop.touch_trial import touch_once
     from ..planners import touch as T
 
     truth = np.array(floats(args.true_pose, 3, "--true-pose") + [args.true_scale])
@@ -62,61 +64,32 @@ def run(args) -> int:
     given = {k: getattr(args, k) for k in ("optimizer", "budget", "contact_term") if getattr(args, k) is not None}
     settings = T.TouchSettings(unknowns=case, seed=ctx.seed, spread=args.spread, threads=0, **given)
     obj = object_arg(args)                          # in --units, read once
-    planner = T.TouchPlanner(obj, guess, settings, hand=ctx.hand)
-    world = T.touch_world(obj, truth[:3], truth[3], planner.model.hand)
-    grasp = planner.plan().touch
-    readings = T.read(world, grasp)
-    r = planner.observe(grasp, readings)
-    out = _result(args, planner, grasp, readings, r, truth, guess, case)
-    if png:
-        out["png"] = str(_landscape(planner, grasp, readings, truth, guess, png, args))
+    trial = touch_once(T.TouchPlanner(obj, guess, settings, hand=ctx.hand), obj, truth)
+    out = touch_document(trial, args.object, args.units, case)
+    landscape = _landscape(trial, png, args) if png else None
+    if landscape is not None:
+        out["png"] = str(landscape)
     fmt = output_format(args)
     if fmt == "ros":
         from ..io.grasp_schema import to_ros
 
-        print(json.dumps(to_ros(out["grasp"], grasp_id=f"{args.object}-touch")))
+        print(json.dumps(to_ros(trial.grasp, grasp_id=f"{args.object}-touch")))
     elif fmt == "json":
         print(json.dumps(out))
     else:
-        _print(out)
+        _print(trial, args.object, case, landscape)
     from .view import show_result
 
     show_result(args, out)
     return 0
 
 
-def _errors(obj, state, truth) -> dict:
-    from ..planners.touch import orientation_error, symmetry_order
-
-    yaw = orientation_error(state[2], truth[2], symmetry_order(obj))
-    return {"position_error": float(np.hypot(*(state[:2] - truth[:2]))),
-            "orientation_error": None if yaw is None else yaw,
-            "size_error": float(abs(state[3] - truth[3]) / truth[3])}
-
-
-def _result(args, planner, grasp, readings, r, truth, guess, case) -> dict:
-    from ..io.grasp_schema import hand_grasp_record
-
-    names = list(planner.model.hand.core.link_names)
-    est = np.asarray(planner.estimate, dtype=float)
-    return {
-        "object": args.object, "units": args.units, "case": case, "optimizer": planner.settings.optimizer,
-        "contact_term": planner.settings.contact_term,
-        "true_state": truth.tolist(), "initial": guess.tolist(), "estimate": est.tolist(),
-        "top_grasp": {"x": grasp.x, "y": grasp.y, "yaw": grasp.yaw, "spread": grasp.spread},
-        "grasp": hand_grasp_record(planner.model.hand, readings.hand_pose, readings.joints, grasp.spread),
-        "readings": {"joint_angles": np.asarray(readings.joints).tolist(),
-                     "joint_names": list(planner.model.hand.core.joint_names),
-                     "contact_links": [n for n, c in zip(names, readings.contact) if c],
-                     "hand_pose": np.asarray(readings.hand_pose).tolist()},
-        **{k: v for k, v in r.to_dict().items() if k not in ("initial", "state", "stopped", "cpu_seconds")},
-        "errors_before": _errors(planner.model.object, guess, truth),
-        "errors_after": _errors(planner.model.object, est, truth),
-    }
-
-
-def _landscape(planner, grasp, readings, truth, guess, png, args, n: int = 25):
+def _landscape(trial, png, args, n: int = 25):
+    """The fitness around the guess: over x, y at the true yaw and scale, and over yaw at the
+    truth's and the estimate's position."""
     from .. import viz
+
+    planner, grasp, readings, truth, guess = trial.planner, trial.touch, trial.readings, trial.truth, trial.initial
 
     box = planner.settings.box
     xs = np.linspace(guess[0] - box[0], guess[0] + box[0], n)
@@ -138,30 +111,40 @@ def _deg(v):
     return "undefined (body of revolution)" if v is None else f"{np.degrees(v):.2f} deg"
 
 
-def _print(o: dict) -> None:
-    g, rd = o["top_grasp"], o["readings"]
-    print(f"touch on {o['object']} ({o['case']}, {o['optimizer']}, contact term {o['contact_term']})")
-    print(f"  true state      x={o['true_state'][0]:.4f} y={o['true_state'][1]:.4f} "
-          f"yaw={o['true_state'][2]:.4f} scale={o['true_state'][3]:.3f}")
-    print(f"  executed grasp  top grasp at x={g['x']:.4f} y={g['y']:.4f} yaw={g['yaw']:.4f}, spread {g['spread']:.3f}")
-    print("  readings        joints (deg): " + ", ".join(f"{n}={np.degrees(v):.1f}"
-                                                           for n, v in zip(rd["joint_names"], rd["joint_angles"])))
-    print(f"                  contacts: {', '.join(rd['contact_links']) or 'none'}; "
-          f"hand closed at z = {rd['hand_pose'][2][3]:.4f} m")
-    if o["status"] != "estimated":
-        print(f"  {o['message']}")
-    e = o["estimate"]
+def _print(t, name: str, case: str, landscape) -> None:
+    """The text report of a :class:`~bayesgrasp.loop.touch_trial.TouchTrial`."""
+    g, rd, fit, settings = t.touch, t.readings, t.fit, t.planner.settings
+    ts, e = t.truth, t.estimate
+    print(f"touch on {name} ({case}, {settings.optimizer}, contact term {settings.contact_term})")
+    print(f"  true state      x={ts[0]:.4f} y={ts[1]:.4f} yaw={ts[2]:.4f} scale={ts[3]:.3f}")
+    print(f"  executed grasp  top grasp at x={g.x:.4f} y={g.y:.4f} yaw={g.yaw:.4f}, spread {g.spread:.3f}")
+    print("  readings        joints (deg): " + ", ".join(f"{n}={np.degrees(v):.1f}" for n, v in
+                                                           zip(t.planner.model.hand.core.joint_names, rd.joints)))
+    print(f"                  contacts: {', '.join(t.contact_links) or 'none'}; "
+          f"hand closed at z = {np.asarray(rd.hand_pose)[2, 3]:.4f} m")
+    _print_fit(fit, e)
+    for when, er in (("before", t.errors_before), ("after", t.errors_after)):
+        print(f"  errors {when:<7}  position {1000 * er.position_error:.1f} mm, orientation "
+              f"{_deg(er.orientation_error)}, size {100 * er.size_error:.1f} %")
+    _print_trace(fit)
+    if landscape is not None:
+        print(f"  landscape       {landscape}")
+
+
+def _print_fit(fit, e) -> None:
+    """The fit's status, estimate and fitness (``fit``: the optimiser's EstimateResult)."""
+    from ..planners.touch import EstimateStatus
+
+    if fit.status != EstimateStatus.estimated:
+        print(f"  {fit.message}")
     print(f"  estimate        x={e[0]:.4f} y={e[1]:.4f} yaw={e[2]:.4f} scale={e[3]:.3f}")
-    print(f"  fitness         {o['initial_fitness']:.4g} at the guess -> {o['fitness']:.4g} "
-          f"(joint {o['fitness_terms']['joint']:.3g}, contact {o['fitness_terms']['contact']:.3g}, "
-          f"height {o['fitness_terms']['height']:.3g}); {o['evaluations']} evaluations in {o['seconds']:.2f} s")
-    for when in ("before", "after"):
-        er = o[f"errors_{when}"]
-        print(f"  errors {when:<7}  position {1000 * er['position_error']:.1f} mm, orientation "
-              f"{_deg(er['orientation_error'])}, size {100 * er['size_error']:.1f} %")
-    tr = o["trace"]
-    if tr["evaluations"]:
-        k = np.unique(np.linspace(0, len(tr["evaluations"]) - 1, 6).astype(int))
-        print("  trace           " + ", ".join(f"{tr['evaluations'][i]}: {tr['best_fitness'][i]:.3g}" for i in k))
-    if "png" in o:
-        print(f"  landscape       {o['png']}")
+    print(f"  fitness         {fit.initial_fitness:.4g} at the guess -> {fit.fitness:.4g} "
+          f"(joint {fit.joint_term:.3g}, contact {fit.contact_term:.3g}, "
+          f"height {fit.height_term:.3g}); {fit.evaluations} evaluations in {fit.seconds:.2f} s")
+
+
+def _print_trace(fit) -> None:
+    evaluations, best = list(fit.trace_evaluations), list(fit.trace_fitness)
+    if evaluations:
+        k = np.unique(np.linspace(0, len(evaluations) - 1, 6).astype(int))
+        print("  trace           " + ", ".join(f"{evaluations[i]}: {best[i]:.3g}" for i in k))

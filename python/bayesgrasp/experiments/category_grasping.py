@@ -44,7 +44,8 @@ def category_run(experiment: str, obj: str, run_index: int, seed: int, *, ctx: R
     cat = obj.split("/")[0]
     pose, eye = view(seed)
     ep = see(obj, pose, cat, exclude=(obj,), eye_offset=eye, seed=seed % (2**31), complete=complete)
-    tasks = {t: {m: plan_and_execute(ep, cat, t, m, ctx, seed=seed % (2**31)) for m in METHODS} for t in TASKS[cat]}
+    tasks = {t: {m: plan_and_execute(ep, cat, t, m, ctx, seed=seed % (2**31)).to_dict() for m in METHODS}
+             for t in TASKS[cat]}
     return {"object": obj, "category": cat, "pose": list(pose), "eye_offset": list(eye), "complete": complete,
             "cloud_points": int(len(ep.observation.cloud)),
             "registrations": [{"model": r.model, "phi": r.phi, "success": r.success} for r in ep.registrations],

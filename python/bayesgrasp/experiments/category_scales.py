@@ -46,7 +46,7 @@ def scales_run(experiment: str, obj: str, run_index: int, seed: int, *, ctx: Run
     ep = see(obj, pose, cat, exclude=(obj,), eye_offset=eye, seed=seed % (2**31))
     t, r = scales
     tasks = {task: {m: plan_and_execute(ep, cat, task, m, ctx, seed=seed % (2**31),
-                                        settings=CategorySettings(method=m, translation_scale=t, rotation_scale=r))
+                                        settings=CategorySettings(method=m, translation_scale=t, rotation_scale=r)).to_dict()
                     for m in DENSITIES} for task in TASKS[cat]}
     return {"object": obj, "category": cat, "pose": list(pose), "scales": [t, r], "tasks": tasks}
 

@@ -32,6 +32,7 @@ from scipy import stats
 from ..belief import relative_planar_pose, weight_entropy
 from ..loop.context import RunContext
 from ..loop.episode import EpisodeSettings, run_episode
+from ..loop.episode_result import EpisodeResult
 from ..models import relative_top_grasps
 from ..planners import PLANNERS, PlannerSettings, make_planner
 from ..world import World
@@ -51,16 +52,12 @@ def true_pose(seed: int) -> np.ndarray:
     return np.array([rng.uniform(-0.1, 0.1), rng.uniform(-0.1, 0.1), rng.uniform(-np.pi, np.pi)])
 
 
-def _strip(result: dict) -> dict:
-    return {k: v for k, v in result.items() if k not in ("planner", "snapshots")}
-
-
 # ---- run functions (module level: sent to worker processes) ----------------------------------------
 def episode_run(experiment: str, obj: str, run_index: int, seed: int, *, method: str, stop_when_stable: bool,
-                ctx: RunContext) -> dict:
+                ctx: RunContext) -> EpisodeResult:
     """One closed-loop episode on the run's true pose (the same problem for every method)."""
     episode = EpisodeSettings(method=method, stop_when_stable=stop_when_stable)
-    return _strip(run_episode(obj, true_pose(seed), episode, ctx, seed=seed))
+    return run_episode(obj, true_pose(seed), episode, ctx, seed=seed)
 
 
 def _initial_planner(obj: str, ctx: RunContext, seed: int, models=None, settings: Optional[PlannerSettings] = None):
@@ -197,8 +194,9 @@ def belief_figures(exp: Experiment, objects: List[str], ctx: RunContext, out: Pa
         pose = true_pose(seed)
         episode = EpisodeSettings(method=method, stop_when_stable=(exp.name != "pub4"))
         r = run_episode(o, pose, episode, ctx, seed=seed, keep_planner=True)
-        p = plot_belief_evolution(r["snapshots"], pose, out / f"belief_{o}.png",
-                                  f"{o}, {method}, run 0: true pose {np.round(pose, 3).tolist()}", r["attempts"])
+        p = plot_belief_evolution(r.snapshots, pose, out / f"belief_{o}.png",
+                                  f"{o}, {method}, run 0: true pose {np.round(pose, 3).tolist()}",
+                                  [a.to_dict() for a in r.attempts])
         lines.append(f"![{o}]({p.name})")
     with open(out / "summary.md", "a") as f:
         f.write("\n## Belief evolution (run 0)\n\n" + "\n\n".join(lines) + "\n")

@@ -17,7 +17,7 @@ import sqlite3
 import sys
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Callable, Dict, Iterable, Optional, Sequence
+from typing import Any, Callable, Dict, Iterable, Optional, Sequence
 
 from tqdm import tqdm
 
@@ -115,10 +115,12 @@ def settings_difference(stored: dict, now: dict, prefix: str = "") -> list[str]:
     return out
 
 
-def _run(job) -> dict:
-    """One run: ``job`` is (fn, RunKey); returns fn(experiment, object, run_index, seed)."""
+def _run(job):
+    """One run: ``job`` is (fn, RunKey); returns fn(experiment, object, run_index, seed) as JSON
+    (a typed result through its ``to_dict()``, in the worker: it may hold what does not pickle)."""
     fn, key = job
-    return fn(key.experiment, key.object, key.run_index, key.seed)
+    result = fn(key.experiment, key.object, key.run_index, key.seed)
+    return result.to_dict() if hasattr(result, "to_dict") else result
 
 
 @dataclass(frozen=True)
@@ -131,7 +133,7 @@ class Series:
     experiment: str
     objects: tuple
     runs: int
-    fn: Callable[[str, str, int, int], dict]
+    fn: Callable[[str, str, int, int], Any]
     seed_name: Optional[str] = None
 
     def keys(self, base_seed: int) -> list:

@@ -29,8 +29,8 @@ import numpy as np
 
 from ..loop.context import RunContext
 from ..loop.episode import execute
-from ..planners.touch import (TouchModel, TouchPlanner, TouchSettings, orientation_error, read, symmetry_order,
-                              touch_world)
+from ..loop.touch_trial import pose_errors, touch_once
+from ..planners.touch import TouchModel, TouchPlanner, TouchSettings
 from ..world import World
 from . import report
 from .registry import Experiment, register
@@ -73,30 +73,21 @@ def problem(case: str, rng: np.random.Generator):
     return truth, initial
 
 
-def _errors(obj: str, state, truth) -> dict:
-    state, truth = np.asarray(state, dtype=float), np.asarray(truth, dtype=float)
-    yaw = orientation_error(state[2], truth[2], symmetry_order(obj))
-    return {"position_error": float(np.hypot(*(state[:2] - truth[:2]))), "orientation_error": yaw,
-            "size_error": float(abs(state[3] - truth[3]) / truth[3])}
-
-
 def _one_case(obj: str, case: str, optimizer: str, rng: np.random.Generator, seed: int, ctx: RunContext,
               contact_term: str = "flags", hand: Optional[str] = None):
     truth, initial = problem(case, rng)
     model = touch_model(obj, hand or ctx.hand)
     settings = TouchSettings(optimizer=optimizer, unknowns=case, budget=BUDGET, seed=seed,
                              box=(ERROR_XY, ERROR_YAW, SCALES[0], SCALES[1]), contact_term=contact_term)
-    planner = TouchPlanner(model, initial, settings)
-    grasp = planner.plan().touch
-    readings = read(touch_world(obj, truth[:3], truth[3], model.hand), grasp)
-    r = planner.observe(grasp, readings)
-    rec = {"truth": truth.tolist(), "initial": initial.tolist(), "estimate": planner.estimate.tolist(),
-           "status": r.status.name, "contacts": int(readings.contact_count), "fitness": r.fitness,
+    t = touch_once(TouchPlanner(model, initial, settings), obj, truth)
+    r = t.fit
+    rec = {"truth": truth.tolist(), "initial": initial.tolist(), "estimate": t.estimate.tolist(),
+           "status": r.status.name, "contacts": int(t.readings.contact_count), "fitness": r.fitness,
            "initial_fitness": r.initial_fitness, "evaluations": int(r.evaluations), "seconds": r.seconds,
            "cpu_seconds": r.cpu_seconds,
            "trace": [list(map(int, r.trace_evaluations[::10])), list(r.trace_fitness[::10])],
-           "before": _errors(obj, initial, truth), "after": _errors(obj, planner.estimate, truth)}
-    return rec, planner, truth
+           "before": pose_errors(obj, initial, truth).to_dict(), "after": pose_errors(obj, t.estimate, truth).to_dict()}
+    return rec, t.planner, truth
 
 
 def _second_grasp(obj: str, planner: TouchPlanner, truth, ctx: RunContext) -> dict:

@@ -43,8 +43,8 @@ def fusion_run(experiment: str, obj: str, run_index: int, seed: int, *, ctx: Run
     pose, eye = view(seed)
     trial = FusionTrial(obj, pose, ctx, eye_offset=eye, seed=seed % (2**31),
                         settings=FusionSettings(belief=belief, task_term=task_term, avoid_failed=avoid_failed))
-    out = trial.run(mode)
-    baseline = trial.run("vision", rounds=0) if mode == "random" else None
+    out = trial.run(mode).to_dict()
+    baseline = trial.run("vision", rounds=0).to_dict() if mode == "random" else None
     out.update({"object": obj, "pose": list(pose), "vision_only": baseline["rounds"][0] if baseline else out["rounds"][0]})
     return out
 

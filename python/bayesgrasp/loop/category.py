@@ -10,7 +10,7 @@ surface in the "complete model" mode the thesis warns is biased), :func:`registe
 """
 from __future__ import annotations
 
-from dataclasses import dataclass, field, fields, replace
+from dataclasses import dataclass, field, replace
 from functools import lru_cache
 from pathlib import Path
 from typing import Dict, List, Optional, Sequence, Tuple
@@ -25,6 +25,7 @@ from ..objects.views import DEFAULT_EYE_OFFSET, capture_view
 from ..planners.category import CategoryPlan, CategoryPlanner, CategorySettings
 from ..vision import Registrar, RegistrationResult, model_samples
 from ..world import World
+from .category_result import TaskGraspOutcome, TaskGraspResult
 from .context import RunContext
 
 #: Categories that train on another category's models (the thesis's tools experiment).
@@ -91,32 +92,6 @@ def demonstrated(models: Sequence[str], rule: TaskRule, ctx: RunContext,
     return task_grasps(models, rule, ctx.hand, settings, cache_dir=cache, say=ctx.progress)
 
 
-@dataclass
-class TaskGraspOutcome:
-    """A category plan's grasp on the stand-in object: executed (approach, close, lift test) or
-    not (no stand-in: a camera's view; or no plan, ``reason``). One key set either way: what was
-    not measured is None. success = lifted and task_ok (the contacts obey the task's rule)."""
-
-    executed: bool
-    reason: str = ""
-    hand_pose: Optional[list] = None
-    spread: Optional[float] = None
-    epsilon: Optional[float] = None
-    force_closure: Optional[bool] = None
-    lifted: Optional[bool] = None
-    task_ok: Optional[bool] = None
-    success: Optional[bool] = None
-    failure: Optional[str] = None
-    contact_parts: List[str] = field(default_factory=list)
-    collision_at_start: Optional[bool] = None
-    stopped_by_table: Optional[bool] = None
-    joint_angles: Optional[list] = None
-    joint_names: Optional[list] = None
-
-    def to_dict(self) -> dict:
-        return {f.name: getattr(self, f.name) for f in fields(self)}
-
-
 def execute(obj, pose, plan: CategoryPlan, rule: TaskRule, ctx: RunContext) -> TaskGraspOutcome:
     """The planned grasp executed on the object at its true pose: the open hand approaches along
     the planned pose's direction through its position with its roll, closes, is lift-tested;
@@ -181,7 +156,7 @@ def see(obj: Optional[str], pose, category_name: str, exclude: Sequence[str] = (
 
 def plan_and_execute(ep: CategoryEpisode, category_name: str, task: str, method: str, ctx: RunContext,
                      settings: Optional[CategorySettings] = None, seed: int = 0,
-                     grasps: Optional[Sequence] = None) -> dict:
+                     grasps: Optional[Sequence] = None) -> TaskGraspResult:
     """Eq. 4.1 for one task and method on the episode's registrations, then the execution.
     ``grasps``: the demonstrated grasps to use (default: generated from the task's rule, cached)."""
     rule = task_rule(category_name, task)
@@ -195,4 +170,4 @@ def plan_and_execute(ep: CategoryEpisode, category_name: str, task: str, method:
     if s.method == "warped":
         ep.warps[key] = planner.warped_models()        # the same view's other tasks reuse them
     outcome = execute(ep.obj, ep.pose, plan, rule, ctx) if ep.obj is not None else not_executed(plan)
-    return {**outcome.to_dict(), **plan.to_dict(), "method": method, "task": task, "task_grasps": len(grasps)}
+    return TaskGraspResult(plan, outcome, method, task, len(grasps))

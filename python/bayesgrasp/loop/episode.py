@@ -10,15 +10,16 @@ steps: :func:`plan` is the planner's, then :func:`execute` (the grasp at the tru
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Callable, Optional, Sequence, Tuple, Union
+from typing import Callable, Optional, Sequence, Union
 
 import numpy as np
 
 from ..models import GraspModels, relative_top_grasps
 from ..objects import ObjectModel, load_object
 from ..planners import Planner, PlannerSettings, Reading, make_planner
-from ..world import ContactRecord, World
+from ..world import World
 from .context import RunContext
+from .episode_result import Attempt, EpisodeResult, Execution
 
 
 @dataclass(frozen=True)
@@ -38,23 +39,6 @@ class EpisodeSettings:
     def __post_init__(self):
         if self.attempts < 1:
             raise ValueError(f"attempts: must be at least 1, got {self.attempts}")
-
-
-@dataclass
-class Execution:
-    """One executed grasp: where it was relative to the object, how it scored, what the fingers
-    read. ``success`` is the context's criterion (lifted, or ``stable``: epsilon above the models'
-    eps_stable); ``lifted`` is None when no lift test ran."""
-
-    relative_grasp: np.ndarray
-    epsilon: float
-    stable: bool
-    lifted: Optional[bool]
-    success: bool
-    collision_at_start: bool
-    joint_angles: np.ndarray
-    hand_pose: Optional[np.ndarray] = None   # (4, 4) world pose of the hand where it closed
-    contacts: Tuple[ContactRecord, ...] = ()  # where the hand touched (object and table), with parts
 
 
 def initial_estimate(true_pose: np.ndarray, settings: PlannerSettings, rng: np.random.Generator) -> np.ndarray:
@@ -93,16 +77,15 @@ def read_fingers(execution: Execution, models: GraspModels, noise: float, rng: n
     return q
 
 
-def _attempt_record(k: int, plan, ex: Execution, q: np.ndarray, before: dict, models: GraspModels) -> dict:
-    return {"attempt": k + 1, "kind": plan.kind, "family": plan.family, "variant": models.variant.as_dict(),
-            "action": plan.action.tolist(),
-            "relative_grasp": ex.relative_grasp.tolist(), "predicted_stability": float(plan.predicted_stability),
-            "objective": float(plan.objective), "expected_entropy": plan.expected_entropy,
-            "plan_seconds": plan.seconds, "evaluations": plan.evaluations, "epsilon": ex.epsilon,
-            "force_closure": ex.epsilon > 0.0, "stable": ex.stable, "lifted": ex.lifted, "success": ex.success,
-            "collision_at_start": ex.collision_at_start, "joint_angles": q.tolist(),
-            "hand_pose": None if ex.hand_pose is None else ex.hand_pose.tolist(),
-            "joint_positions": ex.joint_angles.tolist(), "belief_before": before}
+def _attempt(k: int, planner: Planner, world: World, true_pose: np.ndarray, ctx: RunContext,
+             rng: np.random.Generator) -> Attempt:
+    """Attempt ``k`` (from 0): the plan, its execution at the true pose and the fingers' reading."""
+    before = planner.summary(true_pose)
+    plan = planner.plan()
+    executed = planner.family_models[plan.family]
+    ex = execute(world, executed, plan.action, true_pose, ctx)
+    q = read_fingers(ex, executed, ctx.measurement_noise, rng)
+    return Attempt(k + 1, plan, executed.variant, ex, q, world.hand, before)
 
 
 def _check_pose(true_pose) -> np.ndarray:
@@ -115,16 +98,15 @@ def _check_pose(true_pose) -> np.ndarray:
 def run_episode(obj: Union[str, ObjectModel], true_pose: Sequence[float], episode: Optional[EpisodeSettings] = None,
                 ctx: Optional[RunContext] = None, seed: int = 0, estimate: Optional[Sequence[float]] = None,
                 models=None, keep_planner: bool = False,
-                on_attempt: Optional[Callable[[dict], None]] = None) -> dict:
+                on_attempt: Optional[Callable[[Attempt], None]] = None) -> EpisodeResult:
     """One run of the loop on ``obj`` whose hidden true pose is ``true_pose`` (x, y, yaw).
 
     ``models``: one family's GraspModels or {family: GraspModels} (default: the context's
     families, :meth:`RunContext.family_models`). The estimate defaults to
-    :func:`initial_estimate`. Returns a JSON-ready dict: success,
-    attempts (one dict per attempt), the initial and final belief summaries; with ``keep_planner``
-    also "planner" (the Planner object, not JSON), "snapshots" (the particles and weights
-    before each attempt and at the end) and "executions" (each attempt's :class:`Execution`, with
-    its contacts).
+    :func:`initial_estimate`. ``on_attempt`` is called with each :class:`Attempt` when it is done.
+    Returns an :class:`EpisodeResult` (its ``to_dict()`` is the stored record); with
+    ``keep_planner`` it also holds the planner and the belief's snapshots (particles and weights
+    before each attempt and at the end).
     """
     episode = episode or EpisodeSettings()
     ctx = ctx or RunContext()
@@ -138,43 +120,22 @@ def run_episode(obj: Union[str, ObjectModel], true_pose: Sequence[float], episod
     estimate = np.asarray(estimate, dtype=float)
     planner = make_planner(episode.method, models, estimate, settings, seed=int(rng.integers(2**31)))
     initial = planner.summary(true_pose)
-    snapshots, attempts, executions = [], [], []
+    snapshots, attempts = [], []
     for k in range(episode.attempts):
-        before = planner.summary(true_pose)
         if keep_planner:
             snapshots.append((planner.belief.particles, planner.belief.weights))
-        plan = planner.plan()
-        executed = planner.family_models[plan.family]
-        ex = execute(world, executed, plan.action, true_pose, ctx)
-        q = read_fingers(ex, executed, ctx.measurement_noise, rng)
-        rec = _attempt_record(k, plan, ex, q, before, executed)
-        executions.append(ex)
-        stop = ex.success and episode.stop_when_stable
+        attempt = _attempt(k, planner, world, true_pose, ctx, rng)
+        stop = attempt.success and episode.stop_when_stable
         if not stop:
-            planner.observe(plan, Reading(q, held=ex.success))
-            rec["belief_after"] = planner.summary(true_pose)
-        attempts.append(rec)
+            planner.observe(attempt.plan, Reading(attempt.measured, held=attempt.success))
+            attempt.belief_after = planner.summary(true_pose)
+        attempts.append(attempt)
         if on_attempt is not None:
-            on_attempt(rec)
+            on_attempt(attempt)
         if stop:
             break
-    result = _episode_result(obj_model.name, episode.method, true_pose, estimate, seed, attempts, initial,
-                             planner, true_pose, snapshots if keep_planner else None)
     if keep_planner:
-        result["executions"] = executions
-    return result
-
-
-def _episode_result(name: str, method: str, true_pose, estimate, seed: int, attempts: list, initial: dict,
-                    planner: Planner, truth, snapshots: Optional[list]) -> dict:
-    result = {"object": name, "method": method, "true_pose": true_pose.tolist(),
-              "estimate": np.asarray(estimate).tolist(), "seed": int(seed),
-              "success": any(a["success"] for a in attempts),
-              "first_success": next((a["attempt"] for a in attempts if a["success"]), None),
-              "lifted": any(a["lifted"] for a in attempts if a["lifted"] is not None),
-              "attempts": attempts, "initial_belief": initial, "final_belief": planner.summary(truth)}
-    if snapshots is not None:
-        result["planner"] = planner
         snapshots.append((planner.belief.particles, planner.belief.weights))
-        result["snapshots"] = snapshots
-    return result
+    return EpisodeResult(obj_model.name, episode.method, true_pose, estimate, int(seed), attempts, initial,
+                         planner.summary(true_pose), planner if keep_planner else None,
+                         snapshots if keep_planner else None)

@@ -24,6 +24,7 @@ from ..planners.protocol import Reading
 from ..world import World
 from .category import demonstrated, see
 from .context import RunContext
+from .fusion_result import FusionResult, FusionRound, TopGraspExecution
 
 ROUNDS = 3   # tactile rounds after G(0)
 
@@ -40,12 +41,12 @@ def planar_pose(T: np.ndarray) -> np.ndarray:
     return np.array([T[0, 3], T[1, 3], np.arctan2(T[1, 0], T[0, 0])])
 
 
-def top_grasp(world: World, action: np.ndarray, true_pose: np.ndarray, spread: float) -> dict:
+def top_grasp(world: World, action: np.ndarray, true_pose: np.ndarray, spread: float) -> TopGraspExecution:
     """The world top grasp (x, y, yaw) executed on the object at its true pose, lift-tested."""
     rel = relative_top_grasps(action, true_pose)[0]
     b = world.grasp_batch(rel, spread=spread, lift=True)
-    return {"action": action.tolist(), "lifted": bool(b.lifted[0]), "epsilon": float(b.epsilon[0]),
-            "joint_angles": np.asarray(b.joint_angles[0], float), "hand_pose": np.asarray(b.hand_pose[0]).tolist()}
+    return TopGraspExecution(np.array(action, dtype=float), bool(b.lifted[0]), float(b.epsilon[0]),
+                             np.asarray(b.joint_angles[0], float), np.asarray(b.hand_pose[0], float))
 
 
 class FusionTrial:
@@ -119,38 +120,32 @@ class FusionTrial:
             self.pose[1] + np.sin(self.pose[2]) * c[0] + np.cos(self.pose[2]) * c[1]
         return np.array([cx + rng.uniform(-0.03, 0.03), cy + rng.uniform(-0.03, 0.03), rng.uniform(-np.pi, np.pi)])
 
-    def run(self, mode: str = "random", rounds: int = ROUNDS, on_round=None, stop_at_lift: bool = False) -> dict:
+    def run(self, mode: str = "random", rounds: int = ROUNDS, on_round=None, stop_at_lift: bool = False) -> FusionResult:
         """G(0) (random or vision-planned) and up to ``rounds`` tactile rounds, until a grasp after
         round 1 is lifted (the thesis's protocol always runs round 1); ``stop_at_lift``: from the
         first lifted grasp on, round 0 included (the robot's rule: the object is up)."""
         rng, planner = self.start()
         belief = planner.belief
         g0 = self.random_grasp(rng) if mode == "random" else planner.plan().action
-        records = [self._record(0, self._execute(g0), belief)]
+        records = [self._round(0, g0, belief)]
         if on_round:
             on_round(records[-1])
         for t in range(1, rounds + 1):
             last = records[-1]
-            if (t > 1 or stop_at_lift) and any(r["lifted"] for r in records):
+            if (t > 1 or stop_at_lift) and any(r.lifted for r in records):
                 break
-            up = planner.observe(last["action"], Reading(last["measurement"], held=bool(last["lifted"])))
+            up = planner.observe(last.execution.action, Reading(last.measurement, held=bool(last.lifted)))
             plan = planner.plan()
-            rec = self._record(t, self._execute(plan.action), belief, plan, up.underflow)
-            records.append(rec)
+            records.append(self._round(t, plan.action, belief, plan, up.underflow))
             if on_round:
-                on_round(rec)
-        return {"mode": mode, "rounds": [{k: v for k, v in r.items() if k != "measurement"} for r in records],
-                "registrations": [{"model": n, "weight": float(w)} for n, w in zip(self.names, self.w0)]}
+                on_round(records[-1])
+        return FusionResult(mode, records, list(self.names), self.w0)
 
-    def _execute(self, action) -> dict:
+    def measurement(self, e: TopGraspExecution) -> np.ndarray:
+        """The modelled joint angles of an executed grasp (what the models read)."""
+        return e.joint_angles[self.models[0].joint_index]
+
+    def _round(self, t: int, action, belief: ModelMixtureBelief, plan=None, underflow: bool = False) -> FusionRound:
+        """Round ``t``: ``action`` executed, with the belief it was planned from (copied now)."""
         e = top_grasp(self.world, np.asarray(action, float), self.pose, self.spread)
-        idx = self.models[0].joint_index
-        e["joint_positions"] = np.asarray(e["joint_angles"]).tolist()
-        e["measurement"] = np.asarray(e.pop("joint_angles"))[idx]
-        return e
-
-    def _record(self, t: int, e: dict, belief: ModelMixtureBelief, plan=None, underflow: bool = False) -> dict:
-        return {"round": t, **e, "weights": belief.weights.tolist(), "poses": belief.poses.tolist(),
-                "underflow": underflow, "objective": None if plan is None else plan.objective,
-                **({} if plan is None or plan.part is None else {"part": plan.part}),
-                "stability": None if plan is None else plan.stability, "task": None if plan is None else plan.task}
+        return FusionRound(t, e, self.measurement(e), belief.weights.tolist(), belief.poses.tolist(), underflow, plan)

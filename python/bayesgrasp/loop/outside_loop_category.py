@@ -22,12 +22,12 @@ from typing import Optional, Sequence
 import numpy as np
 
 from ..cache import atomic_write
-from ..io.grasp_schema import hand_grasp_record
 from ..models.task_grasps import grasp_from_json, grasp_to_json
 from ..models.tasks import task_rule
 from ..planners.category import THESIS_METHODS
 from ..planners.fusion import FusionSettings
 from .category import Observation, demonstrated, plan_and_execute, see, training_models
+from .category_result import TaskGraspResult
 from .context import RunContext
 from .outside_loop import (STATE_FILE, DiskEpisode, EpisodeError, PoseEpisode, open_state, particles_digest,
                            predicted_top_grasp, settings_json)
@@ -134,7 +134,7 @@ class CategoryTaskEpisode(_CategoryBase):
         episode._start()
         return episode
 
-    def _planned(self) -> dict:
+    def _planned(self) -> TaskGraspResult:
         s = self.state
         return plan_and_execute(self._see(), s["category"], s["task"], s["method"], self.ctx, seed=s["seed"],
                                 grasps=self.grasps)
@@ -143,7 +143,7 @@ class CategoryTaskEpisode(_CategoryBase):
         if self.state["steps"] or self.state["next"] is not None:
             self.plan = self._planned()
             recorded = (self.state["steps"][0] if self.state["steps"] else self.state["next"])["planned_pose"]
-            self._check_replayed("the task grasp", self.plan["pose"], recorded)
+            self._check_replayed("the task grasp", self.plan.planned_pose, recorded)
 
     def _executed(self, nxt: dict) -> dict:
         return {"planned_pose": nxt["planned_pose"]}
@@ -152,19 +152,20 @@ class CategoryTaskEpisode(_CategoryBase):
         """Pub. V has no update from touch: the reading is recorded, the episode ends."""
 
     def _plan_next(self) -> None:
-        out = self.plan = self._planned()
-        if out["pose"] is None:
-            raise EpisodeError(f"no task grasp: {out['reason'] or 'the plan failed'}")
-        grasp = hand_grasp_record(self.hand, out["pose"], self.hand.open_joints(out["spread"]), out["spread"])
-        self.state["next"] = {"attempt": 1, "kind": "task", "planned_pose": out["pose"], "grasp": grasp,
-                              "objective": out["objective"], "weights": out["weights"],
-                              "contributions": out["contributions"], "dominant_model": out["dominant_model"]}
+        r = self.plan = self._planned()
+        if not r.plan.ok:
+            raise EpisodeError(f"no task grasp: {r.outcome.reason or 'the plan failed'}")
+        p = r.plan
+        self.state["next"] = {"attempt": 1, "kind": "task", "planned_pose": r.planned_pose,
+                              "grasp": r.planned_grasp(self.hand), "objective": p.objective, "weights": p.weights,
+                              "contributions": p.contributions, "dominant_model": p.dominant_model}
 
     def belief(self) -> dict:
         """The registrations' weights and contributions to the planned grasp."""
-        p = self.plan or {}
-        return {"weights": p.get("weights"), "contributions": p.get("contributions"),
-                "dominant_model": p.get("dominant_model")}
+        if self.plan is None:
+            return {"weights": None, "contributions": None, "dominant_model": None}
+        p = self.plan.plan
+        return {"weights": p.weights, "contributions": p.contributions, "dominant_model": p.dominant_model}
 
 
 # ---- vision then touch (Pub. VI) ----------------------------------------------------------------
