@@ -16,7 +16,7 @@ DEB_PACKAGES := build-essential cmake pkg-config python3-dev python3-venv \
 SOURCES := $(shell find cpp python tests/cpp -type f \( -name '*.cpp' -o -name '*.hpp' -o -name '*.h' -o -name '*.py' -o -name '*.json' \) 2>/dev/null) \
            $(wildcard bench/*.cpp bench/*.hpp) CMakeLists.txt pyproject.toml
 
-.PHONY: all demo test bench bench-peers deps clean distclean ctest pytest fuzz sanitize readme
+.PHONY: all demo test bench bench-peers deps clean distclean ctest pytest fuzz sanitize readme shipped-cache
 all: $(VENV)/.installed
 
 # ---- system packages -------------------------------------------------------------------
@@ -50,7 +50,13 @@ $(VENV)/.installed: $(VENV)/.base $(SOURCES)
 demo: $(VENV)/.installed
 	$(VENV)/bin/bayesgrasp demo --out out/demo
 
-ctest: $(VENV)/.installed
+# The C++ tests and benchmarks, in the package's build tree (the package itself builds only _core,
+# so `make demo` compiles no test or benchmark).
+build/py/.cpp-all: $(VENV)/.installed
+	cmake --build build/py
+	@touch $@
+
+ctest: build/py/.cpp-all
 	ctest --test-dir build/py --output-on-failure -j $(JOBS)
 
 pytest: $(VENV)/.installed
@@ -77,7 +83,7 @@ $(BENCH_VENV)/.base: build/.deps-ok
 	$(BENCH_VENV)/bin/pip install -q -r bench/requirements.txt
 	@touch $@
 
-bench: $(VENV)/.installed $(BENCH_VENV)/.base
+bench: build/py/.cpp-all $(BENCH_VENV)/.base
 	BENCH_PY=$(BENCH_VENV)/bin/python BAYESGRASP_PY=$(PY) BUILD_DIR=build/py bash bench/bench_all.sh
 
 # Peer planners (issue 52), each in its own virtual environment, driven by bench/peers/*_driver.py
@@ -106,6 +112,13 @@ $(PEER_CGN)/.installed: bench/peers/requirements-cgn.txt bench/peers/requirement
 bench-peers: $(VENV)/.installed $(BENCH_VENV)/.base $(PEER_PBG)/.installed $(PEER_CGN)/.installed
 	$(PY) bench/peers/protocol.py --out $(PEERS_OUT) --runs $(PEERS_RUNS) \
 	  $(if $(PEERS_OBJECTS),--objects $(PEERS_OBJECTS)) $(PEERS_ARGS)
+
+# The package's shipped cache (python/bayesgrasp/data/cache): the demo's, pub2's and the README's
+# category and fuse examples' models, task grasps and decompositions, rebuilt from an empty cache
+# (bayesgrasp.cache_build, into build/shipped-cache: an interrupted build resumes there; about an
+# hour on 2 cores). Found again by their cache keys.
+shipped-cache: $(VENV)/.installed
+	$(PY) -m bayesgrasp.cache_build --out python/bayesgrasp/data/cache
 
 clean:
 	rm -rf build/py out

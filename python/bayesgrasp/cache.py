@@ -3,6 +3,12 @@
 ``convex_decomposition/``, demonstrated task grasps beside the models), and how it writes and
 reads those files safely.
 
+The package ships a read-only cache of the built-in objects' entries (``bayesgrasp/data/cache``,
+rebuilt by ``make shipped-cache``: :mod:`bayesgrasp.cache_build`): :func:`load_cached` reads an
+entry from the user's cache, else the shipped file of the same name (same key: same mesh, hand and
+settings), so a first call on a built-in object builds nothing. ``BAYESGRASP_SHIPPED_CACHE=0``
+turns the shipped cache off (a truly empty cache, e.g. to rebuild it).
+
 Every cache file is written atomically: first to a temporary file with a unique name in the same
 directory, flushed to disk with fsync, then renamed over the target. So a reader never sees half a
 file, and builders of the same key never write into each other's files. Beside each file,
@@ -30,6 +36,26 @@ READ_ERRORS = (OSError, ValueError, KeyError, EOFError, zipfile.BadZipFile)
 def cache_root() -> Path:
     """``$BAYESGRASP_CACHE``, else ``~/.cache/bayesgrasp``."""
     return Path(os.environ.get("BAYESGRASP_CACHE") or os.path.join(os.path.expanduser("~"), ".cache", "bayesgrasp"))
+
+
+def shipped_root() -> Optional[Path]:
+    """The package's read-only cache (``bayesgrasp/data/cache``), or None when
+    ``$BAYESGRASP_SHIPPED_CACHE`` is ``0`` (or the package has none)."""
+    if os.environ.get("BAYESGRASP_SHIPPED_CACHE", "1").strip().lower() in ("0", "false", "no", "off"):
+        return None
+    root = Path(__file__).resolve().parent / "data" / "cache"
+    return root if root.is_dir() else None
+
+
+def shipped_copy(path: PathLike) -> Optional[Path]:
+    """The shipped file standing for cache file ``path`` (the same directory name and file name
+    under :func:`shipped_root`), if there is one."""
+    root = shipped_root()
+    if root is None:
+        return None
+    path = Path(path)
+    p = root / path.parent.name / path.name
+    return p if p.is_file() else None
 
 
 class CacheWarning(UserWarning):
@@ -108,3 +134,18 @@ def load_checked(path: PathLike, what: str, read: Callable[[Path], T]) -> Option
     except READ_ERRORS as e:
         warnings.warn(f"{what} {path}: unreadable ({type(e).__name__}: {e}); rebuilding it", CacheWarning, stacklevel=2)
         return None
+
+
+def load_cached(path: PathLike, what: str, read: Callable[[Path], T]) -> Optional[T]:
+    """:func:`load_checked` of the user's cache file ``path``; if it is absent, of its shipped copy
+    (:func:`shipped_copy`). None: build the entry."""
+    if not Path(path).is_file():
+        ship = shipped_copy(path)
+        if ship is not None:
+            return load_checked(ship, f"shipped {what}", read)
+    return load_checked(path, what, read)
+
+
+def cached(path: PathLike) -> bool:
+    """Whether ``path`` or its shipped copy exists (no checksum read)."""
+    return Path(path).is_file() or shipped_copy(path) is not None

@@ -33,7 +33,7 @@ from typing import Callable, List, Optional, Union
 import numpy as np
 
 from bayesgrasp._args import c_seed
-from bayesgrasp.cache import atomic_write, cache_root, load_checked
+from bayesgrasp.cache import atomic_write, cache_root, load_cached
 
 #: Triangles above which the mesh is simplified before CoACD (the built-in objects, at most
 #: 3,640, stay below).
@@ -202,7 +202,7 @@ def convex_decomposition(vertices, faces, threshold: float = 0.05, seed: int = 0
     what = f"'{name}'" if name else "the mesh"
     path = None if cache_dir is False else _cache_path(V, F, threshold, seed, max_faces, cache_dir)
     if path is not None:
-        cached = load_checked(path, "convex decomposition cache file", _read_pieces)
+        cached = load_cached(path, "convex decomposition cache file", _read_pieces)
         if cached is not None:
             return cached
     if say is not None:

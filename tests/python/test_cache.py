@@ -1,5 +1,6 @@
 """Cache files: atomic, checksummed writes; a damaged file is detected and rebuilt with a warning."""
 import json
+from dataclasses import replace
 import warnings
 
 import numpy as np
@@ -65,3 +66,62 @@ def test_a_damaged_decomposition_is_recomputed(tmp_path):
     with pytest.warns(CacheWarning, match="convex decomposition"):
         again = convex_decomposition(mug.vertices, mug.faces, cache_dir=tmp_path)
     assert len(again) == len(pieces) and all(np.array_equal(a, b) for a, b in zip(again, pieces))
+
+
+def test_a_shipped_entry_is_read_when_the_users_cache_has_none(tmp_path, monkeypatch):
+    """The shipped cache stands behind the user's: the same key's files are loaded from it, the
+    models are not trained, and BAYESGRASP_SHIPPED_CACHE=0 turns it off."""
+    import bayesgrasp.models.build as build
+    from bayesgrasp import cache
+    from bayesgrasp.models import models_cached
+
+    shipped = tmp_path / "shipped"
+    made = build_models("cube", settings=TINY, cache_dir=shipped / "models")
+    monkeypatch.setattr(cache, "shipped_root", lambda: shipped)
+    user = tmp_path / "user" / "models"
+    assert models_cached("cube", settings=TINY, cache_dir=user)
+
+    def no_training(*a, **k):
+        raise AssertionError("trained although the shipped cache has the models")
+
+    monkeypatch.setattr(build, "_train", no_training)
+    got = build_models("cube", settings=TINY, cache_dir=user)
+    assert got.loaded_from_cache and not user.exists()          # read from the shipped copy, nothing written
+    X = np.array([[0.01, -0.02, 0.3, 1.0]])
+    np.testing.assert_array_equal(got.stability.predict(X), made.stability.predict(X))
+    with pytest.raises(AssertionError, match="trained"):          # another key: not shipped, so built
+        build_models("cube", settings=replace(TINY, seed=6), cache_dir=user)
+    monkeypatch.undo()
+    monkeypatch.setenv("BAYESGRASP_SHIPPED_CACHE", "0")
+    assert cache.shipped_root() is None and cache.shipped_copy(shipped / "models" / "x.json") is None
+
+
+def test_the_users_entry_wins_and_a_damaged_shipped_one_is_rebuilt(tmp_path, monkeypatch):
+    from bayesgrasp import cache
+
+    monkeypatch.setattr(cache, "shipped_root", lambda: tmp_path / "shipped")
+    ship, mine = tmp_path / "shipped" / "task_grasps" / "t.json", tmp_path / "mine" / "task_grasps" / "t.json"
+    atomic_write_text(ship, '{"from": "shipped"}')
+    assert cache.load_cached(mine, "task grasp cache file", lambda p: json.loads(p.read_text())) == {"from": "shipped"}
+    atomic_write_text(mine, '{"from": "mine"}')
+    assert cache.load_cached(mine, "task grasp cache file", lambda p: json.loads(p.read_text())) == {"from": "mine"}
+    mine.unlink()
+    ship.write_text('{"from": "altered"}')
+    with pytest.warns(CacheWarning, match="shipped task grasp cache file"):
+        assert cache.load_cached(mine, "task grasp cache file", lambda p: json.loads(p.read_text())) is None
+
+
+def test_the_cache_build_keeps_each_folders_entries_and_names_them(tmp_path):
+    from bayesgrasp import cache_build
+
+    cache, out = tmp_path / "cache", tmp_path / "out"
+    atomic_write_text(cache / "models" / "k.json", "{}")
+    atomic_write_text(cache / "task_grasps" / "task_t.json", "{}")
+    (cache / "models" / ".k.123.tmp.json").write_text("half")      # a builder's temporary: not kept
+    atomic_write_text(out / "convex_decomposition" / "stale.npz", "old")   # replaced by the cache's (none)
+    m = cache_build.keep(cache, out, [{"name": "demo"}])
+    assert m["files"] == {"models": ["k.json", "k.json.sha256"], "task_grasps": ["task_t.json", "task_t.json.sha256"]}
+    assert checked(out / "models" / "k.json") and not (out / "convex_decomposition").exists()
+    assert json.loads((out / "MANIFEST.json").read_text())["commands"] == [{"name": "demo"}]
+    with pytest.raises(SystemExit):
+        cache_build.main(["--only", "demo,nonsense", "--out", str(out)])

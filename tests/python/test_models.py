@@ -165,3 +165,31 @@ def test_models_of_several_objects_says_what_is_missing_and_the_time_left(tmp_pa
     ctx2 = RunContext(cache_dir=str(tmp_path), model_settings=tiny, progress=said.append)
     ctx2.models_of(["cube", "cylinder", "mug"])
     assert not [m for m in said if m.startswith("models: ")]
+
+
+def test_cross_fitted_calibration_lift_tests_no_held_out_grasp(tmp_path, monkeypatch):
+    """calibration="cross_fit" fits P(S)'s calibration on the training grasps' own lift outcomes,
+    scored out of fold: no calibration grasp is simulated, the key differs from the default's (which
+    stays what it was before the option), and the calibration orders outcomes as the labels do."""
+    from dataclasses import replace
+
+    import bayesgrasp.models.build as build
+    from bayesgrasp.models import cache_key
+    from bayesgrasp.objects import load_object
+
+    settings = replace(SMALL, spread=0.0, calibration="cross_fit")
+    calls = []
+    real = build.simulate_training_data
+    monkeypatch.setattr(build, "simulate_training_data", lambda *a, **k: calls.append(k) or real(*a, **k))
+    m = build_models("cylinder", settings=settings, cache_dir=tmp_path)
+    assert [k.get("seed_offset", 0) for k in calls] == [0]      # the training set only
+    a, b = m.info["calibration"]
+    assert a > 0                                                 # a higher GP score, a likelier lift
+    cyl = load_object("cylinder")
+    keys = {cache_key(cyl, "h", s) for s in (settings, replace(settings, calibration="held_out"))}
+    assert len(keys) == 2
+    assert "calibration" not in replace(settings, calibration="held_out").as_stored()
+    with pytest.raises(ValueError, match="cross_fit"):
+        ModelSettings(success="epsilon", calibration="cross_fit")
+    with pytest.raises(ValueError, match="calibration"):
+        ModelSettings(calibration="bogus")

@@ -159,7 +159,7 @@ class RunContext:
         return {"bayesgrasp": __version__, "cache_version": CACHE_VERSION, "hand": hand.name,
                 "hand_file_sha256": hashlib.sha256(text).hexdigest()[:16], "success": self.success,
                 "lift": self.lift, "families": list(self.families),
-                "models": {k: _plain(v) for k, v in asdict(models).items()},
+                "models": {k: _plain(v) for k, v in models.as_stored().items()},
                 "planner": {k: _plain(v) for k, v in asdict(self.planner_settings()).items()},
                 "measurement_noise": float(self.measurement_noise), "run_seeds": RUN_SEEDS}
 

@@ -16,7 +16,7 @@ import numpy as np
 
 from .. import DEFAULT_HAND
 from .. import gp as _gp
-from ..cache import atomic_write, atomic_write_text, cache_root, load_checked
+from ..cache import atomic_write, atomic_write_text, cache_root, cached, load_cached
 from ..objects import ObjectModel, load_object
 from ..world import World
 from .families import Variant
@@ -42,7 +42,7 @@ def cache_key(obj: ObjectModel, hand_text: str, settings: ModelSettings) -> str:
     h.update(np.ascontiguousarray(obj.faces, dtype=np.int64).tobytes())
     h.update(hand_text.encode())
     h.update(cache_salt(obj))      # the lift test's mass, where it is not the closed mesh's
-    fields = asdict(settings)
+    fields = settings.as_stored()
     if fields["family"] == "top":  # top models keep the keys they had before there were families
         del fields["family"]
     h.update(json.dumps(fields, sort_keys=True).encode())
@@ -59,8 +59,8 @@ class _CacheFiles:
 
     def load(self, settings: ModelSettings) -> Optional[GraspModels]:
         """The cached models, or None (a damaged or unreadable file warns) to rebuild them."""
-        info = load_checked(self.info, "model cache file", lambda p: json.loads(p.read_text()))
-        gps = [load_checked(f, "model cache file", _gp.load) for f in (self.measurement, self.stability)]
+        info = load_cached(self.info, "model cache file", lambda p: json.loads(p.read_text()))
+        gps = [load_cached(f, "model cache file", _gp.load) for f in (self.measurement, self.stability)]
         if info is None or None in gps:
             return None
         models = GraspModels(gps[0], gps[1], settings, info["joint_index"], info)
@@ -81,9 +81,13 @@ def _fit(X, Y, settings: ModelSettings, n: int) -> _gp.SparseGP:
                         noise=1e-2).fit(X, Y)
 
 
-def _calibrate(models: GraspModels, world: World, settings: ModelSettings, spread: Variant, say: Say) -> tuple:
-    """The logistic calibration of P(S) on the outcomes of held-out simulated grasps (the
-    probit-like default when there are too few)."""
+def _calibrate(models: GraspModels, world: World, settings: ModelSettings, spread: Variant, say: Say,
+               labelled: tuple) -> tuple:
+    """The logistic calibration of P(S) on the outcomes of held-out simulated grasps, or (calibration
+    "cross_fit") of the labelled training grasps ``labelled`` = (rel, outcomes) scored across folds;
+    the probit-like default when there are too few."""
+    if settings.calibration == "cross_fit":
+        return _cross_fit_calibration(models, settings, spread, say, *labelled)
     if settings.n_calibration <= 0:
         return DEFAULT_CALIBRATION
     say(f"models for {world.object.name}: calibrating P(S) on {settings.n_calibration} held-out grasps "
@@ -94,6 +98,24 @@ def _calibrate(models: GraspModels, world: World, settings: ModelSettings, sprea
     return fit_calibration(models.stability_z(rel_c), success_labels(world, settings, rel_c, eps_c, spread, say))
 
 
+def _cross_fit_calibration(models: GraspModels, settings: ModelSettings, variant: Variant, say: Say, rel,
+                           outcomes) -> tuple:
+    """Two-fold cross-fitting: a stability GP fitted on each half of the labelled grasps scores the
+    other half (z, as GraspModels.stability_z); the logistic calibration of the outcomes on those
+    out-of-fold scores. No grasp is simulated or lift-tested again."""
+    n = len(rel)
+    if n < 20 or np.all(outcomes) or not np.any(outcomes):
+        return DEFAULT_CALIBRATION
+    say(f"models: calibrating P(S) on the {n} labelled grasps, each scored by a GP fitted on the other half")
+    fold = np.random.default_rng([settings.seed, 11]).permutation(n) % 2
+    z = np.empty(n)
+    for k in (0, 1):
+        train, test = fold != k, fold == k
+        gp = _fit(variant.features(rel[train]), outcomes[train].astype(float), settings, int(train.sum()))
+        z[test] = GraspModels(models.measurement, gp, settings, models.joint_index, models.info).stability_z(rel[test])
+    return fit_calibration(z, outcomes)
+
+
 def _fit_stability(world: World, settings: ModelSettings, rel, eps, variant: Variant, say: Say):
     """The stability GP and the outcomes it was fitted on: lift outcomes (0/1) of the first
     n_lift_samples training grasps, or the epsilon of all of them."""
@@ -101,8 +123,8 @@ def _fit_stability(world: World, settings: ModelSettings, rel, eps, variant: Var
         n = min(settings.scaled(settings.n_lift_samples, settings.grasp_box(world.object)), len(rel))
         say(f"models for {world.object.name}: lift tests of {n} training grasps")
         lifted = success_labels(world, settings, rel[:n], eps[:n], variant, say)
-        return _fit(variant.features(rel[:n]), lifted.astype(float), settings, n), lifted
-    return _fit(variant.features(rel), np.maximum(eps, 0.0), settings, len(rel)), eps > settings.eps_stable
+        return _fit(variant.features(rel[:n]), lifted.astype(float), settings, n), (rel[:n], lifted)
+    return _fit(variant.features(rel), np.maximum(eps, 0.0), settings, len(rel)), (rel, eps > settings.eps_stable)
 
 
 def _choose_variant(world: World, settings: ModelSettings, say: Say):
@@ -139,11 +161,12 @@ def _train(world: World, settings: ModelSettings, key: str, say: Say) -> GraspMo
     X = variant.features(rel)
     say(f"models for {name}: fitting FITC GPs on {len(rel)} grasps")
     measurement = _fit(X, q[:, joint_index], settings, len(rel))
-    stability, outcomes = _fit_stability(world, settings, rel, eps, variant, say)
+    stability, labelled = _fit_stability(world, settings, rel, eps, variant, say)
+    outcomes = labelled[1]
     models = GraspModels(measurement, stability, settings, joint_index,
                          {"spread": float(spread), "grasp_box": settings.grasp_box(world.object).tolist(),
                           "variant": variant.as_dict()})
-    calibration = _calibrate(models, world, settings, variant, say)
+    calibration = _calibrate(models, world, settings, variant, say, labelled)
     models.info = {"key": key, "object": name, "calibration": list(calibration), "hand": world.hand.name,
                    "settings": asdict(settings), "samples": int(len(rel)),
                    "force_closure_fraction": float(np.mean(eps > 0)),
@@ -214,7 +237,7 @@ def models_cached(obj: Union[str, ObjectModel], hand=DEFAULT_HAND, settings: Opt
         return True
     _, key = _world_and_key(load_object(obj) if isinstance(obj, str) else obj, hand, settings)
     files = _CacheFiles(cache_dir, key)
-    return all(f.is_file() for f in (files.measurement, files.stability, files.info))
+    return all(cached(f) for f in (files.measurement, files.stability, files.info))
 
 
 def get_models(obj: Union[str, ObjectModel], hand: str = DEFAULT_HAND, settings: Optional[ModelSettings] = None,

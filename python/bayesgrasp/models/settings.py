@@ -13,6 +13,9 @@ CACHE_VERSION = 11  # 11: measured joints and their measurement scale from the h
 #: What a successful grasp is: held in the lift test (the default) or epsilon above eps_stable.
 SUCCESS_CRITERIA = ("lift", "epsilon")
 
+#: Where the P(S) calibration's outcomes come from (ModelSettings.calibration).
+CALIBRATIONS = ("held_out", "cross_fit")
+
 #: The default grasp box (xy_range None): the object's footprint grown by BOX_MARGIN, and at least
 #: +-BOX_MIN_HALF around the object's origin; the sample counts grow with its area relative to
 #: (2 BOX_MIN_HALF)^2, at most MAX_SAMPLE_SCALE times (a pitcher's handle reaches 12 cm out).
@@ -50,6 +53,10 @@ class ModelSettings:
     eps_stable: float = 0.01
     max_iter: int = 150           # hyper-parameter optimisation iterations
     n_calibration: int = 1000     # held-out simulated grasps for the P(S) calibration
+    # Where the P(S) calibration's outcomes come from: "held_out" (n_calibration fresh simulated and
+    # lift-tested grasps) or "cross_fit" (success "lift" only: the stability model's own labelled
+    # grasps, each scored by a GP fitted on the other half of them; no further lift test).
+    calibration: str = "held_out"
     seed: int = 0
     success: str = "lift"
     n_lift_samples: int = 1000    # training grasps lift-tested for the stability model (success "lift")
@@ -72,8 +79,22 @@ class ModelSettings:
         from .families import FAMILIES
         if self.family not in FAMILIES:
             raise ValueError(f"family: one of {', '.join(FAMILIES)}; got {self.family!r}")
+        if self.calibration not in CALIBRATIONS:
+            raise ValueError(f"calibration: one of {', '.join(CALIBRATIONS)}; got {self.calibration!r}")
+        if self.calibration == "cross_fit" and self.success != "lift":
+            raise ValueError("calibration: 'cross_fit' needs success 'lift' (it reuses the lift-tested training grasps)")
         if not 10 <= self.n_lift_samples:
             raise ValueError(f"n_lift_samples: need at least 10, got {self.n_lift_samples}")
+
+    def as_stored(self) -> dict:
+        """The fields as stored in cache keys and beside results: all of them, except ``calibration``
+        at its default (entries and results made before it existed keep their identity)."""
+        from dataclasses import asdict
+
+        fields = asdict(self)
+        if fields["calibration"] == "held_out":
+            del fields["calibration"]
+        return fields
 
     def grasp_box(self, obj) -> np.ndarray:
         """(2, 2) rows (x_lo, y_lo), (x_hi, y_hi): where relative top grasps are sampled for ``obj``

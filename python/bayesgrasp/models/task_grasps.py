@@ -24,7 +24,7 @@ from typing import Callable, List, Optional, Sequence, Union
 import numpy as np
 
 from .. import DEFAULT_HAND
-from ..cache import atomic_write_text, load_checked
+from ..cache import atomic_write_text, load_cached
 from ..objects import ObjectModel, load_object
 from ..world import World
 from ..objects.mass import cache_salt
@@ -241,7 +241,7 @@ def task_grasps(models: Sequence[Union[str, ObjectModel]], rule: TaskRule, hand:
     for m in models:
         o = load_object(m)
         f = None if cache_dir is None else Path(cache_dir) / f"task_{_key(o, hand_text, rule, s)}.json"
-        cached = None if f is None else load_checked(f, "task grasp cache file", load_task_grasp_file)
+        cached = None if f is None else load_cached(f, "task grasp cache file", load_task_grasp_file)
         if cached is not None:
             out += cached
             continue
