@@ -111,6 +111,29 @@ def test_the_users_entry_wins_and_a_damaged_shipped_one_is_rebuilt(tmp_path, mon
         assert cache.load_cached(mine, "task grasp cache file", lambda p: json.loads(p.read_text())) is None
 
 
+def test_the_shipped_cache_is_current_for_the_first_calls():
+    """Every shipped file passes its checksum, each model's info names its own key, and the
+    demo's and pub2's models (the default settings on the built-in objects) are found by today's
+    cache keys: a change of the keys without `make shipped-cache` fails here."""
+    from bayesgrasp import cache
+    from bayesgrasp.models import models_cached
+
+    root = cache.shipped_root()
+    assert root is not None, "no shipped cache in the package (make shipped-cache)"
+    manifest = json.loads((root / "MANIFEST.json").read_text())
+    for folder, names in manifest["files"].items():
+        for name in names:
+            if not name.endswith(".sha256"):
+                with warnings.catch_warnings():
+                    warnings.simplefilter("error")
+                    assert checked(root / folder / name), name
+            if name.endswith(".json") and folder == "models" and not name.startswith("task_"):
+                assert json.loads((root / folder / name).read_text())["key"] == name[:-5]
+    empty = root / "no-such-user-cache" / "models"
+    for obj in ("cube", "cylinder", "mug", "mug2", "pitcher"):
+        assert models_cached(obj, settings=ModelSettings(success="lift"), cache_dir=empty), obj
+
+
 def test_the_cache_build_keeps_each_folders_entries_and_names_them(tmp_path):
     from bayesgrasp import cache_build
 

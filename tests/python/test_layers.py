@@ -53,7 +53,7 @@ LAYERS = [
     {"viewer"},                      # viewer -> viz
     {"loop"},                        # the run context, the episodes, the category pipeline
     {"experiments"},                 # the thesis's experiments, run through the loop
-    {"cli"},
+    {"cli", "cache_build"},           # cache_build runs the CLI to fill the shipped cache
 ]
 LEVEL = {name: i for i, layer in enumerate(LAYERS) for name in layer}
 
