@@ -126,3 +126,23 @@ def test_a_headless_screenshot_is_not_blank_and_differs_between_attempts(capsys,
     A, B = mpimg.imread(tmp_path / "a.png"), mpimg.imread(tmp_path / "b.png")
     assert A.shape == B.shape and np.abs(A[..., :3] - B[..., :3]).mean() > 1e-3
     assert port_free(port)
+
+
+def test_the_demo_draws_its_pictures_with_matplotlib_when_the_browser_fails(capsys, tmp_path, grasp_doc, monkeypatch):
+    """A browser whose renderer times out (a loaded machine) does not end the demo: the pictures
+    are drawn by matplotlib instead, and stderr says why."""
+    from selenium.common.exceptions import TimeoutException
+
+    import bayesgrasp.viewer.snapshot as snap
+    from bayesgrasp.cli.plan import _attempt_pictures
+
+    def timed_out(*a, **k):
+        raise TimeoutException("timeout: Timed out receiving message from renderer: 10.000")
+
+    monkeypatch.setattr(snap, "find_browser", lambda: None)
+    monkeypatch.setattr(snap, "snapshot_steps", timed_out)
+    doc = {"scene_object": "mug/3", "object_pose": [0, 0, 0],
+           "rounds": [{"round": 0, "grasp": grasp_doc["grasp"], "lifted": grasp_doc["lifted"], "weights": {}, "poses": {}}]}
+    paths = _attempt_pictures(doc, tmp_path)
+    assert [p.name for p in paths] == ["attempt_1.png"] and paths[0].stat().st_size > 1000
+    assert "screenshots failed (Message: timeout: Timed out receiving message from renderer" in capsys.readouterr().err

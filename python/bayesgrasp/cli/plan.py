@@ -117,6 +117,8 @@ def demo(args) -> int:
     if skipped:
         print(f"  (the hidden pose is draw {skipped + 1} of seed {ctx.seed}: at the first {skipped}, the first grasp "
               f"lifted and the belief would not have moved)")
+    if ctx.progress:
+        ctx.progress("demo: the loop at the hidden pose (each attempt is printed when it has been executed)")
     r = _loop(args, ctx, pose, obj=obj)
     f = r.final_belief
     print(f"{'success' if r.success else 'no successful grasp'} after {len(r.attempts)} attempt(s); "
@@ -124,7 +126,9 @@ def demo(args) -> int:
     png = _belief_png(r, out / "belief_evolution.png")
     doc = plan_document(r, args.object, args.units, ctx.success)
     (out / "demo.json").write_text(json.dumps(doc, indent=1))
-    pictures = _attempt_pictures(doc, out)
+    if ctx.progress:
+        ctx.progress(f"demo: drawing the {len(r.attempts)} attempt(s) in the 3D view")
+    pictures = _attempt_pictures(doc, out, say=ctx.progress)
     print(f"saved {png}, {out / 'demo.json'} (see it in 3D: bayesgrasp view {out / 'demo.json'}) and "
           f"{len(pictures)} picture(s) of the hand on the {args.object}: {', '.join(p.name for p in pictures)}")
     return 0
@@ -141,10 +145,12 @@ def _demo_pose(args, ctx, obj) -> tuple:
     attempt (the same seed, so the demo repeats it exactly)."""
     from ..loop.episode import run_episode
 
+    say = ctx.progress or (lambda msg: None)
     rng = np.random.default_rng(ctx.seed)
     models = ctx.family_models(obj)
     for k in range(DEMO_DRAWS):
         pose = [float(rng.uniform(-0.08, 0.08)), float(rng.uniform(-0.08, 0.08)), float(rng.uniform(-np.pi, np.pi))]
+        say(f"demo: hidden pose draw {k + 1}: trying its first grasp (a draw whose first grasp lifts is skipped)")
         first = run_episode(obj, pose, EpisodeSettings(method=args.method, attempts=1), ctx, seed=ctx.seed,
                             models=models)
         if not first.attempts[0].success:
@@ -152,24 +158,30 @@ def _demo_pose(args, ctx, obj) -> tuple:
     return pose, DEMO_DRAWS - 1
 
 
-def _attempt_pictures(doc: dict, out: Path) -> list:
+def _attempt_pictures(doc: dict, out: Path, say=None) -> list:
     """attempt_K.png per attempt: the 3D view's screenshot (headless Chromium), or the same scene
-    drawn by matplotlib when no browser is installed (said on stderr)."""
+    drawn by matplotlib when no browser is installed or the browser fails (e.g. its renderer times
+    out on a loaded machine; said on stderr)."""
+    import sys
+
     from ..viewer import scene_from_result
+    from ..viewer.static import render_steps
 
     scene = scene_from_result(doc)
     paths = {k: out / f"attempt_{k + 1}.png" for k in range(len(scene.steps))}
     try:
+        from selenium.common.exceptions import WebDriverException
+
         from ..viewer.snapshot import NoBrowser, find_browser, snapshot_steps
-
-        find_browser()
-        return snapshot_steps(scene, paths, port=8090)
-    except (ImportError, NoBrowser) as e:
-        import sys
-
-        from ..viewer.static import render_steps
-
+    except ImportError as e:
         print(f"no browser for the 3D view's screenshots ({e}); drawing them with matplotlib", file=sys.stderr)
+        return render_steps(scene, paths)
+    try:
+        find_browser()
+        return snapshot_steps(scene, paths, port=8090, say=say)
+    except (NoBrowser, WebDriverException) as e:
+        reason = str(e).strip().splitlines()[0] if str(e).strip() else type(e).__name__
+        print(f"the 3D view's screenshots failed ({reason}); drawing them with matplotlib", file=sys.stderr)
         return render_steps(scene, paths)
 
 
