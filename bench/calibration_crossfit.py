@@ -32,9 +32,8 @@ def counted(real):
 
 def judge_set(world, models, settings, n):
     """n fresh grasps of the models' variant (seed offset 5) and their lift outcomes."""
-    variant = Variant(**models.info["variant"]) if isinstance(models.info.get("variant"), dict) else \
-        Variant("top", models.spread)
-    rel, _, eps = training.simulate_training_data(world, settings, seed_offset=5, n=n, spread=variant)
+    variant = Variant(**models.info["variant"])
+    rel, _, _ = training.simulate_training_data(world, settings, seed_offset=5, n=n, spread=variant)
     return rel, training.lift_outcomes(world, rel, variant)
 
 

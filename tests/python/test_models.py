@@ -178,11 +178,17 @@ def test_cross_fitted_calibration_lift_tests_no_held_out_grasp(tmp_path, monkeyp
     from bayesgrasp.objects import load_object
 
     settings = replace(SMALL, spread=0.0, calibration="cross_fit")
-    calls = []
-    real = build.simulate_training_data
+    calls, fitted = [], []
+    real, real_fit = build.simulate_training_data, build.fit_calibration
     monkeypatch.setattr(build, "simulate_training_data", lambda *a, **k: calls.append(k) or real(*a, **k))
+    monkeypatch.setattr(build, "fit_calibration", lambda z, y: fitted.append((z, y)) or real_fit(z, y))
     m = build_models("cylinder", settings=settings, cache_dir=tmp_path)
     assert [k.get("seed_offset", 0) for k in calls] == [0]      # the training set only
+    # fitted once, on every lift-tested training grasp (their outcomes are the stability GP's labels)
+    assert len(fitted) == 1
+    z, y = fitted[0]
+    assert len(z) == len(y) == SMALL.n_lift_samples and np.mean(y) == pytest.approx(m.info["success_fraction"])
+    assert tuple(m.info["calibration"]) == pytest.approx(real_fit(z, y))
     a, b = m.info["calibration"]
     assert a > 0                                                 # a higher GP score, a likelier lift
     cyl = load_object("cylinder")

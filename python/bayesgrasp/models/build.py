@@ -87,7 +87,7 @@ def _calibrate(models: GraspModels, world: World, settings: ModelSettings, sprea
     "cross_fit") of the labelled training grasps ``labelled`` = (rel, outcomes) scored across folds;
     the probit-like default when there are too few."""
     if settings.calibration == "cross_fit":
-        return _cross_fit_calibration(models, settings, spread, say, *labelled)
+        return _cross_fit_calibration(models, settings, spread, say, world.object.name, *labelled)
     if settings.n_calibration <= 0:
         return DEFAULT_CALIBRATION
     say(f"models for {world.object.name}: calibrating P(S) on {settings.n_calibration} held-out grasps "
@@ -98,15 +98,16 @@ def _calibrate(models: GraspModels, world: World, settings: ModelSettings, sprea
     return fit_calibration(models.stability_z(rel_c), success_labels(world, settings, rel_c, eps_c, spread, say))
 
 
-def _cross_fit_calibration(models: GraspModels, settings: ModelSettings, variant: Variant, say: Say, rel,
-                           outcomes) -> tuple:
+def _cross_fit_calibration(models: GraspModels, settings: ModelSettings, variant: Variant, say: Say, name: str,
+                           rel, outcomes) -> tuple:
     """Two-fold cross-fitting: a stability GP fitted on each half of the labelled grasps scores the
     other half (z, as GraspModels.stability_z); the logistic calibration of the outcomes on those
     out-of-fold scores. No grasp is simulated or lift-tested again."""
     n = len(rel)
     if n < 20 or np.all(outcomes) or not np.any(outcomes):
         return DEFAULT_CALIBRATION
-    say(f"models: calibrating P(S) on the {n} labelled grasps, each scored by a GP fitted on the other half")
+    say(f"models for {name}: calibrating P(S) on the {n} lift-tested training grasps, each scored by a GP "
+        f"fitted on the other half")
     fold = np.random.default_rng([settings.seed, 11]).permutation(n) % 2
     z = np.empty(n)
     for k in (0, 1):
