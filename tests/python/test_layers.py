@@ -46,6 +46,7 @@ LAYERS = [
     {"sim", "vision"},               # sim -> hand; vision -> belief
     {"physics"},                     # physics -> sim
     {"objects"},
+    {"arm"},                         # the arm under the hand: URDF kinematics, batched IK, its collisions
     {"world"},
     {"models"},
     {"planners"},

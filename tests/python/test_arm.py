@@ -1,0 +1,217 @@
+"""The arm: kinematics read from a URDF, batched IK and the reachability check (issue 57).
+
+Oracles: a planar two-link arm (links 0.5 and 0.3 m) reaches exactly the annulus
+0.2 <= r <= 0.8 about its base; with its elbow held to |q2| <= 0.5 rad it reaches only
+r >= sqrt(l1^2 + l2^2 + 2 l1 l2 cos 0.5) (law of cosines); the KUKA's IK solutions are driven
+through forward kinematics computed by yourdfpy from the URDF's own chain (testkit.urdf_fk),
+not through our kinematics; a wall between the arm and the grasp, and a grasp under the table,
+leave no configuration free of them.
+"""
+from pathlib import Path
+
+import numpy as np
+import pytest
+import trimesh
+from scipy.spatial.transform import Rotation
+
+from bayesgrasp.arm import Arm, ReachOptions, check_reach, default_mount, palm_depth
+from bayesgrasp.arm.ik import rotation_log
+from bayesgrasp.hand import Hand
+from testkit import urdf_fk
+
+PLANAR = Path(__file__).resolve().parents[1] / "data" / "arms" / "planar_2link.urdf"
+L1, L2, Z = 0.5, 0.3, 0.1
+
+
+def planar_targets(radii, angles):
+    """Palm poses in the planar arm's plane at (r cos a, r sin a, Z), the approach (palm z) pointing
+    radially outwards, so that backing off stays in the plane."""
+    P = np.tile(np.eye(4), (len(radii), 1, 1))
+    for i, (r, a) in enumerate(zip(radii, angles)):
+        out = np.array([np.cos(a), np.sin(a), 0.0])
+        P[i, :3, :3] = np.column_stack([np.array([0.0, 0.0, 1.0]), np.cross(out, [0.0, 0.0, 1.0]), out])   # y = z x x
+        P[i, :3, 3] = [r * np.cos(a), r * np.sin(a), Z]
+    assert np.allclose(np.linalg.det(P[:, :3, :3]), 1.0)
+    return P
+
+
+def top_grasp(x, y, z, yaw=0.0):
+    """A palm pose at (x, y, z) approaching straight down (palm z = -z of the table)."""
+    T = np.eye(4)
+    T[:3, :3] = Rotation.from_euler("z", yaw).as_matrix() @ np.diag([1.0, -1.0, -1.0])
+    T[:3, 3] = [x, y, z]
+    return T
+
+
+PLANAR_OPTIONS = ReachOptions(position_only=True, pregrasp_distance=0.02, seeds=6)
+
+
+def test_planar_arm_reaches_exactly_its_annulus():
+    """Inside 0.2 < r < 0.8 (and the pre-grasp 0.02 m nearer the base still inside): reachable;
+    inside the hole or beyond the outer circle: refused, "no IK solution"."""
+    rng = np.random.default_rng(4)
+    inside = np.array([0.25, 0.3, 0.45, 0.6, 0.72, 0.78])
+    outside = np.array([0.05, 0.12, 0.17, 0.83, 0.9, 1.2])
+    radii = np.r_[inside, outside]
+    P = planar_targets(radii, rng.uniform(-np.pi, np.pi, radii.size))
+    arm = Arm.load(PLANAR)
+    res = check_reach(arm, P, options=PLANAR_OPTIONS)
+    assert res.reachable.tolist() == [True] * inside.size + [False] * outside.size, (radii, res.reason)
+    assert res.reason[inside.size:] == ["no IK solution"] * outside.size
+    assert res.joint_names == ["shoulder", "elbow"]
+    # the solution is an elbow angle given by the law of cosines: r^2 = l1^2 + l2^2 + 2 l1 l2 cos q2
+    cos_q2 = (inside ** 2 - L1 ** 2 - L2 ** 2) / (2 * L1 * L2)
+    assert np.allclose(np.cos(res.q[:inside.size, 1]), cos_q2, atol=1e-3)
+    # the pre-grasp's elbow: 0.02 m nearer the base
+    cos_pre = ((inside - 0.02) ** 2 - L1 ** 2 - L2 ** 2) / (2 * L1 * L2)
+    assert np.allclose(np.cos(res.q_pre[:inside.size, 1]), cos_pre, atol=1e-3)
+
+
+def test_planar_arm_held_at_its_elbow_names_the_joint_limits(tmp_path):
+    """With the elbow limited to |q2| <= 0.5 rad the arm reaches only r >= r_min =
+    sqrt(l1^2 + l2^2 + 2 l1 l2 cos 0.5) = 0.7767 m: r = 0.5 is "joint limits" (the angle it needs,
+    2.21 rad, is outside them), r = 0.79 reachable, r = 0.9 still "no IK solution"."""
+    text = PLANAR.read_text().replace('lower="-3.14159" upper="3.14159" effort="10" velocity="1"/>\n    <parent link="upper"/>',
+                                      'lower="-0.5" upper="0.5" effort="10" velocity="1"/>\n    <parent link="upper"/>')
+    assert text != PLANAR.read_text()
+    urdf = tmp_path / "held.urdf"
+    urdf.write_text(text)
+    r_min = np.sqrt(L1 ** 2 + L2 ** 2 + 2 * L1 * L2 * np.cos(0.5))
+    assert 0.776 < r_min < 0.777
+    res = check_reach(Arm.load(urdf), planar_targets([0.5, 0.79, 0.9], [0.3, -1.0, 2.0]),
+                      options=PLANAR_OPTIONS.with_(pregrasp_distance=0.0))
+    assert res.reachable.tolist() == [False, True, False]
+    assert res.reason == ["joint limits", "", "no IK solution"]
+    assert np.all(np.abs(res.q[1]) <= [np.pi, 0.5])
+
+
+def kuka(base=(-0.6, 0.0, 0.0, 0.0)):
+    return Arm.load("kuka_lbr4", base=base, mount=default_mount(Hand.load("barrett_bh8")))
+
+
+def test_the_default_mount_puts_the_barrett_palm_on_the_flange():
+    """The BH8's palm box spans z in [-0.06, 0] of the hand frame: its back rests on the flange,
+    the palm face 0.06 m out along the flange's z."""
+    hand = Hand.load("barrett_bh8")
+    assert palm_depth(hand) == pytest.approx(0.06)
+    assert np.allclose(default_mount(hand), [[1, 0, 0, 0], [0, 1, 0, 0], [0, 0, 1, 0.06], [0, 0, 0, 1]])
+
+
+def test_kuka_solutions_drive_the_urdf_chain_to_the_palm_pose():
+    """Palm poses made from random joint vectors (so they are reachable) at a yawed base; every
+    solution, put through the URDF's chain by yourdfpy (plus base and mount), lands on its palm
+    pose within 1 mm and 0.5 degrees, within the joint limits; the pre-grasp 0.1 m back along the
+    approach likewise."""
+    arm = kuka(base=(0.2, -0.4, 0.05, 0.8))
+    rng = np.random.default_rng(11)
+    q_true = rng.uniform(0.7 * arm.lower, 0.7 * arm.upper, (24, arm.dof))
+    P = arm.palm_poses(q_true)
+    res = check_reach(arm, P, options=ReachOptions(table=False))
+    assert res.reachable.mean() >= 0.9, res.reason
+    flange = arm.flange
+    for i in np.flatnonzero(res.reachable):
+        pre = P[i].copy()
+        pre[:3, 3] -= 0.1 * P[i][:3, 2]                 # 0.1 m back along the approach (palm z)
+        for q, target in ((res.q[i], P[i]), (res.q_pre[i], pre)):
+            assert np.all((q >= arm.lower - 1e-12) & (q <= arm.upper + 1e-12))
+            T = arm.base @ urdf_fk(arm.urdf, dict(zip(res.joint_names, q)))[flange] @ arm.mount
+            assert np.linalg.norm(T[:3, 3] - target[:3, 3]) <= 1e-3
+            angle = np.linalg.norm(Rotation.from_matrix(T[:3, :3] @ target[:3, :3].T).as_rotvec())
+            assert np.degrees(angle) <= 0.5
+    assert np.all(res.position_error[res.reachable] <= 1e-3)
+
+
+def test_our_kinematics_match_pinocchio():
+    """The batched forward kinematics against pinocchio's own on the same model."""
+    import pinocchio as pin
+
+    arm = kuka(base=(0.1, 0.2, 0.3, 0.7))
+    q = np.random.default_rng(2).uniform(arm.lower, arm.upper, (5, arm.dof))
+    F = arm.flange_poses(q)
+    data = arm.model.createData()
+    fid = arm.model.getFrameId(arm.flange)
+    for i in range(5):
+        pin.framesForwardKinematics(arm.model, data, arm.pin_q(q[i]))
+        assert np.allclose(arm.base @ data.oMf[fid].homogeneous, F[i], atol=1e-12)
+
+
+def test_rotation_log_matches_scipy_near_zero_and_near_half_a_turn():
+    v = np.array([[1e-7, 0, 0], [0.3, -0.2, 0.1], [0, 0, np.pi - 1e-5], [0.0, np.pi - 0.5, 0.0]])
+    assert np.allclose(rotation_log(Rotation.from_rotvec(v).as_matrix()), v, atol=1e-9)
+
+
+def wall():
+    """A wall 5 cm thick across the table at x in [-0.35, -0.30], 2 m wide and 1.6 m tall: higher
+    and wider than the arm (1.24 m from base to palm) can reach over or around from x = -0.6."""
+    w = trimesh.creation.box((0.05, 2.0, 1.6))
+    w.apply_translation((-0.325, 0.0, 0.8))
+    return w
+
+
+def test_a_grasp_behind_a_wall_is_refused_with_its_reason():
+    grasp = top_grasp(0.0, 0.0, 0.12)
+    arm = kuka()
+    free = check_reach(arm, grasp)
+    assert free.reachable.tolist() == [True]        # the control: the same grasp with no wall
+    res = check_reach(arm, grasp, object_mesh=wall())
+    assert res.reachable.tolist() == [False]
+    assert res.reason == ["arm hits object"]
+    assert np.all(np.isnan(res.q)) and np.all(np.isnan(res.q_pre))
+
+
+def test_a_grasp_under_the_table_is_refused_with_its_reason():
+    """The palm 0.1 m under the table top, 0.6 m in front of the arm, approaching sideways (along
+    +x): the arm standing on the table must put its wrist through the top."""
+    grasp = np.eye(4)
+    grasp[:3, :3] = [[0, 0, 1], [0, 1, 0], [-1, 0, 0]]   # palm z = +x
+    grasp[:3, 3] = [0.0, 0.0, -0.1]
+    arm = kuka()
+    assert check_reach(arm, grasp, options=ReachOptions(table=False)).reachable.tolist() == [True]
+    res = check_reach(arm, grasp)
+    assert res.reachable.tolist() == [False]
+    assert res.reason == ["arm hits table"]
+
+
+def test_a_batch_keeps_each_grasps_own_answer():
+    """One call on a mixed batch gives each grasp the answer it gets alone."""
+    arm = kuka()
+    P = np.stack([top_grasp(0.0, 0.0, 0.12), top_grasp(2.0, 0.0, 0.12), top_grasp(0.1, 0.2, 0.15, 1.0)])
+    batch = check_reach(arm, P, object_mesh=wall())
+    alone = [check_reach(arm, P[i], object_mesh=wall()) for i in range(3)]
+    assert batch.reason == [a.reason[0] for a in alone]
+    assert batch.reason[1] == "no IK solution"
+    d = batch.to_dict()
+    assert d["joint_names"] == arm.joint_names and len(d["q"]) == 3
+
+
+def test_the_same_seed_gives_the_same_answer():
+    arm = kuka()
+    P = np.stack([top_grasp(x, y, 0.1, a) for x, y, a in [(0, 0, 0), (0.2, -0.1, 1.0), (-0.1, 0.3, 2.0)]])
+    a, b = check_reach(arm, P), check_reach(arm, P)
+    assert a.reason == b.reason and np.array_equal(a.q, b.q, equal_nan=True)
+
+
+@pytest.mark.parametrize("call, match", [
+    (lambda arm: check_reach(arm, np.eye(3)), "palm_poses"),
+    (lambda arm: check_reach(arm, np.full((2, 4, 4), np.nan)), "palm_poses"),
+    (lambda arm: check_reach(arm, np.diag([2.0, 1.0, 1.0, 1.0])), r"palm_poses\[0\]"),
+    (lambda arm: check_reach(arm, np.eye(4), object_mesh=(np.zeros((3, 2)), [[0, 1, 2]])), "object_mesh"),
+    (lambda arm: check_reach(arm, np.eye(4), object_mesh=(np.eye(3), [[0, 1, 5]])), "object_mesh"),
+    (lambda arm: check_reach(arm, np.eye(4), options={"seeds": 3}), "options"),
+    (lambda arm: arm.palm_poses(np.zeros((2, 3))), "q"),
+    (lambda arm: arm.set_base((0.0, 0.0, 0.0)), "base"),
+    (lambda arm: arm.set_mount(np.eye(3)), "mount"),
+    (lambda arm: Arm.load("kuka_lbr4", flange="no_such_link"), "flange: the URDF has no link 'no_such_link'"),
+    (lambda arm: Arm.load("no_such_arm"), "urdf"),
+])
+def test_bad_input_raises_an_error_naming_the_argument(call, match):
+    with pytest.raises(ValueError, match=match):
+        call(kuka())
+
+
+@pytest.mark.parametrize("field, value", [("seeds", 0), ("iterations", -1), ("damping", 0.0), ("tol_position", np.nan),
+                                          ("pregrasp_distance", -0.1), ("clearance", np.inf), ("approach_steps", 1.5),
+                                          ("seed", -1)])
+def test_bad_options_raise_naming_the_field(field, value):
+    with pytest.raises(ValueError, match=field):
+        ReachOptions(**{field: value})
