@@ -65,15 +65,17 @@ def pose_error(R_t: np.ndarray, p_t: np.ndarray, R: np.ndarray, p: np.ndarray,
 
 def solve_ik(arm, target: np.ndarray, q0: np.ndarray, *, iterations: int, damping: float, max_step: float,
              tol_position: float, tol_rotation: float, position_only: bool = False,
-             limits: bool = True) -> IKSolution:
+             limits=True) -> IKSolution:
     """Damped least squares from q0 (B, dof) towards the palm poses ``target`` (B, 4, 4) in the table
-    frame. ``limits=False`` lets the joints run past their limits (to tell "no IK solution" from
-    "joint limits")."""
+    frame. ``limits``: True, False, or (B,) bool per problem; False lets the joints run past their
+    limits (to tell "no IK solution" from "joint limits")."""
     q = np.array(q0, dtype=float)
     B = q.shape[0]
     R_t, p_t = target[:, :3, :3], target[:, :3, 3]
     rows = slice(0, 3) if position_only else slice(0, 6)
-    lo, hi = (arm.lower, arm.upper) if limits else (-np.inf, np.inf)
+    held = np.broadcast_to(np.asarray(limits, dtype=bool), (B,))[:, None]
+    lo = np.where(held, arm.lower, -np.inf)
+    hi = np.where(held, arm.upper, np.inf)
     done = np.zeros(B, dtype=bool)
     err = np.zeros((B, 6))
     size = np.full(B, np.inf)      # the error's size STALL_WINDOW steps ago
@@ -101,5 +103,5 @@ def solve_ik(arm, target: np.ndarray, q0: np.ndarray, *, iterations: int, dampin
         dq = (J.transpose(0, 2, 1) @ np.linalg.solve(A, e[..., None]))[..., 0]
         big = np.abs(dq).max(axis=1)
         dq *= np.minimum(1.0, max_step / np.maximum(big, 1e-12))[:, None]
-        q[active] = np.clip(q[active] + dq, lo, hi)
+        q[active] = np.clip(q[active] + dq, lo[active], hi[active])
     return IKSolution(q, np.linalg.norm(err[:, :3], axis=1), np.linalg.norm(err[:, 3:], axis=1), done, it)

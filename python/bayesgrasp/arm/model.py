@@ -115,7 +115,7 @@ class Arm:
         if not self._chain:
             raise ValueError(f"flange: link '{flange}' is fixed to the root; no joint moves it")
         self._read_joints(pin)
-        self.mount = np.eye(4) if mount is None else _pose4(mount, "mount")
+        self.mount = np.eye(4) if mount is None else mount
         self.set_base(np.zeros(4) if base is None else base)
 
     @classmethod
@@ -162,8 +162,9 @@ class Arm:
         self._axes = np.array(axes)             # (dof, 3) unit axes in each joint's frame
         self._prismatic = np.array(prism)
         self._rev = ~self._prismatic
-        self._K = np.array([_skew(a) for a in self._axes])   # cross-product matrices of the axes
-        self._K2 = self._K @ self._K
+        K = np.array([_skew(a) for a in self._axes])           # cross-product matrices of the axes
+        MR = self._M[:, :3, :3]
+        self._MK, self._MK2, self._Ma = MR @ K, MR @ K @ K, (MR @ self._axes[:, :, None])[..., 0]
         self.lower = np.array(lo)
         self.upper = np.array(hi)
         bad = [n for n, a, b in zip(names, self.lower, self.upper) if not (np.isfinite(a) and np.isfinite(b) and a < b)]
@@ -189,9 +190,19 @@ class Arm:
         b = np.asarray(base, dtype=float)
         self.base = _pose4(b, "base") if b.shape == (4, 4) else base_pose(b)
 
+    @property
+    def mount(self) -> np.ndarray:
+        """4x4: the palm's pose in the flange's frame."""
+        return self._mount
+
+    @mount.setter
+    def mount(self, value) -> None:
+        self._mount = _pose4(value, "mount")
+        self._tip = self._flange_in_joint @ self._mount      # the palm in the last joint's frame
+
     def set_mount(self, mount) -> None:
         """The palm's pose in the flange's frame (4x4)."""
-        self.mount = _pose4(mount, "mount")
+        self.mount = mount
 
     def check_q(self, q, name: str = "q") -> np.ndarray:
         """q as a finite (B, dof) array; ValueError naming ``name`` otherwise."""
@@ -203,43 +214,35 @@ class Arm:
         return q
 
     # ---- forward kinematics ---------------------------------------------------------------------
-    def _joint_motion(self, q: np.ndarray):
-        """The rotation part of M_j exp(a_j q_j) for every joint, (B, dof, 3, 3), and its translation,
-        (B, dof, 3): Rodrigues, R = I + sin(q) K + (1 - cos(q)) K^2 (K the axis's cross-product
-        matrix), for a revolute joint; the translation q a for a prismatic one."""
+    def _local(self, q: np.ndarray) -> np.ndarray:
+        """(B, dof, 4, 4): each joint's frame in its parent's, M_j exp(a_j q_j). For a revolute joint
+        Rodrigues, exp = I + sin(q) K + (1 - cos(q)) K^2 (K the axis's cross-product matrix), so that
+        M_R exp = M_R + sin(q) M_R K + (1 - cos(q)) M_R K^2 with the products precomputed; a
+        prismatic joint adds M_R (q a) to the translation."""
+        B, n = q.shape
         s = np.where(self._rev, np.sin(q), 0.0)[..., None, None]
         c = np.where(self._rev, 1.0 - np.cos(q), 0.0)[..., None, None]
-        E = np.eye(3) + s * self._K + c * self._K2                          # (B, dof, 3, 3)
-        R = self._M[:, :3, :3] @ E
-        t = np.broadcast_to(self._M[:, :3, 3], q.shape + (3,))
-        if self._prismatic.any():   # the slide q a along the axis of the joint's frame, seen after M: M_R (q a)
-            slide = np.where(self._prismatic[:, None], q[..., None] * self._axes, 0.0)
-            t = t + (self._M[:, :3, :3] @ slide[..., None])[..., 0]
-        return R, t
+        L = np.empty((B, n, 4, 4))
+        L[..., :3, :3] = self._M[:, :3, :3] + s * self._MK + c * self._MK2
+        L[..., :3, 3] = self._M[:, :3, 3]
+        if self._prismatic.any():
+            L[..., :3, 3] += q[..., None] * np.where(self._prismatic[:, None], self._Ma, 0.0)
+        L[..., 3, :3] = 0.0
+        L[..., 3, 3] = 1.0
+        return L
 
-    def _frames(self, q: np.ndarray):
-        """Rotations (B, dof, 3, 3) and origins (B, dof, 3) of the chain's joint frames in the table
-        frame: R_j = R_parent M_R,j E_j, p_j = p_parent + R_parent t_j (q already checked)."""
-        R_loc, t_loc = self._joint_motion(q)
-        B, n = q.shape
-        R = np.empty((B, n, 3, 3))
-        p = np.empty((B, n, 3))
-        R0, p0 = self.base[:3, :3], self.base[:3, 3]
-        for k in range(n):
-            if self._parent[k] < 0:
-                Rp, pp = np.broadcast_to(R0, (B, 3, 3)), np.broadcast_to(p0, (B, 3))
-            else:
-                Rp, pp = R[:, self._parent[k]], p[:, self._parent[k]]
-            R[:, k] = Rp @ R_loc[:, k]
-            p[:, k] = pp + (Rp @ t_loc[:, k, :, None])[..., 0]
-        return R, p
+    def _frames(self, q: np.ndarray) -> np.ndarray:
+        """(B, dof, 4, 4): the chain's joint frames in the table frame, T_j = T_parent(j) L_j, with
+        T of the root = the base (q already checked)."""
+        L = self._local(q)
+        T = np.empty_like(L)
+        for k in range(q.shape[1]):
+            T[:, k] = (self.base if self._parent[k] < 0 else T[:, self._parent[k]]) @ L[:, k]
+        return T
 
     def joint_frames(self, q) -> np.ndarray:
         """(B, dof, 4, 4): each chain joint's frame (after its motion) in the table frame."""
-        R, p = self._frames(self.check_q(q))
-        out = np.zeros(R.shape[:2] + (4, 4))
-        out[..., :3, :3], out[..., :3, 3], out[..., 3, 3] = R, p, 1.0
-        return out
+        return self._frames(self.check_q(q))
 
     def flange_poses(self, q) -> np.ndarray:
         """(B, 4, 4): the flange link's frame in the table frame."""
@@ -255,19 +258,22 @@ class Arm:
         angular velocity). Column j of a revolute joint is (w_j x (p - o_j); w_j), of a prismatic
         one (w_j; 0), w_j the joint's axis in the table frame and o_j its origin."""
         q = q if checked else self.check_q(q)
-        R, o = self._frames(q)
-        tip = self._flange_in_joint @ self.mount                           # palm in the last joint's frame
-        Rp = R[:, -1] @ tip[:3, :3]
-        pp = o[:, -1] + R[:, -1] @ tip[:3, 3]
-        w = R @ self._axes[:, :, None]                                      # (B, dof, 3, 1)
-        w = w[..., 0]
-        r = pp[:, None, :] - o
+        T = self._frames(q)
+        Pm = T[:, -1] @ self._tip                                           # the palm, (B, 4, 4)
+        Rp, pp = Pm[:, :3, :3], Pm[:, :3, 3]
+        w = (T[:, :, :3, :3] @ self._axes[:, :, None])[..., 0]              # (B, dof, 3) axes in the table frame
+        r = pp[:, None, :] - T[:, :, :3, 3]
         J = np.empty((q.shape[0], 6, self.dof))
         lin = np.stack([w[..., 1] * r[..., 2] - w[..., 2] * r[..., 1],
                         w[..., 2] * r[..., 0] - w[..., 0] * r[..., 2],
                         w[..., 0] * r[..., 1] - w[..., 1] * r[..., 0]], axis=1)   # (B, 3, dof)
-        J[:, :3] = np.where(self._prismatic, w.transpose(0, 2, 1), lin)
-        J[:, 3:] = np.where(self._prismatic, 0.0, w.transpose(0, 2, 1))
+        if self._prismatic.any():
+            wt = w.transpose(0, 2, 1)
+            J[:, :3] = np.where(self._prismatic, wt, lin)
+            J[:, 3:] = np.where(self._prismatic, 0.0, wt)
+        else:
+            J[:, :3] = lin
+            J[:, 3:] = w.transpose(0, 2, 1)
         return Rp, pp, J
 
     def pin_q(self, q) -> np.ndarray:

@@ -190,17 +190,29 @@ def check_reach(arm, palm_poses, object_mesh=None, options: Optional[ReachOption
     N, n = len(P), arm.dof
     starts = _starts(arm, options)
     state = _State(N, n)
-    # round 0 from the mid-range for every grasp; round 1 from every other start at once for the rest
-    for rows in (starts[:1], starts[1:]):
-        idx = np.flatnonzero(~state.done)
-        if idx.size == 0 or len(rows) == 0:
-            continue
-        cand = np.repeat(idx, len(rows))
-        sol = _ik(arm, P[cand], np.tile(rows, (idx.size, 1)), options, options.iterations)   # 1. seed_round
+    # 1. seed_round. Round 0 from the mid-range for every grasp; round 1 from every other start at
+    # once for the grasps round 0 left open, beside the same grasps from the first three starts with
+    # the limits lifted (for 4. diagnose_limits, in the same batch)
+    idx = np.arange(N)
+    sol = _ik(arm, P, np.repeat(starts[:1], N, axis=0), options, options.iterations)
+    state.counts["ik_problems"] += N
+    state.solved[sol.converged] = True
+    _accept(arm, P, idx[sol.converged], sol.q[sol.converged], scene, options, state)
+    idx = np.flatnonzero(~state.done)
+    free = np.zeros((0, n))
+    if idx.size:
+        rows, lifted = starts[1:], starts[:3]
+        cand = np.r_[np.repeat(idx, len(rows)), np.repeat(idx, len(lifted))]
+        q0 = np.r_[np.tile(rows, (idx.size, 1)), np.tile(lifted, (idx.size, 1))]
+        held = np.r_[np.ones(idx.size * len(rows), dtype=bool), np.zeros(idx.size * len(lifted), dtype=bool)]
+        sol = _ik(arm, P[cand], q0, options, options.iterations, limits=held)
         state.counts["ik_problems"] += cand.size
-        state.solved[cand[sol.converged]] = True
-        _accept(arm, P, cand[sol.converged], sol.q[sol.converged], scene, options, state)
-    reason = _reasons(arm, P, starts, options, state)
+        conv = sol.converged & held
+        state.solved[cand[conv]] = True
+        _accept(arm, P, cand[conv], sol.q[conv], scene, options, state)
+        lift = sol.converged & ~held
+        state.lifted_cand, free = cand[lift], sol.q[lift]
+    reason = _reasons(arm, N, free, state)
     pe, re = np.full(N, np.nan), np.full(N, np.nan)
     d = state.done
     if d.any():
@@ -220,6 +232,7 @@ class _State:
         self.code = np.full(N, FREE)                 # the first collision met (FREE: none yet)
         self.solved = np.zeros(N, dtype=bool)        # some start's IK converged at the grasp
         self.counts = {"ik_problems": 0}
+        self.lifted_cand = np.zeros(0, dtype=int)      # grasps solved with the limits lifted
 
     def collided(self, cand: np.ndarray, code: np.ndarray) -> None:
         hit = code != FREE
@@ -229,45 +242,40 @@ class _State:
 
 def _accept(arm, P, cand: np.ndarray, q: np.ndarray, scene: ArmCollision, options: ReachOptions,
             state: _State) -> None:
-    """Converged grasp solutions (cand (K,) grasp indices, q (K, dof)): 2. grasp_collisions on all of
-    them, then 3. walk_approach from each grasp's first collision-free solution, then its second
-    for the grasps whose first walk failed, and so on."""
+    """Converged grasp solutions (cand (K,) grasp indices in start order, q (K, dof)) of grasps not
+    done yet: 2. grasp_collisions on all of them, then 3. walk_approach from every collision-free
+    one in one batch; a grasp is done with its first solution whose walk held."""
     if cand.size == 0:
         return
     c = scene.check(q)                                # 2. grasp_collisions
     state.collided(cand, c)
     cand, q = cand[c == FREE], q[c == FREE]
-    rank = np.zeros(cand.size, dtype=int)             # each solution's place among its grasp's
-    for k in range(1, cand.size):
-        rank[k] = rank[k - 1] + 1 if cand[k] == cand[k - 1] else 0
-    for a in range(rank.max() + 1 if rank.size else 0):
-        pick = np.flatnonzero((rank == a) & ~state.done[cand])
-        if pick.size == 0:
-            break
-        g = cand[pick]
-        ok, qp, pc = walk_approach(arm, P[g], q[pick], scene, options)   # 3. walk_approach
-        state.collided(g, pc)
-        state.done[g[ok]] = True
-        state.q[g[ok]], state.q_pre[g[ok]] = q[pick][ok], qp[ok]
+    if cand.size == 0:
+        return
+    ok, qp, pc = walk_approach(arm, P[cand], q, scene, options)     # 3. walk_approach, all at once
+    state.collided(cand, pc)
+    # each grasp takes its first solution (in start order) whose walk held
+    first = np.flatnonzero(ok)
+    g, k = np.unique(cand[first], return_index=True)
+    k = first[k]
+    state.done[g] = True
+    state.q[g], state.q_pre[g] = q[k], qp[k]
 
 
-def _reasons(arm, P, starts, options: ReachOptions, state: _State) -> List[str]:
+def _reasons(arm, N: int, lifted_q: np.ndarray, state: _State) -> List[str]:
     """Each grasp's reason: "" when reachable, else its first collision, else 4. diagnose_limits: a
-    grasp no start could solve is solved from the first three starts with the limits lifted; a
-    converged solution outside the limits (revolute angles wrapped to (-pi, pi]) makes it "joint
-    limits", else "no IK solution"."""
-    N = len(P)
+    grasp no start could solve within the limits but that the lifted solves reached
+    (``state.lifted_cand``, ``lifted_q``) at joint values outside the limits (revolute angles
+    wrapped to (-pi, pi]) is "joint limits", else "no IK solution"."""
     reason = np.array([""] * N, dtype=object)
     hit = ~state.done & (state.code != FREE)
     reason[hit] = [_COLLISION_REASON[int(c)] for c in state.code[hit]]
-    rest = np.flatnonzero(~state.done & (state.code == FREE))
+    rest = ~state.done & (state.code == FREE)
     reason[rest] = NO_IK
-    unsolved = rest[~state.solved[rest]]
-    if unsolved.size:
-        rows = starts[:3]
-        cand = np.repeat(unsolved, len(rows))
-        sol = _ik(arm, P[cand], np.tile(rows, (unsolved.size, 1)), options, options.iterations, limits=False)
-        qw = np.where(arm.revolute, np.mod(sol.q + np.pi, 2 * np.pi) - np.pi, sol.q)
-        beyond = sol.converged & np.any((qw < arm.lower) | (qw > arm.upper), axis=1)
-        reason[np.unique(cand[beyond])] = JOINT_LIMITS
+    if state.lifted_cand.size:
+        qw = np.where(arm.revolute, np.mod(lifted_q + np.pi, 2 * np.pi) - np.pi, lifted_q)
+        beyond = np.any((qw < arm.lower) | (qw > arm.upper), axis=1)
+        g = np.unique(state.lifted_cand[beyond])
+        g = g[rest[g] & ~state.solved[g]]
+        reason[g] = JOINT_LIMITS
     return [str(x) for x in reason]
