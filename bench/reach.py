@@ -6,7 +6,8 @@ The scene: the shipped KUKA LBR4+ with the Barrett BH8 on its flange (the defaul
 at once: top grasps (approach straight down) and side grasps (horizontal approach) around the mug,
 positions, heights and yaws drawn from a seeded generator.
 
-Rows, all medians over ``--repeats`` runs of the same 64 candidates:
+Rows, all medians over ``--repeats`` runs of the same 64 candidates, the three run in turn in each
+repeat (so that they see the same load on a shared machine):
 
 * ``ours, full check``: check_reach: IK of the grasp (8 starts), the pre-grasp 0.1 m back and the
   approach between them at 5 steps, the arm's links against the table and the mug;
@@ -17,7 +18,7 @@ Rows, all medians over ``--repeats`` runs of the same 64 candidates:
   lambda^2 I)^-1 e, q <- integrate(q, v), clipped to the limits), from the same starts in turn
   until one converges, with the same tolerances, damping, step and iteration cap: the grasp IK only.
 
-    OMP_NUM_THREADS=1 taskset -c 0 python bench/reach.py [--candidates 64] [--repeats 5]
+    OMP_NUM_THREADS=1 taskset -c 0 python bench/reach.py [--candidates 64] [--repeats 9]
 """
 import argparse
 import json
@@ -100,19 +101,21 @@ def ours_ik_only(arm: Arm, P: np.ndarray, starts: np.ndarray, opt: ReachOptions)
     return ok
 
 
-def timed(f, repeats: int):
-    times, out = [], None
+def interleaved(fs, repeats: int):
+    """Median seconds of each function, run in turn repeats times (each round sees the same load)."""
+    times, outs = [[] for _ in fs], [None] * len(fs)
     for _ in range(repeats):
-        t = time.perf_counter()
-        out = f()
-        times.append(time.perf_counter() - t)
-    return statistics.median(times), out
+        for k, f in enumerate(fs):
+            t = time.perf_counter()
+            outs[k] = f()
+            times[k].append(time.perf_counter() - t)
+    return [statistics.median(t) for t in times], outs
 
 
 def main(argv=None) -> int:
     p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     p.add_argument("--candidates", type=int, default=64)
-    p.add_argument("--repeats", type=int, default=5)
+    p.add_argument("--repeats", type=int, default=9)
     p.add_argument("--out", default="", help="also write the figures to this JSON file")
     a = p.parse_args(argv)
     arm = Arm.load("kuka_lbr4", base=(-0.6, 0.0, 0.0, 0.0), mount=default_mount(Hand.load("barrett_bh8")))
@@ -122,9 +125,9 @@ def main(argv=None) -> int:
     from bayesgrasp.arm.reach import _starts
     starts = _starts(arm, opt)
     check_reach(arm, P[:4], (mug.vertices, mug.faces), opt)   # warm-up (imports, first calls)
-    t_full, res = timed(lambda: check_reach(arm, P, (mug.vertices, mug.faces), opt), a.repeats)
-    t_ik, ik_ok = timed(lambda: ours_ik_only(arm, P, starts, opt), a.repeats)
-    t_peer, peer_ok = timed(lambda: peer_clik(arm, P, starts, opt), a.repeats)
+    (t_full, t_ik, t_peer), (res, ik_ok, peer_ok) = interleaved(
+        [lambda: check_reach(arm, P, (mug.vertices, mug.faces), opt), lambda: ours_ik_only(arm, P, starts, opt),
+         lambda: peer_clik(arm, P, starts, opt)], a.repeats)
     n = len(P)
     rows = [("ours, full check (grasp + pre-grasp + approach + collisions)", t_full, int(res.reachable.sum())),
             ("ours, grasp IK only", t_ik, int(ik_ok.sum())),

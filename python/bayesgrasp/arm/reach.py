@@ -191,8 +191,8 @@ def check_reach(arm, palm_poses, object_mesh=None, options: Optional[ReachOption
     starts = _starts(arm, options)
     state = _State(N, n)
     # 1. seed_round. Round 0 from the mid-range for every grasp; round 1 from every other start at
-    # once for the grasps round 0 left open, beside the same grasps from the first three starts with
-    # the limits lifted (for 4. diagnose_limits, in the same batch)
+    # once for the grasps round 0 left open, beside those it could not solve from the first three
+    # starts with the limits lifted (for 4. diagnose_limits, in the same batch)
     idx = np.arange(N)
     sol = _ik(arm, P, np.repeat(starts[:1], N, axis=0), options, options.iterations)
     state.counts["ik_problems"] += N
@@ -202,9 +202,10 @@ def check_reach(arm, palm_poses, object_mesh=None, options: Optional[ReachOption
     free = np.zeros((0, n))
     if idx.size:
         rows, lifted = starts[1:], starts[:3]
-        cand = np.r_[np.repeat(idx, len(rows)), np.repeat(idx, len(lifted))]
-        q0 = np.r_[np.tile(rows, (idx.size, 1)), np.tile(lifted, (idx.size, 1))]
-        held = np.r_[np.ones(idx.size * len(rows), dtype=bool), np.zeros(idx.size * len(lifted), dtype=bool)]
+        unsolved = idx[~state.solved[idx]]      # only these may need the diagnosis
+        cand = np.r_[np.repeat(idx, len(rows)), np.repeat(unsolved, len(lifted))].astype(int)
+        q0 = np.r_[np.tile(rows, (idx.size, 1)), np.tile(lifted, (unsolved.size, 1))]
+        held = np.r_[np.ones(idx.size * len(rows), dtype=bool), np.zeros(unsolved.size * len(lifted), dtype=bool)]
         sol = _ik(arm, P[cand], q0, options, options.iterations, limits=held)
         state.counts["ik_problems"] += cand.size
         conv = sol.converged & held
