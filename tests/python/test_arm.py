@@ -215,3 +215,61 @@ def test_bad_input_raises_an_error_naming_the_argument(call, match):
 def test_bad_options_raise_naming_the_field(field, value):
     with pytest.raises(ValueError, match=field):
         ReachOptions(**{field: value})
+
+
+# ---- the planners weigh only reachable actions (Eq. 3.1 over what the arm reaches) -------------------
+@pytest.fixture(scope="module")
+def tiny():
+    """Two stability planners on the same tiny cube models, the same seed."""
+    from testkit import tiny_planner
+
+    return tiny_planner, tiny_planner()
+
+
+def test_the_stability_search_never_chooses_an_unreachable_action_while_it_met_a_reachable_one(tiny):
+    make, free = tiny
+    a0 = free.plan().action
+    p = make()
+    seen = []
+
+    def reach(models, X, pose):   # the arm reaches only actions 5 mm or more on the -x side of the free choice
+        ok = X[:, 0] <= a0[0] - 0.005
+        seen.append((X.copy(), ok))
+        return ok
+
+    p.reach = reach
+    plan = p.plan()
+    X = np.concatenate([x for x, _ in seen])
+    ok = np.concatenate([k for _, k in seen])
+    assert ok.any() and (~ok).any()                       # the search met both kinds
+    assert plan.action[0] <= a0[0] - 0.005                # the chosen one is reachable
+    b = p.belief
+    es = p.tables["top"].expected_stability(X[ok], b.particles, b.weights, 1)
+    assert plan.predicted_stability == pytest.approx(p.expected_stability(plan.action))
+    assert plan.predicted_stability >= es.max() - 1e-9    # and the best reachable one the search met
+    assert 0.0 <= plan.predicted_stability <= 1.0
+
+
+def test_with_nothing_reachable_the_search_returns_what_it_would_without_an_arm(tiny):
+    make, _ = tiny
+    a, b = make(), make()
+    b.reach = lambda models, X, pose: np.zeros(len(X), dtype=bool)
+    pa, pb = a.plan(), b.plan()
+    assert np.allclose(pa.action, pb.action) and pa.predicted_stability == pytest.approx(pb.predicted_stability)
+
+
+def test_action_reach_puts_the_familys_grasp_on_the_arm(tiny):
+    """The cube's top grasps at its pose: the palm comes down (palm z = -z) above the table; the
+    KUKA beside the table reaches them, the same arm 5 m away reaches none."""
+    from bayesgrasp.planners.reach import ActionReach
+
+    _, p = tiny
+    models = p.family_models["top"]
+    pose = np.array([0.02, -0.01, 0.3])
+    actions = np.array([[0.02, -0.01, 0.3], [0.03, -0.01, 1.0], [0.02, 0.0, -0.5]])
+    near = ActionReach(kuka(), "cube", hand="barrett_bh8")
+    P = near.palm_poses(models, actions, pose)
+    assert np.allclose(P[:, :3, 2], [0.0, 0.0, -1.0], atol=1e-9) and np.all(P[:, 2, 3] > 0)
+    assert near(models, actions, pose).tolist() == [True, True, True]
+    far = ActionReach(kuka(base=(5.0, 0.0, 0.0, 0.0)), "cube", hand="barrett_bh8")
+    assert far(models, actions, pose).tolist() == [False, False, False]

@@ -134,10 +134,28 @@ def wrap_angle(a):
     return np.mod(np.asarray(a, dtype=float) + np.pi, 2 * np.pi) - np.pi
 
 
+#: What an unreachable action's objective loses in the stability search: more than any expected
+#: stability (in [0, 1]) can gain, so that a reachable action always wins over an unreachable one.
+UNREACHABLE_PENALTY = 2.0
+
+
+def _unpenalised(v: float) -> float:
+    """The expected stability behind a search's value (reachable: in [0, 1]; unreachable: minus the penalty)."""
+    return v + UNREACHABLE_PENALTY if v < -0.5 * UNREACHABLE_PENALTY else v
+
+
 class Planner:
-    """Base class: belief, Bayes update and the stability search; subclasses choose the action."""
+    """Base class: belief, Bayes update and the stability search; subclasses choose the action.
+
+    ``reach``: None (the hand is free-floating), or a callable (models, actions (K, 3) in the world,
+    object pose (3,)) -> (K,) bool telling which actions an arm can reach (e.g.
+    :class:`bayesgrasp.planners.reach.ActionReach`); set it after construction. Eq. 3.1 is then
+    maximised over the reachable actions: an unreachable action is never chosen while the search
+    has met a reachable one (if it met none, the most stable action is returned as without an arm).
+    """
 
     method = "base"
+    reach = None
 
     def __init__(self, models: Union[GraspModels, Mapping[str, GraspModels]], estimate: Sequence[float],
                  settings: Optional[PlannerSettings] = None, seed: int = 0,
@@ -287,31 +305,49 @@ class Planner:
 
     def maximise_stability(self, poses: np.ndarray, weights: np.ndarray, family: Optional[str] = None):
         """PSO over (x, y, yaw) of sum_j w_j P(S | A, O_j) (Eq. 3.1) for one family (None: the
-        first). Returns (action, value, nfev)."""
+        first), over the reachable actions when the planner has a ``reach``. Returns (action,
+        value, nfev), the value the action's expected stability."""
+        a, v, n = self._maximise(poses, weights, self._family(family))
+        return a, _unpenalised(v), n
+
+    def _maximise(self, poses: np.ndarray, weights: np.ndarray, family: str):
+        """maximise_stability's search; its value is lowered by UNREACHABLE_PENALTY when the action
+        is unreachable."""
         s = self.settings
-        family = self._family(family)
         table = self.tables[family]
         low, high = self.action_bounds(poses)
         w = np.asarray(weights, dtype=float)
         init = np.clip(self._seed_actions(poses, w, s.pso_particles, family), low, high)
+        reachable = self._reachable(family)
 
         def negative(X):
-            return -table.expected_stability(X, poses, w, s.threads)
+            v = table.expected_stability(X, poses, w, s.threads)
+            if reachable is not None:
+                v = v - UNREACHABLE_PENALTY * ~reachable(X)
+            return -v
 
         r = optim.pso(negative, (low, high), n_particles=s.pso_particles, max_iter=s.pso_iter,
                       seed=int(self._rng.integers(2**31)), init=init)
         return r.x, -r.fun, r.nfev
 
+    def _reachable(self, family: str):
+        """actions (K, 3) -> (K,) bool for ``family`` at the belief's mean pose, or None without a reach."""
+        if self.reach is None:
+            return None
+        models, pose = self.family_models[family], self.belief.mean()
+        return lambda X: np.asarray(self.reach(models, X, pose), dtype=bool).reshape(len(X))
+
     def most_stable(self, poses: np.ndarray, weights: np.ndarray):
         """Eq. 3.1 over every family: (family, action, value, total nfev) of the best; ties go
-        to the earlier family (top first)."""
+        to the earlier family (top first); a reachable action beats an unreachable one of any
+        family (with a ``reach``)."""
         best, total = None, 0
         for f in self.families:
-            a, v, n = self.maximise_stability(poses, weights, f)
+            a, v, n = self._maximise(poses, weights, f)
             total += n
             if best is None or v > best[2]:
                 best = (f, a, v)
-        return best[0], best[1], best[2], total
+        return best[0], best[1], _unpenalised(best[2]), total
 
     def expected_stability(self, action, family: Optional[str] = None) -> float:
         """The belief-weighted P(S) of one action of ``family`` (None: the first)."""
