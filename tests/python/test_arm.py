@@ -273,3 +273,53 @@ def test_action_reach_puts_the_familys_grasp_on_the_arm(tiny):
     assert near(models, actions, pose).tolist() == [True, True, True]
     far = ActionReach(kuka(base=(5.0, 0.0, 0.0, 0.0)), "cube", hand="barrett_bh8")
     assert far(models, actions, pose).tolist() == [False, False, False]
+
+
+# ---- the command line: grasp --robot -------------------------------------------------------------------
+def test_grasp_with_the_robot_gives_the_grasp_in_the_arms_terms(capsys):
+    """A top grasp on the cube at the origin with the KUKA 0.6 m behind the table's origin: the grasp
+    record's ``arm`` (schema-valid) holds the URDF's joints; their forward kinematics (yourdfpy)
+    put the palm where the hand closed. The same arm 3 m away cannot reach it."""
+    from bayesgrasp.io.grasp_schema import validate
+    from testkit import cli_json
+
+    d = cli_json(capsys, "grasp", "--object", "cube", "--top", "0,0,0", "--no-lift", "--robot", "kuka_lbr4", "--json")
+    validate(d["grasp"])
+    arm = d["grasp"]["arm"]
+    assert arm["reachable"] is True and arm["reason"] == "" and arm["flange_link"] == "lbr4_link7"
+    assert np.allclose(arm["mount"], default_mount(Hand.load("barrett_bh8")))
+    T = np.asarray(arm["base"]) @ urdf_fk(arm["urdf"], dict(zip(arm["joint_names"], arm["joint_positions"])))[
+        arm["flange_link"]] @ np.asarray(arm["mount"])
+    assert np.linalg.norm(T[:3, 3] - np.asarray(d["hand_pose"])[:3, 3]) <= 1e-3
+    far = cli_json(capsys, "grasp", "--object", "cube", "--top", "0,0,0", "--no-lift", "--robot", "kuka_lbr4",
+                   "--robot-base", "3,0,0,0", "--json")["grasp"]
+    validate(far)
+    assert far["arm"]["reachable"] is False and far["arm"]["reason"] == "no IK solution"
+    assert "joint_positions" not in far["arm"]
+
+
+@pytest.mark.parametrize("extra, needle", [
+    (["--robot", "kuka_lbr4", "--flange", "nope"], "--flange: the URDF has no link 'nope'"),
+    (["--robot", "no_such_arm.urdf"], "--robot: no such file"),
+    (["--robot", "kuka_lbr4", "--robot-base", "1,2"], "--robot-base: expected 4"),
+    (["--robot", "kuka_lbr4", "--mount", "0,0,0.1"], "--mount: expected 6"),
+    (["--flange", "lbr4_link7"], "--flange: only with --robot"),
+])
+def test_grasp_robot_options_name_themselves_in_errors(extra, needle, capsys):
+    from bayesgrasp.cli import main
+
+    code = main(["grasp", "--object", "cube", "--top", "0,0,0", "--no-lift", *extra])
+    assert code != 0 and needle in capsys.readouterr().err
+
+
+def test_plan_with_the_robot_plans_reachable_grasps_and_reports_them(capsys):
+    """plan --robot: the stability planner searches the grasps the KUKA reaches; the executed grasp
+    comes back with the arm's joints (schema-valid), reachable."""
+    from bayesgrasp.io.grasp_schema import validate
+    from testkit import cli_json
+
+    d = cli_json(capsys, "plan", "--object", "mug", "--true-pose", "0.01,0,0.3", "--attempts", "1", "--method",
+                 "stability", "--robot", "kuka_lbr4", "--json")
+    g = d["attempts"][0]["grasp"]
+    validate(g)
+    assert g["arm"]["reachable"] is True and len(g["arm"]["joint_positions"]) == 7

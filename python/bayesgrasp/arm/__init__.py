@@ -11,7 +11,7 @@ Files by step: :mod:`.model` (the URDF, the chain, forward kinematics and the Ja
 """
 from .model import ROBOTS_DIR, Arm, base_pose, builtin_arms, resolve_arm
 from .mount import default_mount, mount_pose, palm_depth
-from .reach import REASONS, ReachOptions, ReachResult, check_reach
+from .reach import REASONS, ReachOptions, ReachResult, arm_record, check_reach
 
 __all__ = ["Arm", "ROBOTS_DIR", "REASONS", "ReachOptions", "ReachResult", "base_pose", "builtin_arms",
-           "check_reach", "default_mount", "mount_pose", "palm_depth", "resolve_arm"]
+           "arm_record", "check_reach", "default_mount", "mount_pose", "palm_depth", "resolve_arm"]

@@ -34,7 +34,7 @@ import numpy as np
 from .collision import FREE, HITS_OBJECT, HITS_TABLE, ArmCollision
 from .ik import pose_error, solve_ik
 
-__all__ = ["ReachOptions", "ReachResult", "check_reach", "REASONS"]
+__all__ = ["ReachOptions", "ReachResult", "arm_record", "check_reach", "REASONS"]
 
 NO_IK, HITS_TABLE_REASON, HITS_OBJECT_REASON, JOINT_LIMITS = (
     "no IK solution", "arm hits table", "arm hits object", "joint limits")
@@ -280,3 +280,15 @@ def _reasons(arm, N: int, lifted_q: np.ndarray, state: _State) -> List[str]:
         g = g[rest[g] & ~state.solved[g]]
         reason[g] = JOINT_LIMITS
     return [str(x) for x in reason]
+
+
+def arm_record(arm, result: ReachResult, i: int = 0) -> dict:
+    """Grasp i of ``result`` in the robot's terms, the grasp schema's ``arm``: the URDF, the base (4x4
+    in the table frame), the flange link, the mount (4x4, flange to palm), the URDF's joint names and,
+    when reachable, their values at the grasp and at the pre-grasp; else the reason."""
+    rec = {"urdf": str(arm.urdf), "base": arm.base.tolist(), "flange_link": arm.flange, "mount": arm.mount.tolist(),
+           "joint_names": list(result.joint_names), "reachable": bool(result.reachable[i]), "reason": result.reason[i]}
+    if result.reachable[i]:
+        rec["joint_positions"] = [float(v) for v in result.q[i]]
+        rec["pregrasp_joint_positions"] = [float(v) for v in result.q_pre[i]]
+    return rec

@@ -97,6 +97,46 @@ def add_hand_option(p: argparse.ArgumentParser) -> None:
                    help="built-in hand name, hand file or URDF (with its NAME.hand.json sidecar)")
 
 
+def add_robot_options(p: argparse.ArgumentParser) -> None:
+    """--robot, --robot-base, --flange and --mount: the arm the hand is mounted on (bayesgrasp.arm)."""
+    g = p.add_argument_group("arm", "the arm the hand is mounted on: grasps it cannot reach are refused (grasp) "
+                                    "or never chosen while a reachable one exists (plan)")
+    g.add_argument("--robot", default=None, metavar="ARM.urdf",
+                   help="the arm's URDF (any serial arm), or a built-in arm's name (kuka_lbr4, the thesis's KUKA "
+                        "LBR4+); default: none, the hand is free-floating")
+    g.add_argument("--robot-base", default="-0.6,0,0,0", metavar="X,Y,Z,YAW",
+                   help="the arm's root in the table frame (m, m, m, rad)")
+    g.add_argument("--flange", default=None, metavar="LINK",
+                   help="the link the hand is mounted on (default: the chain's last link)")
+    g.add_argument("--mount", default=None, metavar="X,Y,Z,R,P,Y",
+                   help="the palm in the flange's frame (m, rad; roll, pitch, yaw as in a URDF) (default: the "
+                        "hand's base on the flange, its approach along the flange's z)")
+
+
+def robot_arm(args: argparse.Namespace, hand):
+    """The --robot arm with --robot-base, --flange and --mount (``hand``: the loaded hand, for the
+    default mount), or None without --robot; CliError naming the option."""
+    if getattr(args, "robot", None) is None:
+        for opt in ("flange", "mount"):
+            if getattr(args, opt, None) is not None:
+                raise CliError(f"--{opt}: only with --robot")
+        return None
+    from ..arm import Arm, default_mount, mount_pose, resolve_arm
+
+    base = floats(args.robot_base, 4, "--robot-base")
+    mount = default_mount(hand) if args.mount is None else mount_pose(floats(args.mount, 6, "--mount"))
+    try:
+        resolve_arm(args.robot)
+    except ValueError as e:
+        raise CliError(f"--robot: {str(e).split(': ', 1)[-1]}") from None
+    try:
+        return Arm.load(args.robot, flange=args.flange, mount=mount, base=base)
+    except ValueError as e:
+        msg = str(e)
+        option = "--flange" if msg.startswith("flange") else "--robot"
+        raise CliError(f"{option}: {msg.split(': ', 1)[-1]}") from None
+
+
 def add_object_options(p: argparse.ArgumentParser, units: bool = True, mass: bool = True) -> None:
     """--units (unless the command's camera options give it) and --mass (for commands that lift)
     for --object's mesh."""

@@ -24,8 +24,8 @@ from typing import List, Optional
 import numpy as np
 
 from ..io.results import mass_source
-from .args import (CliError, Renamed, add_format_options, add_hand_option, add_object_options, add_view_option, floats,
-                   object_arg, output_file, output_format)
+from .args import (CliError, Renamed, add_format_options, add_hand_option, add_object_options, add_robot_options,
+                   add_view_option, floats, object_arg, output_file, output_format, robot_arm)
 
 
 def add(sub) -> None:
@@ -54,6 +54,7 @@ def add(sub) -> None:
     g.add_argument("--no-lift", action="store_true", help="skip the physical lift test")
     g.add_argument("--lift-trace", action="store_true",
                    help="record the lift test's trace (the object's path in the hand) in the JSON, for `view`")
+    add_robot_options(g)
     add_format_options(g)
     add_view_option(g)
     g.add_argument("--png", default=None, metavar="FILE", help="write a PNG of the hand, the object and the contacts")
@@ -90,10 +91,13 @@ def run(args) -> int:
     pose = floats(args.object_pose, 3, "--object-pose")
     request = _request(args)
     world = _world(args, pose)
+    arm = robot_arm(args, world.hand)
     grasp = _grasp(world, args, request)
     spread = world.spread if args.spread is None else args.spread
     out = grasp_document(grasp, request, world, object_name=args.object, object_pose=pose, frame=args.frame,
                          units=args.units, spread=spread)
+    if arm is not None:
+        out["grasp"]["arm"] = _arm_check(arm, world, grasp, out["grasp"]["pregrasp"]["distance"])
     if args.lift_trace:
         out["lift_trace"] = _lift_trace(world, args, grasp)
     fmt = output_format(args)
@@ -103,6 +107,8 @@ def run(args) -> int:
         print(json.dumps(out))
     else:
         _print(grasp, request, world, args, pose)
+        if arm is not None:
+            _print_arm(out["grasp"]["arm"])
     if png:
         from ..viz import plot_grasp
 
@@ -115,6 +121,16 @@ def run(args) -> int:
 
     show_result(args, out)
     return 0
+
+
+def _arm_check(arm, world, g, pregrasp_distance: float) -> dict:
+    """The grasp's palm pose (world frame) checked with the arm: its pre-grasp as far back as the grasp
+    record's, the links against the table and the object (the grasp schema's ``arm``)."""
+    from ..arm import ReachOptions, arm_record, check_reach
+
+    r = check_reach(arm, np.asarray(g.hand_pose), (world.vertices, world.faces),
+                    ReachOptions(pregrasp_distance=pregrasp_distance))
+    return arm_record(arm, r, 0)
 
 
 def _lift_trace(world, args, g) -> dict:
@@ -214,6 +230,16 @@ def _describe(request: GraspRequest) -> str:
         fmt = lambda v: "(" + ", ".join(f"{x:.3g}" for x in v) + ")"  # noqa: E731
         return f"approach {fmt(a.direction)}, roll {a.roll:.3g}, through {fmt(a.target)}"
     return "closing at the given pose"
+
+
+def _print_arm(rec: dict) -> None:
+    """The arm's verdict: its joints at the grasp (degrees), or why it cannot reach it."""
+    name = Path(rec["urdf"]).name
+    if not rec["reachable"]:
+        print(f"  arm {name}: cannot reach this grasp ({rec['reason']})")
+        return
+    print(f"  arm {name}: reaches it (grasp, pre-grasp and approach); joints at the grasp: "
+          + ", ".join(f"{n}={np.degrees(v):.1f} deg" for n, v in zip(rec["joint_names"], rec["joint_positions"])))
 
 
 def _print(g, request: GraspRequest, world, args, pose) -> None:

@@ -11,8 +11,8 @@ from ..loop.episode import EpisodeSettings
 from ..planners.registry import PLANNERS
 from . import camera_input
 from .args import (CliError, add_context_options, add_families_option, add_format_options, add_object_options,
-                   add_view_option, bounded_int, context, floats, object_arg, out_dir, output_file, output_format,
-                   parse_set)
+                   add_robot_options, add_view_option, bounded_int, context, floats, object_arg, out_dir, output_file,
+                   output_format, parse_set, robot_arm)
 
 METHODS = list(PLANNERS)
 METHOD_HELP = ("stability: the most stable grasp (Eq. 3.1); explore: informative grasps while none is likely to hold "
@@ -53,6 +53,7 @@ def add(sub) -> None:
     add_families_option(p)
     add_object_options(p, units=False)
     camera_input.add(p)
+    add_robot_options(p)
     p.set_defaults(run=plan)
 
 
@@ -71,9 +72,9 @@ def _print_attempt(a) -> None:
 
 
 def _loop(args, ctx, pose, attempts: int = EpisodeSettings.attempts, estimate=None, noise: float = 0.0,
-          quiet: bool = False, start=None, obj=None):
+          quiet: bool = False, start=None, obj=None, reach=None):
     """The episode on ``obj`` (default: --object by name) in the command's run context ``ctx``;
-    ``start``: the vision start (its spread is the belief's)."""
+    ``start``: the vision start (its spread is the belief's); ``reach``: the planner's (the arm)."""
     from dataclasses import replace
 
     from ..loop.episode import EpisodeSettings, run_episode
@@ -89,7 +90,7 @@ def _loop(args, ctx, pose, attempts: int = EpisodeSettings.attempts, estimate=No
     ctx = replace(ctx, planner=started(ctx.planner_settings(), start), measurement_noise=noise or ctx.measurement_noise)
     episode = EpisodeSettings(method=args.method, attempts=attempts)
     return run_episode(obj, pose, episode, ctx, seed=ctx.seed, estimate=estimate, models=models,
-                       keep_planner=True, on_attempt=None if quiet else _print_attempt)
+                       keep_planner=True, on_attempt=None if quiet else _print_attempt, reach=reach)
 
 
 def _belief_png(r, path) -> Path:
@@ -197,10 +198,17 @@ def plan(args) -> int:
     if args.units or args.mass is not None or camera_input.given(args):   # the mesh read once, in its unit
         obj = object_arg(args)
     ctx = context(args)
+    arm = robot_arm(args, ctx.hand_model)
+    reach = None
+    if arm is not None:
+        from ..planners.reach import ActionReach
+
+        reach = ActionReach(arm, obj, ctx.hand)
     start, view = _vision_start(args, obj, est, quiet, ctx.seed)
     if start is not None:
         est = start.estimate.tolist()
-    r = _loop(args, ctx, pose, args.attempts, est, args.noise, quiet=quiet, start=start, obj=obj)
+    r = _loop(args, ctx, pose, args.attempts, est, args.noise, quiet=quiet, start=start, obj=obj, reach=reach)
+    arms = None if arm is None else _arm_records(arm, obj, pose, r, ctx.hand)
     if png:
         _belief_png(r, png)
     if fmt == "ros":
@@ -209,23 +217,45 @@ def plan(args) -> int:
         print(json.dumps({"attempts": [to_ros(a.grasp, grasp_id=f"attempt-{a.number}", quality=a.plan.predicted_stability)
                                        for a in r.attempts]}))
     elif fmt == "json":
-        print(json.dumps(_plan_doc(args, ctx, r, start, view)))
+        print(json.dumps(_plan_doc(args, ctx, r, start, view, arms)))
     else:
         print(f"{'success' if r.success else 'no successful grasp'} after {len(r.attempts)} attempt(s)")
+        if arms is not None:
+            k = sum(a["reachable"] for a in arms)
+            print(f"arm {Path(arm.urdf).name}: {k} of {len(arms)} executed grasp(s) reachable"
+                  + "".join(f"; attempt {i + 1}: {a['reason']}" for i, a in enumerate(arms) if not a["reachable"]))
     if args.view is not None:
         from .view import show_result
 
-        show_result(args, _plan_doc(args, ctx, r, start, view))
+        show_result(args, _plan_doc(args, ctx, r, start, view, arms))
     return 0
 
 
-def _plan_doc(args, ctx, r, start, view) -> dict:
-    """plan's JSON, with the vision start (and its cloud) when the belief came from camera data."""
+def _arm_records(arm, obj, pose, r, hand) -> list:
+    """Each executed grasp (at the true pose, where the hand closed) checked with the arm: the grasp
+    schema's ``arm`` per attempt."""
+    from ..arm import ReachOptions, arm_record, check_reach
+    from ..io.grasp_schema import PREGRASP_DISTANCE
+    from ..world import World
+
+    if not r.attempts:
+        return []
+    world = World.single(obj, pose=pose, hand=hand)
+    P = np.stack([np.asarray(a.execution.hand_pose, dtype=float) for a in r.attempts])
+    res = check_reach(arm, P, (world.vertices, world.faces), ReachOptions(pregrasp_distance=PREGRASP_DISTANCE))
+    return [arm_record(arm, res, i) for i in range(len(P))]
+
+
+def _plan_doc(args, ctx, r, start, view, arms=None) -> dict:
+    """plan's JSON, with the vision start (and its cloud) when the belief came from camera data, and
+    each attempt's grasp in the arm's terms with --robot."""
     from ..io.results import plan_document, vision_dict
 
     doc = plan_document(r, args.object, args.units, ctx.success)
     if start is not None:
         doc["vision"] = vision_dict(start, args.cloud or args.depth, view.object_points)
+    for a, rec in zip(doc["attempts"], arms or []):
+        a["grasp"]["arm"] = rec
     return doc
 
 

@@ -98,7 +98,7 @@ def _check_pose(true_pose) -> np.ndarray:
 def run_episode(obj: Union[str, ObjectModel], true_pose: Sequence[float], episode: Optional[EpisodeSettings] = None,
                 ctx: Optional[RunContext] = None, seed: int = 0, estimate: Optional[Sequence[float]] = None,
                 models=None, keep_planner: bool = False,
-                on_attempt: Optional[Callable[[Attempt], None]] = None) -> EpisodeResult:
+                on_attempt: Optional[Callable[[Attempt], None]] = None, reach=None) -> EpisodeResult:
     """One run of the loop on ``obj`` whose hidden true pose is ``true_pose`` (x, y, yaw).
 
     ``models``: one family's GraspModels or {family: GraspModels} (default: the context's
@@ -106,7 +106,8 @@ def run_episode(obj: Union[str, ObjectModel], true_pose: Sequence[float], episod
     :func:`initial_estimate`. ``on_attempt`` is called with each :class:`Attempt` when it is done.
     Returns an :class:`EpisodeResult` (its ``to_dict()`` is the stored record); with
     ``keep_planner`` it also holds the planner and the belief's snapshots (particles and weights
-    before each attempt and at the end).
+    before each attempt and at the end). ``reach``: the planner's (:attr:`Planner.reach`, e.g. a
+    :class:`~bayesgrasp.planners.reach.ActionReach`): it then plans over the grasps an arm reaches.
     """
     episode = episode or EpisodeSettings()
     ctx = ctx or RunContext()
@@ -119,6 +120,7 @@ def run_episode(obj: Union[str, ObjectModel], true_pose: Sequence[float], episod
     estimate = initial_estimate(true_pose, settings, rng) if estimate is None else estimate
     estimate = np.asarray(estimate, dtype=float)
     planner = make_planner(episode.method, models, estimate, settings, seed=int(rng.integers(2**31)))
+    planner.reach = reach
     initial = planner.summary(true_pose)
     snapshots, attempts = [], []
     for k in range(episode.attempts):
