@@ -12,7 +12,8 @@ repeat (so that they see the same load on a shared machine):
 * ``ours, full check``: check_reach: IK of the grasp (8 starts), the pre-grasp 0.1 m back and the
   approach between them at 5 steps, the arm's links against the table and the mug;
 * ``ours, grasp IK only``: the same batched damped least squares on the grasp poses alone, from the
-  same starts (round 0 from the mid-range, then the other 7 at once for the unconverged);
+  same starts (each grasp's 8 nearest entries of the start library: the nearest first, then the
+  other 7 at once for the unconverged);
 * ``peer, pinocchio CLIK``: for each candidate in a Python loop, pinocchio's forward kinematics,
   frame Jacobian and SE(3) log (error e = log(oMf^-1 oMdes), J <- -Jlog6 J, v = -J^T (J J^T +
   lambda^2 I)^-1 e, q <- integrate(q, v), clipped to the limits), from the same starts in turn
@@ -31,6 +32,7 @@ from scipy.spatial.transform import Rotation
 
 from bayesgrasp.arm import Arm, ReachOptions, check_reach, default_mount
 from bayesgrasp.arm.ik import solve_ik
+from bayesgrasp.arm.starts import nearest_starts
 from bayesgrasp.hand import Hand
 from bayesgrasp.objects import load_object
 
@@ -68,7 +70,7 @@ def peer_clik(arm: Arm, P: np.ndarray, starts: np.ndarray, opt: ReachOptions):
     ok = np.zeros(len(P), dtype=bool)
     for i in range(len(P)):
         target = pin.SE3(base_inv @ P[i] @ mount_inv)   # the flange's pose in the arm's root frame
-        for s in starts:
+        for s in starts[i]:
             q = arm.pin_q(s)
             for _ in range(opt.iterations + 1):
                 pin.framesForwardKinematics(model, data, q)
@@ -90,13 +92,14 @@ def peer_clik(arm: Arm, P: np.ndarray, starts: np.ndarray, opt: ReachOptions):
 
 
 def ours_ik_only(arm: Arm, P: np.ndarray, starts: np.ndarray, opt: ReachOptions):
+    """check_reach's step 1 alone: the nearest start for every grasp, then the others at once."""
     kw = dict(iterations=opt.iterations, damping=opt.damping, max_step=opt.max_step,
               tol_position=opt.tol_position, tol_rotation=opt.tol_rotation)
-    ok = solve_ik(arm, P, np.repeat(starts[:1], len(P), axis=0), **kw).converged
+    ok = solve_ik(arm, P, starts[:, 0], **kw).converged
     rest = np.flatnonzero(~ok)
     if rest.size:
-        cand = np.repeat(rest, len(starts) - 1)
-        sol = solve_ik(arm, P[cand], np.tile(starts[1:], (rest.size, 1)), **kw)
+        cand = np.repeat(rest, starts.shape[1] - 1)
+        sol = solve_ik(arm, P[cand], starts[rest, 1:].reshape(-1, arm.dof), **kw)
         ok[np.unique(cand[sol.converged])] = True
     return ok
 
@@ -122,8 +125,7 @@ def main(argv=None) -> int:
     mug = load_object("mug")
     P = candidates(mug, a.candidates)
     opt = ReachOptions()
-    from bayesgrasp.arm.reach import _starts
-    starts = _starts(arm, opt)
+    starts = nearest_starts(arm, P, opt.seeds, opt.seed)    # (n, seeds, dof), the same for all three
     check_reach(arm, P[:4], (mug.vertices, mug.faces), opt)   # warm-up (imports, first calls)
     (t_full, t_ik, t_peer), (res, ik_ok, peer_ok) = interleaved(
         [lambda: check_reach(arm, P, (mug.vertices, mug.faces), opt), lambda: ours_ik_only(arm, P, starts, opt),

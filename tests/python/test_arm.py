@@ -135,6 +135,19 @@ def test_our_kinematics_match_pinocchio():
         assert np.allclose(arm.base @ data.oMf[fid].homogeneous, F[i], atol=1e-12)
 
 
+def test_the_nearest_start_of_a_library_pose_is_its_own_joint_vector():
+    """A palm pose made from library entry j is at distance 0 from it: it comes first; the others
+    follow nearest first (distance 0 is the minimum), and the library is the seed's."""
+    from bayesgrasp.arm.starts import nearest_starts, start_library
+
+    arm = kuka()
+    q, R, p = start_library(arm, seed=3)
+    j = [5, 100, 700]
+    S = nearest_starts(arm, arm.palm_poses(q[j]), k=4, seed=3)
+    assert S.shape == (3, 4, arm.dof) and np.allclose(S[:, 0], q[j])
+    assert np.array_equal(start_library(arm, seed=3)[0], q) and not np.array_equal(start_library(arm, seed=4)[0], q)
+
+
 def test_rotation_log_matches_scipy_near_zero_and_near_half_a_turn():
     v = np.array([[1e-7, 0, 0], [0.3, -0.2, 0.1], [0, 0, np.pi - 1e-5], [0.0, np.pi - 0.5, 0.0]])
     assert np.allclose(rotation_log(Rotation.from_rotvec(v).as_matrix()), v, atol=1e-9)

@@ -11,9 +11,9 @@ from one step to the next, with no link of the arm in the table or the object at
 
 The steps, each batched over the candidates still open:
 
-1. ``seed_round``: IK of the grasp pose; round 0 from the joints' mid-range for every grasp,
-   round 1 from every other start at once (uniform draws within the limits from a generator
-   seeded by ``options.seed``) for the grasps round 0 left open;
+1. ``seed_round``: IK of the grasp pose from its ``seeds`` starts, the joint vectors of a seeded
+   library whose palm poses lie nearest it (:mod:`.starts`); round 0 from the nearest for every
+   grasp, round 1 from the others at once for the grasps round 0 left open;
 2. ``grasp_collisions``: every converged solution against the table and the object;
 3. ``walk_approach``: the approach line from the grasp back to the pre-grasp at steps, each step's
    IK warm-started from the grasp's first collision-free solution, then (if that walk fails) its next;
@@ -33,6 +33,7 @@ import numpy as np
 
 from .collision import FREE, HITS_OBJECT, HITS_TABLE, ArmCollision
 from .ik import pose_error, solve_ik
+from .starts import nearest_starts
 
 __all__ = ["ReachOptions", "ReachResult", "arm_record", "check_reach", "REASONS"]
 
@@ -46,8 +47,8 @@ _COLLISION_REASON = {HITS_TABLE: HITS_TABLE_REASON, HITS_OBJECT: HITS_OBJECT_REA
 class ReachOptions:
     """Settings of :func:`check_reach` (metres, radians); validated when made."""
 
-    seeds: int = 8                   # IK starts per grasp (rounds): mid-range first, then seeded uniform draws
-    seed: int = 0                    # the generator of the uniform starts
+    seeds: int = 8                   # IK starts per grasp: the nearest entries of a seeded library (.starts)
+    seed: int = 0                    # the generator of the start library
     iterations: int = 60             # damped-least-squares steps per start
     damping: float = 0.05            # lambda of the damped least squares
     max_step: float = 0.3            # rad (m for a prismatic joint): largest joint change per IK step
@@ -139,13 +140,6 @@ def _backed_off(P: np.ndarray, d: float) -> np.ndarray:
     return out
 
 
-def _starts(arm, options: ReachOptions) -> np.ndarray:
-    """(seeds, dof): the mid-range of the joints, then uniform draws within the limits."""
-    rng = np.random.default_rng(options.seed)
-    mid = 0.5 * (arm.lower + arm.upper)
-    return np.vstack([mid, rng.uniform(arm.lower, arm.upper, (options.seeds - 1, arm.dof))])
-
-
 def _ik(arm, target, q0, options: ReachOptions, iterations: int, limits: bool = True):
     return solve_ik(arm, target, q0, iterations=iterations, damping=options.damping, max_step=options.max_step,
                     tol_position=options.tol_position, tol_rotation=options.tol_rotation,
@@ -188,24 +182,25 @@ def check_reach(arm, palm_poses, object_mesh=None, options: Optional[ReachOption
     P = _palm_poses(palm_poses)
     scene = ArmCollision(arm, object_mesh, table=options.table, clearance=options.clearance)
     N, n = len(P), arm.dof
-    starts = _starts(arm, options)
+    starts = nearest_starts(arm, P, options.seeds, options.seed, options.position_only)   # (N, seeds, dof)
     state = _State(N, n)
-    # 1. seed_round. Round 0 from the mid-range for every grasp; round 1 from every other start at
-    # once for the grasps round 0 left open, beside those it could not solve from the first three
+    # 1. seed_round. Round 0 from each grasp's nearest start; round 1 from its other starts at once
+    # for the grasps round 0 left open, beside those it could not solve from their first three
     # starts with the limits lifted (for 4. diagnose_limits, in the same batch)
     idx = np.arange(N)
-    sol = _ik(arm, P, np.repeat(starts[:1], N, axis=0), options, options.iterations)
+    sol = _ik(arm, P, starts[:, 0], options, options.iterations)
     state.counts["ik_problems"] += N
     state.solved[sol.converged] = True
     _accept(arm, P, idx[sol.converged], sol.q[sol.converged], scene, options, state)
     idx = np.flatnonzero(~state.done)
     free = np.zeros((0, n))
     if idx.size:
-        rows, lifted = starts[1:], starts[:3]
         unsolved = idx[~state.solved[idx]]      # only these may need the diagnosis
-        cand = np.r_[np.repeat(idx, len(rows)), np.repeat(unsolved, len(lifted))].astype(int)
-        q0 = np.r_[np.tile(rows, (idx.size, 1)), np.tile(lifted, (unsolved.size, 1))]
-        held = np.r_[np.ones(idx.size * len(rows), dtype=bool), np.zeros(unsolved.size * len(lifted), dtype=bool)]
+        rows, lifted = starts[idx, 1:], starts[unsolved, :3]
+        cand = np.r_[np.repeat(idx, rows.shape[1]), np.repeat(unsolved, lifted.shape[1])].astype(int)
+        q0 = np.r_[rows.reshape(-1, n), lifted.reshape(-1, n)]
+        held = np.r_[np.ones(rows.shape[0] * rows.shape[1], dtype=bool),
+                     np.zeros(lifted.shape[0] * lifted.shape[1], dtype=bool)]
         sol = _ik(arm, P[cand], q0, options, options.iterations, limits=held)
         state.counts["ik_problems"] += cand.size
         conv = sol.converged & held
