@@ -336,3 +336,31 @@ def test_plan_with_the_robot_plans_reachable_grasps_and_reports_them(capsys):
     g = d["attempts"][0]["grasp"]
     validate(g)
     assert g["arm"]["reachable"] is True and len(g["arm"]["joint_positions"]) == 7
+
+
+def test_the_exploration_search_never_chooses_an_unreachable_action_while_it_met_a_reachable_one():
+    """Eq. 3.2 (always exploring: threshold 1): reachable only on the -x side of the free choice."""
+    from bayesgrasp.models import build_models
+    from bayesgrasp.planners import PlannerSettings, make_planner
+    from testkit import TINY
+
+    models = build_models("cube", settings=TINY, cache_dir=None)
+    settings = PlannerSettings(explore_threshold=1.0, entropy_samples=10, explore_pso_iter=4)
+
+    def planner():
+        return make_planner("explore", models, estimate=(0.0, 0.0, 0.0), settings=settings)
+
+    free = planner().plan()
+    assert free.kind == "explore"
+    p, seen = planner(), []
+
+    def reach(models, X, pose):
+        ok = X[:, 0] <= free.action[0] - 0.005
+        seen.append(ok)
+        return ok
+
+    p.reach = reach
+    plan = p.plan()
+    ok = np.concatenate(seen)
+    assert plan.kind == "explore" and ok.any() and (~ok).any()
+    assert plan.action[0] <= free.action[0] - 0.005

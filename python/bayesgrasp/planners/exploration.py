@@ -23,6 +23,11 @@ from .. import optim
 from .base import Planner, wrap_angle
 from .pose_results import Plan
 
+#: nats added to an unreachable action's objective in the exploration search: more than the
+#: objective (an entropy of a planar-pose belief minus a weighted P(S)) can span, so that a
+#: reachable action always wins over an unreachable one.
+UNREACHABLE_ENTROPY = 1.0e6
+
 
 def kernel_matrix(particles: np.ndarray, weights: np.ndarray) -> np.ndarray:
     """Gaussian kernel K_ij (N, N) between planar poses, covariance f^2 C with C the weighted
@@ -122,7 +127,8 @@ class ExplorationPlanner(Planner):
 
     def minimise_entropy(self, init_best=None, family: Optional[str] = None):
         """PSO over (x, y, yaw) of ``family``'s grasps (None: the first) of the expected posterior
-        entropy minus explore_stability_weight x P(S). Returns (action, objective, nfev)."""
+        entropy minus explore_stability_weight x P(S); with a ``reach``, an unreachable action's
+        objective is raised by UNREACHABLE_ENTROPY. Returns (action, objective, nfev)."""
         s = self.settings
         family = self._family(family)
         table = self.tables[family]
@@ -135,11 +141,14 @@ class ExplorationPlanner(Planner):
 
         lam = s.explore_stability_weight
         b = self.belief
+        reachable = self._reachable(family)
 
         def objective(X):
             h = self.expected_entropy(X, seed=seed, family=family)[0]
             if lam != 0.0:
                 h = h - lam * table.expected_stability(X, b.particles, b.weights, s.threads)
+            if reachable is not None:   # Eq. 3.2 over the reachable actions
+                h = h + UNREACHABLE_ENTROPY * ~reachable(X)
             return h
 
         r = optim.pso(objective, (low, high), n_particles=k, max_iter=s.explore_pso_iter,
