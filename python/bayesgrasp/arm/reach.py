@@ -41,6 +41,8 @@ NO_IK, HITS_TABLE_REASON, HITS_OBJECT_REASON, JOINT_LIMITS = (
     "no IK solution", "arm hits table", "arm hits object", "joint limits")
 REASONS = (NO_IK, HITS_TABLE_REASON, HITS_OBJECT_REASON, JOINT_LIMITS)
 _COLLISION_REASON = {HITS_TABLE: HITS_TABLE_REASON, HITS_OBJECT: HITS_OBJECT_REASON}
+#: steps of round 0 (from each grasp's nearest start); its unconverged problems continue in round 1
+FIRST_ROUND_ITERATIONS = 20
 
 
 @dataclass(frozen=True)
@@ -57,7 +59,7 @@ class ReachOptions:
     position_only: bool = False      # solve for the palm's position only (an arm of fewer than six joints)
     pregrasp_distance: float = 0.1   # m: the pre-grasp, backed off along the approach
     approach_steps: int = 5          # intervals of the straight line from the grasp to the pre-grasp
-    step_iterations: int = 30        # IK steps per approach pose (warm-started from the grasp's solution)
+    step_iterations: int = 15        # IK steps per approach pose (warm-started from the grasp's solution)
     max_joint_step: float = 0.5      # rad: largest joint change between approach poses (more: the IK jumped)
     table: bool = True               # check the links against the table (z < 0)
     clearance: float = 0.0           # m: the gap a link keeps from the table and the object
@@ -184,22 +186,25 @@ def check_reach(arm, palm_poses, object_mesh=None, options: Optional[ReachOption
     N, n = len(P), arm.dof
     starts = nearest_starts(arm, P, options.seeds, options.seed, options.position_only)   # (N, seeds, dof)
     state = _State(N, n)
-    # 1. seed_round. Round 0 from each grasp's nearest start; round 1 from its other starts at once
-    # for the grasps round 0 left open, beside those it could not solve from their first three
-    # starts with the limits lifted (for 4. diagnose_limits, in the same batch)
+    # 1. seed_round. Round 0 from each grasp's nearest start (FIRST_ROUND_ITERATIONS steps: most
+    # converge well within them); round 1 from its other starts at once for the grasps round 0 left
+    # open, beside round 0's unconverged problems going on where they stopped, and beside those it
+    # could not solve from their first three starts with the limits lifted (for 4. diagnose_limits)
     idx = np.arange(N)
-    sol = _ik(arm, P, starts[:, 0], options, options.iterations)
+    first = min(options.iterations, FIRST_ROUND_ITERATIONS)
+    sol = _ik(arm, P, starts[:, 0], options, first)
     state.counts["ik_problems"] += N
     state.solved[sol.converged] = True
     _accept(arm, P, idx[sol.converged], sol.q[sol.converged], scene, options, state)
+    q_first = sol.q                             # round 0's unconverged problems go on from here in round 1
     idx = np.flatnonzero(~state.done)
     free = np.zeros((0, n))
     if idx.size:
         unsolved = idx[~state.solved[idx]]      # only these may need the diagnosis
         rows, lifted = starts[idx, 1:], starts[unsolved, :3]
-        cand = np.r_[np.repeat(idx, rows.shape[1]), np.repeat(unsolved, lifted.shape[1])].astype(int)
-        q0 = np.r_[rows.reshape(-1, n), lifted.reshape(-1, n)]
-        held = np.r_[np.ones(rows.shape[0] * rows.shape[1], dtype=bool),
+        cand = np.r_[np.repeat(idx, rows.shape[1]), unsolved, np.repeat(unsolved, lifted.shape[1])].astype(int)
+        q0 = np.r_[rows.reshape(-1, n), q_first[unsolved], lifted.reshape(-1, n)]
+        held = np.r_[np.ones(rows.shape[0] * rows.shape[1] + unsolved.size, dtype=bool),
                      np.zeros(lifted.shape[0] * lifted.shape[1], dtype=bool)]
         sol = _ik(arm, P[cand], q0, options, options.iterations, limits=held)
         state.counts["ik_problems"] += cand.size
