@@ -148,6 +148,22 @@ def test_the_nearest_start_of_a_library_pose_is_its_own_joint_vector():
     assert np.array_equal(start_library(arm, seed=3)[0], q) and not np.array_equal(start_library(arm, seed=4)[0], q)
 
 
+def test_the_palm_jacobian_is_the_derivative_of_the_palm_pose():
+    """Central differences of the palm's position and orientation (rotation vector of R(q+h) R(q-h)^T
+    over 2h) against the Jacobian's columns, at random joint vectors."""
+    arm = kuka(base=(0.1, 0.2, 0.3, 0.7))
+    q = np.random.default_rng(8).uniform(arm.lower, arm.upper, (4, arm.dof))
+    _, _, J = arm.palm_jacobian(q)
+    h = 1e-6
+    for k in range(arm.dof):
+        dq = np.zeros(arm.dof)
+        dq[k] = h
+        Pp, Pm = arm.palm_poses(q + dq), arm.palm_poses(q - dq)
+        v = (Pp[:, :3, 3] - Pm[:, :3, 3]) / (2 * h)
+        w = Rotation.from_matrix(Pp[:, :3, :3] @ Pm[:, :3, :3].transpose(0, 2, 1)).as_rotvec() / (2 * h)
+        assert np.allclose(J[:, :3, k], v, atol=1e-6) and np.allclose(J[:, 3:, k], w, atol=1e-6)
+
+
 def test_rotation_log_matches_scipy_near_zero_and_near_half_a_turn():
     v = np.array([[1e-7, 0, 0], [0.3, -0.2, 0.1], [0, 0, np.pi - 1e-5], [0.0, np.pi - 0.5, 0.0]])
     assert np.allclose(rotation_log(Rotation.from_rotvec(v).as_matrix()), v, atol=1e-9)

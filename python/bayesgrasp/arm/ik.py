@@ -82,11 +82,13 @@ def solve_ik(arm, target: np.ndarray, q0: np.ndarray, *, iterations: int, dampin
     active = np.arange(B)
     it = 0
     lam2 = damping * damping
+    diag = np.arange(3 if position_only else 6)
     for it in range(iterations + 1):
         R, p, J = arm.palm_jacobian(q[active], checked=True)
         e = pose_error(R_t[active], p_t[active], R, p, position_only)
         err[active] = e
-        ep, er = np.linalg.norm(e[:, :3], axis=1), np.linalg.norm(e[:, 3:], axis=1)
+        e2 = e * e
+        ep, er = np.sqrt(e2[:, :3].sum(axis=1)), np.sqrt(e2[:, 3:].sum(axis=1))
         ok = (ep <= tol_position) & (er <= tol_rotation)
         done[active[ok]] = True
         keep = ~ok
@@ -99,8 +101,10 @@ def solve_ik(arm, target: np.ndarray, q0: np.ndarray, *, iterations: int, dampin
         active, J, e = active[keep], J[keep][:, rows], e[keep][:, rows]
         if active.size == 0 or it == iterations:
             break
-        A = J @ J.transpose(0, 2, 1) + lam2 * np.eye(J.shape[1])
-        dq = (J.transpose(0, 2, 1) @ np.linalg.solve(A, e[..., None]))[..., 0]
+        Jt = J.transpose(0, 2, 1)
+        A = J @ Jt
+        A[:, diag, diag] += lam2
+        dq = (Jt @ np.linalg.solve(A, e[..., None]))[..., 0]
         big = np.abs(dq).max(axis=1)
         dq *= np.minimum(1.0, max_step / np.maximum(big, 1e-12))[:, None]
         q[active] = np.clip(q[active] + dq, lo[active], hi[active])

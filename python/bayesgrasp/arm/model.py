@@ -219,16 +219,15 @@ class Arm:
         Rodrigues, exp = I + sin(q) K + (1 - cos(q)) K^2 (K the axis's cross-product matrix), so that
         M_R exp = M_R + sin(q) M_R K + (1 - cos(q)) M_R K^2 with the products precomputed; a
         prismatic joint adds M_R (q a) to the translation."""
-        B, n = q.shape
-        s = np.where(self._rev, np.sin(q), 0.0)[..., None, None]
-        c = np.where(self._rev, 1.0 - np.cos(q), 0.0)[..., None, None]
-        L = np.empty((B, n, 4, 4))
-        L[..., :3, :3] = self._M[:, :3, :3] + s * self._MK + c * self._MK2
-        L[..., :3, 3] = self._M[:, :3, 3]
+        if self._prismatic.any():
+            s = np.where(self._rev, np.sin(q), 0.0)[..., None, None]
+            c = np.where(self._rev, 1.0 - np.cos(q), 0.0)[..., None, None]
+        else:
+            s, c = np.sin(q)[..., None, None], (1.0 - np.cos(q))[..., None, None]
+        L = np.repeat(self._M[None], q.shape[0], axis=0)                   # M, its last row 0 0 0 1 included
+        L[..., :3, :3] += s * self._MK + c * self._MK2
         if self._prismatic.any():
             L[..., :3, 3] += q[..., None] * np.where(self._prismatic[:, None], self._Ma, 0.0)
-        L[..., 3, :3] = 0.0
-        L[..., 3, 3] = 1.0
         return L
 
     def _frames(self, q: np.ndarray) -> np.ndarray:
@@ -264,9 +263,7 @@ class Arm:
         w = (T[:, :, :3, :3] @ self._axes[:, :, None])[..., 0]              # (B, dof, 3) axes in the table frame
         r = pp[:, None, :] - T[:, :, :3, 3]
         J = np.empty((q.shape[0], 6, self.dof))
-        lin = np.stack([w[..., 1] * r[..., 2] - w[..., 2] * r[..., 1],
-                        w[..., 2] * r[..., 0] - w[..., 0] * r[..., 2],
-                        w[..., 0] * r[..., 1] - w[..., 1] * r[..., 0]], axis=1)   # (B, 3, dof)
+        lin = np.cross(w, r).transpose(0, 2, 1)                             # (B, 3, dof): w x (p - o)
         if self._prismatic.any():
             wt = w.transpose(0, 2, 1)
             J[:, :3] = np.where(self._prismatic, wt, lin)
