@@ -380,3 +380,17 @@ def test_the_exploration_search_never_chooses_an_unreachable_action_while_it_met
     ok = np.concatenate(seen)
     assert plan.kind == "explore" and ok.any() and (~ok).any()
     assert plan.action[0] <= free.action[0] - 0.005
+
+
+def test_grasp_with_the_robot_in_ros_terms_gives_the_arms_trajectory(capsys):
+    """--format ros: beside the moveit_msgs/Grasp, a JointTrajectory of the arm's joints from the
+    pre-grasp (0 s) to the grasp (1 s), the same values as the JSON's arm record."""
+    from testkit import cli_json
+
+    args = ["grasp", "--object", "cube", "--top", "0,0,0", "--no-lift", "--robot", "kuka_lbr4"]
+    arm = cli_json(capsys, *args, "--json")["grasp"]["arm"]
+    ros = cli_json(capsys, *args, "--format", "ros")
+    t = ros["arm_trajectory"]
+    assert t["joint_names"] == arm["joint_names"]
+    assert [p["positions"] for p in t["points"]] == [arm["pregrasp_joint_positions"], arm["joint_positions"]]
+    assert [p["time_from_start"]["sec"] for p in t["points"]] == [0, 1]

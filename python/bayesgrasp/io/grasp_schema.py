@@ -108,6 +108,15 @@ def _trajectory(names, positions, seconds: float, frame_id: str) -> dict:
                         "time_from_start": {"sec": sec, "nanosec": int(round((seconds - sec) * 1e9))}}]}
 
 
+def _arm_trajectory(arm: dict, frame_id: str) -> dict:
+    """trajectory_msgs/JointTrajectory of the arm from its pre-grasp joints (0 s) to its grasp joints
+    (1 s): the two ends of the straight approach the reach check walked."""
+    pre, grasp = (_trajectory(arm["joint_names"], arm[k], t, frame_id)
+                  for k, t in (("pregrasp_joint_positions", 0.0), ("joint_positions", 1.0)))
+    pre["points"] += grasp["points"]
+    return pre
+
+
 def _translation(frame_id: str, vector, distance: float) -> dict:
     """moveit_msgs/GripperTranslation."""
     x, y, z = (float(v) for v in vector)
@@ -120,22 +129,27 @@ def to_ros(record: dict, grasp_id: str = "grasp", quality: Optional[float] = Non
     """``record`` shaped like ``moveit_msgs/Grasp`` (plus ``joint_state``, a
     ``sensor_msgs/JointState`` of the closed hand). The approach is given in the hand's frame
     (its +z, as MoveIt expects it in the end effector's frame), the retreat is the lift: +z of
-    the record's frame. The frame_id is the record's frame ("world" or "object")."""
+    the record's frame. The frame_id is the record's frame ("world" or "object"). A record whose
+    ``arm`` reaches the grasp also gets ``arm_trajectory``, a ``trajectory_msgs/JointTrajectory`` of
+    the arm's joints from the pre-grasp to the grasp."""
     frame_id = record["frame"]
     pre = record["pregrasp"]
     if "urdf" in record:        # a URDF hand: the joints the robot's driver knows, in its terms
         names, closed, opened = (record["urdf"][k] for k in ("joint_names", "joint_positions", "pregrasp_joint_positions"))
     else:
         names, closed, opened = record["joint_names"], record["joint_positions"], pre["joint_positions"]
-    return {"id": grasp_id,
-            "pre_grasp_posture": _trajectory(names, opened, 0.0, frame_id),
-            "grasp_posture": _trajectory(names, closed, 1.0, frame_id),
-            "grasp_pose": {"header": {"frame_id": frame_id},
-                           "pose": _pose_msg(record["position"], record["quaternion_xyzw"])},
-            "grasp_quality": 0.0 if quality is None else float(quality),
-            "pre_grasp_approach": _translation("hand", (0.0, 0.0, 1.0), pre["distance"]),
-            "post_grasp_retreat": _translation(frame_id, (0.0, 0.0, 1.0), lift),
-            "post_place_retreat": _translation(frame_id, (0.0, 0.0, 0.0), 0.0),
-            "max_contact_force": 0.0, "allowed_touch_objects": [],
-            "joint_state": {"header": {"frame_id": frame_id}, "name": list(names),
-                            "position": list(closed), "velocity": [], "effort": []}}
+    out = {"id": grasp_id,
+           "pre_grasp_posture": _trajectory(names, opened, 0.0, frame_id),
+           "grasp_posture": _trajectory(names, closed, 1.0, frame_id),
+           "grasp_pose": {"header": {"frame_id": frame_id},
+                          "pose": _pose_msg(record["position"], record["quaternion_xyzw"])},
+           "grasp_quality": 0.0 if quality is None else float(quality),
+           "pre_grasp_approach": _translation("hand", (0.0, 0.0, 1.0), pre["distance"]),
+           "post_grasp_retreat": _translation(frame_id, (0.0, 0.0, 1.0), lift),
+           "post_place_retreat": _translation(frame_id, (0.0, 0.0, 0.0), 0.0),
+           "max_contact_force": 0.0, "allowed_touch_objects": [],
+           "joint_state": {"header": {"frame_id": frame_id}, "name": list(names),
+                           "position": list(closed), "velocity": [], "effort": []}}
+    if record.get("arm", {}).get("reachable"):
+        out["arm_trajectory"] = _arm_trajectory(record["arm"], frame_id)
+    return out
