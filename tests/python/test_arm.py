@@ -71,8 +71,8 @@ def test_planar_arm_held_at_its_elbow_names_the_joint_limits(tmp_path):
     """With the elbow limited to |q2| <= 0.5 rad the arm reaches only r >= r_min =
     sqrt(l1^2 + l2^2 + 2 l1 l2 cos 0.5) = 0.7767 m: r = 0.5 is "joint limits" (the angle it needs,
     2.21 rad, is outside them), r = 0.79 reachable, r = 0.9 still "no IK solution"."""
-    text = PLANAR.read_text().replace('lower="-3.14159" upper="3.14159" effort="10" velocity="1"/>\n    <parent link="upper"/>',
-                                      'lower="-0.5" upper="0.5" effort="10" velocity="1"/>\n    <parent link="upper"/>')
+    elbow = 'lower="-3.14159" upper="3.14159" effort="10" velocity="1"/>\n    <parent link="upper"/>'
+    text = PLANAR.read_text().replace(elbow, elbow.replace("-3.14159", "-0.5").replace('"3.14159"', '"0.5"'))
     assert text != PLANAR.read_text()
     urdf = tmp_path / "held.urdf"
     urdf.write_text(text)

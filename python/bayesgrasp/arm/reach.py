@@ -13,13 +13,15 @@ The steps, each batched over the candidates still open:
 
 1. ``seed_round``: IK of the grasp pose from its ``seeds`` starts, the joint vectors of a seeded
    library whose palm poses lie nearest it (:mod:`.starts`); round 0 from the nearest for every
-   grasp, round 1 from the others at once for the grasps round 0 left open;
+   grasp (FIRST_ROUND_ITERATIONS steps), round 1 from the others at once for the grasps round 0
+   left open, round 0's unconverged problems going on beside them;
 2. ``grasp_collisions``: every converged solution against the table and the object;
 3. ``walk_approach``: the approach line from the grasp back to the pre-grasp at steps, each step's
-   IK warm-started from the grasp's first collision-free solution, then (if that walk fails) its next;
-4. after the last round, ``diagnose_limits``: a grasp that no start could solve is solved once
-   more with the limits lifted; if that lands outside the limits the reason is "joint limits",
-   else "no IK solution".
+   IK warm-started from the grasp's solution, for every collision-free solution at once; a grasp
+   takes its first solution (nearest start first) whose walk holds;
+4. ``diagnose_limits``: a grasp that round 0 could not solve is also solved in round 1's batch
+   from its first three starts with the limits lifted; if no start solves it within the limits
+   and a lifted solve lands outside them, the reason is "joint limits", else "no IK solution".
 
 A grasp's reason is the first collision met ("arm hits table", "arm hits object"), else what
 step 4 finds.
@@ -51,7 +53,7 @@ class ReachOptions:
 
     seeds: int = 8                   # IK starts per grasp: the nearest entries of a seeded library (.starts)
     seed: int = 0                    # the generator of the start library
-    iterations: int = 60             # damped-least-squares steps per start
+    iterations: int = 60             # damped-least-squares steps per start (round 0: at most 20, then on in round 1)
     damping: float = 0.05            # lambda of the damped least squares
     max_step: float = 0.3            # rad (m for a prismatic joint): largest joint change per IK step
     tol_position: float = 1e-4       # m: the palm's position error accepted
@@ -95,6 +97,8 @@ class ReachResult:
     joint_names : the arm's joints, the URDF's names in its order
     position_error : (N,) m, the palm's position error at q (NaN when unreachable)
     rotation_error : (N,) rad, the palm's orientation error at q (NaN when unreachable)
+    seconds : float, the call's wall time
+    counts : dict, ``ik_problems``: the grasp IK problems solved (grasps x starts tried)
     """
 
     reachable: np.ndarray
@@ -126,12 +130,11 @@ def _palm_poses(palm_poses) -> np.ndarray:
     if not np.all(np.isfinite(P)):
         raise ValueError("palm_poses: not finite")
     R = P[:, :3, :3]
-    if (not np.allclose(R @ R.transpose(0, 2, 1), np.eye(3), atol=1e-6) or not np.allclose(np.linalg.det(R), 1, atol=1e-6)
-            or not np.allclose(P[:, 3], [0, 0, 0, 1])):
-        bad = int(np.flatnonzero(~np.all(np.isclose(R @ R.transpose(0, 2, 1), np.eye(3), atol=1e-6), axis=(1, 2))
-                                 | ~np.isclose(np.linalg.det(R), 1, atol=1e-6)
-                                 | ~np.all(np.isclose(P[:, 3], [0, 0, 0, 1]), axis=1))[0])
-        raise ValueError(f"palm_poses[{bad}]: not a rigid transform (rotation not orthonormal or last row not 0 0 0 1)")
+    bad = (~np.all(np.isclose(R @ R.transpose(0, 2, 1), np.eye(3), atol=1e-6), axis=(1, 2))
+           | ~np.isclose(np.linalg.det(R), 1, atol=1e-6) | ~np.all(np.isclose(P[:, 3], [0, 0, 0, 1]), axis=1))
+    if bad.any():
+        raise ValueError(f"palm_poses[{int(np.flatnonzero(bad)[0])}]: not a rigid transform (rotation not orthonormal "
+                         "or last row not 0 0 0 1)")
     return P
 
 
