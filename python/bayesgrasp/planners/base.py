@@ -152,6 +152,7 @@ class Planner:
     :class:`bayesgrasp.planners.reach.ActionReach`); set it after construction. Eq. 3.1 is then
     maximised over the reachable actions: an unreachable action is never chosen while the search
     has met a reachable one (if it met none, the most stable action is returned as without an arm).
+    The arm is asked only about the actions that beat the best reachable one met so far.
     """
 
     method = "base"
@@ -319,11 +320,18 @@ class Planner:
         w = np.asarray(weights, dtype=float)
         init = np.clip(self._seed_actions(poses, w, s.pso_particles, family), low, high)
         reachable = self._reachable(family)
+        best = [-np.inf]   # the highest value of a reachable action met so far
 
         def negative(X):
-            v = table.expected_stability(X, poses, w, s.threads)
+            v = np.array(table.expected_stability(X, poses, w, s.threads), dtype=float)
             if reachable is not None:
-                v = v - UNREACHABLE_PENALTY * ~reachable(X)
+                # only an action above the best reachable one could become the search's best: the
+                # others keep their value without asking the arm (they can never be returned)
+                ask = np.flatnonzero(v > best[0])
+                if ask.size:
+                    ok = reachable(X[ask])
+                    best[0] = max(best[0], float(np.max(v[ask][ok], initial=-np.inf)))
+                    v[ask[~ok]] -= UNREACHABLE_PENALTY
             return -v
 
         r = optim.pso(negative, (low, high), n_particles=s.pso_particles, max_iter=s.pso_iter,

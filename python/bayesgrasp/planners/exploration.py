@@ -142,13 +142,19 @@ class ExplorationPlanner(Planner):
         lam = s.explore_stability_weight
         b = self.belief
         reachable = self._reachable(family)
+        best = [np.inf]   # the lowest objective of a reachable action met so far
 
         def objective(X):
             h = self.expected_entropy(X, seed=seed, family=family)[0]
             if lam != 0.0:
                 h = h - lam * table.expected_stability(X, b.particles, b.weights, s.threads)
-            if reachable is not None:   # Eq. 3.2 over the reachable actions
-                h = h + UNREACHABLE_ENTROPY * ~reachable(X)
+            if reachable is not None:   # Eq. 3.2 over the reachable actions; the arm asked only
+                h = np.array(h, dtype=float)
+                ask = np.flatnonzero(h < best[0])   # about those that beat the best reachable one
+                if ask.size:
+                    ok = reachable(X[ask])
+                    best[0] = min(best[0], float(np.min(h[ask][ok], initial=np.inf)))
+                    h[ask[~ok]] += UNREACHABLE_ENTROPY
             return h
 
         r = optim.pso(objective, (low, high), n_particles=k, max_iter=s.explore_pso_iter,
