@@ -394,3 +394,40 @@ def test_grasp_with_the_robot_in_ros_terms_gives_the_arms_trajectory(capsys):
     assert t["joint_names"] == arm["joint_names"]
     assert [p["positions"] for p in t["points"]] == [arm["pregrasp_joint_positions"], arm["joint_positions"]]
     assert [p["time_from_start"]["sec"] for p in t["points"]] == [0, 1]
+
+
+# ---- Eq. 4.1 takes reachability as a constraint --------------------------------------------------
+@pytest.mark.parametrize("method", ["laplace", "regularised"])
+def test_the_category_plan_is_a_grasp_the_arm_reaches(method):
+    """One model, one task grasp: without an arm the plan is the mapped grasp itself (test_category);
+    an arm that reaches only grasps 1 cm or more on the -x side of it moves the plan there, and an
+    arm that reaches nothing leaves no grasp to send, with the reason."""
+    from bayesgrasp.planners.category import CategoryPlanner, CategorySettings
+    from bayesgrasp.vision import RegistrationResult
+    from testkit import HAND, TOP, grasp, rz
+
+    T = rz(0.4, (0.1, -0.05, 0.0))
+    G = T @ TOP
+
+    def planner():
+        return CategoryPlanner(HAND, [grasp("a", TOP)], [RegistrationResult.known("a", T, phi=0.7)],
+                               settings=CategorySettings(method=method), seed=1)
+
+    free = planner().plan()
+    np.testing.assert_allclose(free.pose, G, atol=1e-9)
+    p, asked = planner(), []
+
+    def reach(P):
+        ok = P[:, 0, 3] <= G[0, 3] - 0.01
+        asked.append(ok)
+        return ok
+
+    p.reach = reach
+    plan = p.plan()
+    ok = np.concatenate(asked)
+    assert plan.ok and ok.any() and (~ok).any()
+    assert plan.pose[0, 3] <= G[0, 3] - 0.01 and plan.mixture > 0
+    nowhere = planner()
+    nowhere.reach = lambda P: np.zeros(len(P), dtype=bool)
+    none = nowhere.plan()
+    assert not none.ok and "out of the arm's reach" in none.reason

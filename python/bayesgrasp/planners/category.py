@@ -191,7 +191,15 @@ def warp_models(registrations: Sequence[RegistrationResult], weights, cloud, sam
 
 
 class CategoryPlanner:
-    """Eq. 4.1 for one scene: the mixture of the mapped task grasps, searched in C++ batches."""
+    """Eq. 4.1 for one scene: the mixture of the mapped task grasps, searched in C++ batches.
+
+    ``reach``: None, or a callable (hand poses (N, 4, 4) in the table frame) -> (N,) bool telling
+    which grasps an arm reaches (e.g. ``lambda P: check_reach(arm, P, mesh).reachable``); set it
+    after construction. Eq. 4.1 then takes reachability as a constraint, as it takes the table: a
+    grasp the arm cannot reach is worth nothing in the search and is never sent.
+    """
+
+    reach = None
 
     def __init__(self, hand: Hand, task_grasps: Sequence[TaskGrasp], registrations: Sequence[RegistrationResult],
                  cloud=None, settings: Optional[CategorySettings] = None, seed: int = 0,
@@ -285,6 +293,31 @@ class CategoryPlanner:
         d = self.intrusion(poses, spread)
         return J * np.exp(-d / s.clearance_scale) * ~self.below_table(poses)
 
+    def excluded(self, poses: np.ndarray) -> np.ndarray:
+        """(N,) the grasps never sent: a target under the table, or (with a ``reach``) out of the arm's reach."""
+        out = self.below_table(poses).copy()
+        if self.reach is not None and not out.all():
+            idx = np.flatnonzero(~out)
+            out[idx] = ~np.asarray(self.reach(np.asarray(poses, float)[idx]), bool).reshape(len(idx))
+        return out
+
+    def _searched(self, ref: np.ndarray, spread: float, density):
+        """The PSO's objective about the mapped grasp ``ref``: minus the penalised Eq. 4.1, an
+        unreachable grasp worth 0 (with a ``reach``). The arm is asked only about the grasps above the
+        best reachable one met so far: the others can never be the search's best."""
+        best = [-np.inf]
+
+        def negative(X):
+            v = np.array(self._penalised(ref, X, spread, density), dtype=float)
+            if self.reach is not None:
+                ask = np.flatnonzero(v > max(best[0], 0.0))
+                if ask.size:
+                    ok = np.asarray(self.reach(_task.poses_from_local(ref, X[ask])), bool).reshape(ask.size)
+                    best[0] = max(best[0], float(np.max(v[ask][ok], initial=-np.inf)))
+                    v[ask[~ok]] = 0.0
+            return -v
+        return negative
+
     def below_table(self, poses: np.ndarray) -> np.ndarray:
         """(N,) whether each hand pose's target (its position) lies under the table top, z < 0: such a
         grasp cannot be executed (the simulator refuses it), so it is never chosen. All False without a table."""
@@ -330,17 +363,18 @@ class CategoryPlanner:
             ref, spread = self.mapped[c], self.grasps[c].spread
             init = rng.uniform(-box, box, (s.pso_particles, 6))
             init[0] = 0.0  # the mapped grasp itself
-            r = optim.pso(lambda X: -self._penalised(ref, X, spread, density), (-box, box),
+            r = optim.pso(self._searched(ref, spread, density), (-box, box),
                           n_particles=s.pso_particles, max_iter=s.pso_iter, seed=int(rng.integers(2**31)), init=init)
             nfev += r.nfev
             optima.append(_task.poses_from_local(ref, r.x[None, :])[0])
-            if -r.fun > best_val and not self.below_table(optima[-1][None])[0]:
+            if -r.fun > best_val and not self.excluded(optima[-1][None])[0]:
                 best_val, best_start = -r.fun, c
                 best = optima[-1]
         if s.method in PART_METHODS:
             return self._part_aware(optima, rng, nfev)
         if best is None:
-            return self._empty("every start's optimum has its target below the table")
+            return self._empty("every start's optimum has its target below the table"
+                               + (" or out of the arm's reach" if self.reach is not None else ""))
         return self._result(best, best_val, best_start, nfev)
 
     # ---- part-aware: Eq. 4.1's candidates re-ranked by where the fingers land ------------------------
@@ -367,9 +401,10 @@ class CategoryPlanner:
         on some model (P > 0), and J alone if none passes."""
         s = self.settings
         A = self.candidates(optima, rng)
-        A = A[~self.below_table(A)]            # a target under the table is never sent
+        A = A[~self.excluded(A)]            # a target under the table (or out of the arm's reach) is never sent
         if not len(A):
-            return self._empty("every candidate's target lies below the table")
+            return self._empty("every candidate's target lies below the table"
+                               + (" or out of the arm's reach" if self.reach is not None else ""))
         v = self.evaluate(A)
         comp = np.asarray(v.dominant, int)
         spreads = np.array([self.grasps[c].spread if c >= 0 else self.grasps[0].spread for c in comp], float)
@@ -433,9 +468,10 @@ class CategoryPlanner:
         idx = np.flatnonzero(self.model_of == i)
         if not len(idx):
             return self._empty(f"the best-fitting model {self.registrations[i].model} has no task grasp")
-        idx = idx[~self.below_table(self.mapped[idx])]
+        idx = idx[~self.excluded(self.mapped[idx])]
         if not len(idx):
-            return self._empty(f"every task grasp of {self.registrations[i].model} maps below the table")
+            return self._empty(f"every task grasp of {self.registrations[i].model} maps below the table"
+                               + (" or out of the arm's reach" if self.reach is not None else ""))
         c = int(idx[np.argmax(self.psi[idx])])
         return self._result(self.mapped[c], None, c, 0)
 
