@@ -431,3 +431,16 @@ def test_the_category_plan_is_a_grasp_the_arm_reaches(method):
     nowhere.reach = lambda P: np.zeros(len(P), dtype=bool)
     none = nowhere.plan()
     assert not none.ok and "out of the arm's reach" in none.reason
+
+
+def test_category_with_the_robot_sends_a_grasp_the_arm_reaches(capsys, cat_options):
+    """category --robot (small models, two training mugs: the fixture cat_options): Eq. 4.1 planned
+    over the grasps the KUKA reaches (table only: the new object's mesh is unknown while planning);
+    the grasp sent comes back with the arm's joints, checked against the stand-in's mesh too."""
+    from bayesgrasp.io.grasp_schema import validate
+    from testkit import cli_json, without_set
+
+    d = cli_json(capsys, "category", "--category", "mug", "--task", "top", "--scene-object", "mug/3",
+                 "--object-pose", "0.01,0.02,0.7", *without_set(cat_options), "--robot", "kuka_lbr4", "--json")
+    validate(d["grasp"])
+    assert d["grasp"]["arm"]["reachable"] is True and len(d["grasp"]["arm"]["joint_positions"]) == 7

@@ -12,8 +12,8 @@ import numpy as np
 
 from ..planners.category import METHODS
 from . import camera_input
-from .args import (CliError, Renamed, add_category_options, add_context_options, context, floats, output_file, output_format,
-                   task_grasps_arg)
+from .args import (CliError, Renamed, add_category_options, add_context_options, add_robot_options, context, floats,
+                   output_file, output_format, robot_arm, task_grasps_arg)
 
 
 def add(sub) -> None:
@@ -33,6 +33,7 @@ def add(sub) -> None:
     add_category_options(c, "the cloud, the registered models and the hand")
     add_context_options(c)
     camera_input.add(c)
+    add_robot_options(c)
     c.set_defaults(run=run)
 
 
@@ -56,8 +57,12 @@ def run(args) -> int:
     if not any(r.success for r in ep.registrations):
         raise CliError("no training model registered to the cloud (is the object in view, is it of this category?)")
     grasps = task_grasps_arg(args)
-    r = plan_and_execute(ep, args.category, args.task, args.method, ctx, seed=ctx.seed, grasps=grasps)
+    arm = robot_arm(args, ctx.hand_model)
+    r = plan_and_execute(ep, args.category, args.task, args.method, ctx, seed=ctx.seed, grasps=grasps,
+                         reach=None if arm is None else _table_reach(arm))
     grasp = r.grasp(ctx.hand_model)
+    if arm is not None and grasp is not None:
+        grasp["arm"] = _arm_check(arm, grasp, args.scene_object, pose, ctx.hand)
     scene = (args.cloud or args.depth) if view is not None else "simulated view"
     doc = category_document(r, grasp, ep, args.category, args.units, scene)
     fmt = output_format(args)
@@ -70,6 +75,9 @@ def run(args) -> int:
         print(json.dumps(doc))
     else:
         _print(r, ep, args.category, scene)
+        if grasp is not None and "arm" in grasp:
+            a = grasp["arm"]
+            print(f"  arm: {'reaches the grasp' if a['reachable'] else 'cannot reach the grasp (' + a['reason'] + ')'}")
     if png and r.outcome.executed:
         _png(ep, r, ctx, png)
         if fmt == "text":
@@ -78,6 +86,29 @@ def run(args) -> int:
 
     show_result(args, doc)
     return 0
+
+
+def _table_reach(arm):
+    """Eq. 4.1's reach: the arm against the table (the new object's shape is not known, only its
+    cloud, so its mesh is not checked while planning)."""
+    from ..arm import check_reach
+
+    return lambda poses: check_reach(arm, poses).reachable
+
+
+def _arm_check(arm, grasp: dict, scene_object, pose, hand) -> dict:
+    """The grasp sent (table frame) checked with the arm: against the table and, when there is a
+    simulated stand-in, its mesh at --object-pose (the grasp schema's ``arm``)."""
+    from ..arm import ReachOptions, arm_record, check_reach
+    from ..world import World
+
+    mesh = None
+    if scene_object:
+        world = World.single(scene_object, pose=pose, hand=hand)
+        mesh = (world.vertices, world.faces)
+    r = check_reach(arm, np.asarray(grasp["pose"], dtype=float), mesh,
+                    ReachOptions(pregrasp_distance=grasp["pregrasp"]["distance"]))
+    return arm_record(arm, r, 0)
 
 
 def _print_part_check(pc: dict) -> None:

@@ -156,9 +156,10 @@ def see(obj: Optional[str], pose, category_name: str, exclude: Sequence[str] = (
 
 def plan_and_execute(ep: CategoryEpisode, category_name: str, task: str, method: str, ctx: RunContext,
                      settings: Optional[CategorySettings] = None, seed: int = 0,
-                     grasps: Optional[Sequence] = None) -> TaskGraspResult:
+                     grasps: Optional[Sequence] = None, reach=None) -> TaskGraspResult:
     """Eq. 4.1 for one task and method on the episode's registrations, then the execution.
-    ``grasps``: the demonstrated grasps to use (default: generated from the task's rule, cached)."""
+    ``grasps``: the demonstrated grasps to use (default: generated from the task's rule, cached);
+    ``reach``: the planner's (:attr:`CategoryPlanner.reach`: the grasps an arm reaches)."""
     rule = task_rule(category_name, task)
     grasps = demonstrated(ep.models, rule, ctx) if grasps is None else grasps
     grasps = [g for g in grasps if g.task == task]
@@ -166,6 +167,7 @@ def plan_and_execute(ep: CategoryEpisode, category_name: str, task: str, method:
     key = (s.warp_samples, s.clearance_voxel, seed)
     planner = CategoryPlanner(ctx.hand, grasps, ep.registrations, cloud=ep.observation.cloud, settings=s, seed=seed,
                               rule=rule, warped=ep.warps.get(key))
+    planner.reach = reach
     plan = planner.plan()
     if s.method == "warped":
         ep.warps[key] = planner.warped_models()        # the same view's other tasks reuse them
