@@ -444,3 +444,29 @@ def test_category_with_the_robot_sends_a_grasp_the_arm_reaches(capsys, cat_optio
                  "--object-pose", "0.01,0.02,0.7", *without_set(cat_options), "--robot", "kuka_lbr4", "--json")
     validate(d["grasp"])
     assert d["grasp"]["arm"]["reachable"] is True and len(d["grasp"]["arm"]["joint_positions"]) == 7
+
+
+def test_the_fusion_plan_is_a_grasp_the_arm_reaches():
+    """Eq. 4.6, one model at (0.02, 0.01, 0.3) with its task grasp at its origin: without an arm the
+    plan is that grasp (test_fusion); an arm reaching only x <= 0.01 moves it there."""
+    from bayesgrasp.planners.fusion import FusionPlanner, FusionSettings, ModelMixtureBelief
+    from testkit import analytic
+
+    def planner():
+        belief = ModelMixtureBelief(["a"], [analytic(True)], [1.0], [[0.02, 0.01, 0.3]], FusionSettings(), seed=2)
+        return FusionPlanner(belief, [np.array([[0.0, 0.0, 0.0]])], seed=3)
+
+    free = planner().plan()
+    np.testing.assert_allclose(free.action, [0.02, 0.01, 0.3], atol=2e-3)
+    p, asked = planner(), []
+
+    def reach(X):
+        ok = X[:, 0] <= 0.01
+        asked.append(ok)
+        return ok
+
+    p.reach = reach
+    plan = p.plan()
+    ok = np.concatenate(asked)
+    assert ok.any() and (~ok).any()
+    assert plan.action[0] <= 0.01 and plan.objective > 0

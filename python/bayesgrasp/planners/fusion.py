@@ -111,7 +111,16 @@ class FusionPlan:
 
 
 class FusionPlanner:
-    """Eq. 4.6 over a :class:`ModelMixtureBelief` with the models' top task grasps (planar)."""
+    """Eq. 4.6 over a :class:`ModelMixtureBelief` with the models' top task grasps (planar).
+
+    ``reach``: None, or a callable (top grasps (K, 3) x, y, yaw in the world) -> (K,) bool telling
+    which grasps an arm reaches; set it after construction. Eq. 4.6 then takes reachability as a
+    constraint: an unreachable grasp is worth 0 in the search (the arm is asked only about grasps
+    above the best reachable one met so far) and, among the part-aware candidates, is never chosen
+    while a reachable one is there.
+    """
+
+    reach = None
 
     def __init__(self, belief: ModelMixtureBelief, task_grasps: Sequence[np.ndarray], seed: int = 0,
                  part_check: Optional[Callable[[np.ndarray, "ModelMixtureBelief"], object]] = None):
@@ -210,7 +219,7 @@ class FusionPlanner:
         init = self._rng.uniform(low, high, (s.pso_particles, 3))
         n = min(len(seeds), s.pso_particles)
         init[:n] = np.clip(seeds[:n], low, high)
-        r = optim.pso(lambda X: -self.objective(X, with_s), (low, high), n_particles=s.pso_particles,
+        r = optim.pso(self._searched(with_s), (low, high), n_particles=s.pso_particles,
                       max_iter=s.pso_iter, seed=int(self._rng.integers(2**31)), init=init)
         a = np.asarray(r.x, dtype=float)
         a[2] = wrap(a[2])
@@ -218,6 +227,10 @@ class FusionPlanner:
         if s.task_term in PART_TERMS:
             C = self._candidates(a, seeds, low, high)
             J = self.objective(C, True)          # the re-ranking weighs stability from round 1 on
+            if self.reach is not None:           # an unreachable candidate only when none is reachable
+                ok = np.asarray(self.reach(C), bool).reshape(len(C))
+                if ok.any():
+                    C, J = C[ok], J[ok]
             check = self.part_check(C, self.belief)
             k = choose_lazily(check, J, product=True)
             a, objective, part, nfev = C[k], float(J[k]), float(check.p_success[k]), nfev + len(C)
@@ -225,6 +238,21 @@ class FusionPlanner:
         st, tk = float(self.belief.stability(a[None])[0]), float(self.task(a[None])[0])
         return FusionPlan(action=a, objective=objective, stability=st, task=tk, round=self.round,
                           evaluations=nfev, seeds=n, part=part)
+
+    def _searched(self, with_stability: bool):
+        """The PSO's objective: minus Eq. 4.6, an unreachable grasp worth 0 (with a ``reach``)."""
+        best = [-np.inf]
+
+        def negative(X):
+            v = np.array(self.objective(X, with_stability), dtype=float)
+            if self.reach is not None:
+                ask = np.flatnonzero(v > max(best[0], 0.0))
+                if ask.size:
+                    ok = np.asarray(self.reach(X[ask]), bool).reshape(ask.size)
+                    best[0] = max(best[0], float(np.max(v[ask][ok], initial=-np.inf)))
+                    v[ask[~ok]] = 0.0
+            return -v
+        return negative
 
     def _candidates(self, optimum: np.ndarray, seeds: np.ndarray, low, high) -> np.ndarray:
         """Eq. 4.6's optimum, the seeds (the previous grasp, the mapped task grasps) and perturbations
