@@ -470,3 +470,18 @@ def test_the_fusion_plan_is_a_grasp_the_arm_reaches():
     ok = np.concatenate(asked)
     assert ok.any() and (~ok).any()
     assert plan.action[0] <= 0.01 and plan.objective > 0
+
+
+def test_fuse_with_the_robot_reports_every_round_in_the_arms_terms(capsys, cat_options):
+    """fuse --robot (small models, two training mugs): Eq. 4.6 planned over the top grasps the KUKA
+    reaches; every round's executed grasp carries the arm's verdict, schema-valid."""
+    from bayesgrasp.io.grasp_schema import validate
+    from testkit import cli_json
+
+    d = cli_json(capsys, "fuse", "--category", "mug", "--task", "top", "--scene-object", "mug/3", "--object-pose",
+                 "0.01,0.02,0.7", "--rounds", 1, *cat_options, "--robot", "kuka_lbr4", "--json")
+    assert d["rounds"]
+    for r in d["rounds"]:
+        validate(r["grasp"])
+        assert set(r["grasp"]["arm"]) >= {"reachable", "reason", "joint_names"}
+    assert d["rounds"][-1]["grasp"]["arm"]["reachable"] is True     # the planned round: reachable

@@ -11,8 +11,8 @@ import numpy as np
 
 from . import camera_input
 from ..planners.fusion import TASK_TERMS
-from .args import (CliError, Renamed, add_category_options, add_context_options, bounded_int, context, floats, output_file,
-                   output_format, task_grasps_arg)
+from .args import (CliError, Renamed, add_category_options, add_context_options, add_robot_options, bounded_int, context,
+                   floats, output_file, output_format, robot_arm, task_grasps_arg)
 
 
 def add(sub) -> None:
@@ -40,6 +40,7 @@ def add(sub) -> None:
     add_category_options(f, "the weights and the models' poses per round")
     add_context_options(f)
     camera_input.add(f)
+    add_robot_options(f)
     f.set_defaults(run=run)
 
 
@@ -64,21 +65,29 @@ def run(args) -> int:
                         category=args.category, grasps=grasps,
                         observation=None if view is None else camera_input.observation(view))
     fmt = output_format(args)
+    arm = robot_arm(args, ctx.hand_model)
+    if arm is not None:
+        trial.reach = _top_reach(arm, ctx.hand_model, trial.episode.observation.cloud)
     r = trial.run(args.start, rounds=args.rounds, on_round=None if fmt != "text" else _print_round(trial.names),
                   stop_at_lift=True)
-    rounds = fuse_rounds(r, [x.grasp(ctx.hand_model, trial.spread) for x in r.rounds])
+    grasps = [x.grasp(ctx.hand_model, trial.spread) for x in r.rounds]
+    if arm is not None:
+        _arm_checks(arm, grasps, trial)
+    rounds = fuse_rounds(r, grasps)
     scene = (args.cloud or args.depth) if view is not None else "simulated view"
     doc = fuse_document(r, rounds, trial.episode, settings, category=args.category, task=args.task, units=args.units,
                         scene=scene)
     if fmt == "ros":
         from ..io.grasp_schema import to_ros
 
-        print(json.dumps({"rounds": [to_ros(x.grasp(ctx.hand_model, trial.spread), grasp_id=f"round-{x.number}")
-                                     for x in r.rounds]}))
+        print(json.dumps({"rounds": [to_ros(g, grasp_id=f"round-{x.number}") for x, g in zip(r.rounds, grasps)]}))
     elif fmt == "json":
         print(json.dumps(doc))
     else:
         print(f"{'success' if r.success else 'no grasp lifted'} after {len(r.rounds)} grasp(s)")
+        if arm is not None:
+            k = sum(g["arm"]["reachable"] for g in grasps)
+            print(f"arm: {k} of {len(grasps)} executed grasp(s) reachable")
     if png:
         from ..viz import plot_fusion_rounds
 
@@ -89,6 +98,34 @@ def run(args) -> int:
 
     show_result(args, doc)
     return 0
+
+
+def _top_reach(arm, hand, cloud):
+    """Eq. 4.6's reach: top grasps (K, 3) as the palm down at (x, y, yaw) at the top of the seen cloud
+    (where a top grasp meets the object at the latest), checked against the table (the new
+    object's mesh is not known, only its cloud)."""
+    from ..arm import check_reach
+
+    top = float(np.max(np.asarray(cloud, float)[:, 2])) if len(cloud) else 0.0
+
+    def reach(X):
+        P = np.stack([hand.top_grasp_pose(x, y, yaw, top) for x, y, yaw in np.atleast_2d(X)])
+        return check_reach(arm, P).reachable
+    return reach
+
+
+def _arm_checks(arm, grasps: list, trial) -> None:
+    """Each executed grasp (table frame) checked with the arm against the table and the stand-in's
+    mesh at its pose: the grasp schema's ``arm``, added to each grasp record."""
+    from ..arm import ReachOptions, arm_record, check_reach
+
+    if not grasps:
+        return
+    mesh = None if trial.world is None else (trial.world.vertices, trial.world.faces)
+    P = np.stack([np.asarray(g["pose"], dtype=float) for g in grasps])
+    r = check_reach(arm, P, mesh, ReachOptions(pregrasp_distance=grasps[0]["pregrasp"]["distance"]))
+    for i, g in enumerate(grasps):
+        g["arm"] = arm_record(arm, r, i)
 
 
 def _print_round(names):

@@ -79,6 +79,8 @@ class FusionTrial:
         self.world = None if obj is None else World.single(obj, pose=pose, hand=ctx.hand)
         self.spread = float(np.median([m.spread for m in self.models]))
         self._warped: Optional[list] = None     # the models warped onto the view, when first needed
+        #: the planner's reach (:attr:`FusionPlanner.reach`: the top grasps an arm reaches), or None
+        self.reach = None
 
     def belief(self) -> ModelMixtureBelief:
         w = self.w0 if self.w0.sum() > 0 else np.ones(len(self.w0))
@@ -89,7 +91,9 @@ class FusionTrial:
         the belief is its ``belief``)."""
         rng = np.random.default_rng(self.seed)
         part = self.part_check if self.settings.task_term in PART_TERMS else None
-        return rng, FusionPlanner(self.belief(), self.task_grasps, seed=int(rng.integers(2**31)), part_check=part)
+        planner = FusionPlanner(self.belief(), self.task_grasps, seed=int(rng.integers(2**31)), part_check=part)
+        planner.reach = self.reach
+        return rng, planner
 
     def part_check(self, grasps: np.ndarray, belief: ModelMixtureBelief):
         """The part check of top grasps (K, 3) over the models at the belief's poses and weights
