@@ -44,8 +44,8 @@ def test_pub5_scales_writes_its_grid_as_a_picture(tmp_path):
 
     results = {name: [(f"{name}-{i}", run(f"mug/{i}", {"laplace"} if k % 2 else {"baseline", "gaussian"}))
                       for i in range(2)] for k, name in enumerate(GRID)}
-    summary = scales_report(get_experiment("pub5_scales"), results, tmp_path)
+    written = scales_report(get_experiment("pub5_scales"), results, tmp_path)
     png = tmp_path / "scales.png"
     assert png.stat().st_size > 5000 and "scales.png" in (tmp_path / "summary.md").read_text()
     assert np.asarray(Image.open(png)).std() > 10                           # drawn, not blank
-    assert {r["laplace"] for r in summary["grid"]} == {0.0, 1.0}
+    assert written.out == tmp_path and {r["laplace"] for r in written.summary["grid"]} == {0.0, 1.0}

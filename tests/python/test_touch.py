@@ -166,7 +166,7 @@ def test_pub1_runs_and_reports_without_the_loop(tmp_path, monkeypatch):
     # every optimiser saw the same problems
     truths = {opt: [r["cases"]["pose"]["truth"] for _, r in res] for opt, res in results.items()}
     assert all(t == truths["pso"] for t in truths.values())
-    summary = exp.report(exp, results, tmp_path)
+    summary = exp.report(exp, results, tmp_path).summary
     for case in S.CASES:
         assert (tmp_path / f"errors_{case}.png").exists()
         assert {r["optimizer"] for r in summary[case]} == set(S.OPTIMIZERS)

@@ -72,7 +72,7 @@ COLS = ("category", "task", "method", "runs", "success", "ci_low", "ci_high", "l
         "epsilon") + FAILURES
 
 
-def write_report(exp: Experiment, results: Dict[str, list], out: Path) -> dict:
+def write_report(exp: Experiment, results: Dict[str, list], out: Path) -> report.Report:
     out, md, summary = report.start(exp.name, out)
     rows = outcome_rows(results["all"])
     report.write_csv(rows, out / "outcomes.csv")

@@ -55,7 +55,7 @@ def _make(exp: Experiment, method: str, ctx: RunContext):
     return method, partial(scales_run, ctx=ctx, scales=GRID[method])
 
 
-def write_report(exp: Experiment, results: Dict[str, list], out: Path) -> dict:
+def write_report(exp: Experiment, results: Dict[str, list], out: Path) -> report.Report:
     out, md, summary = report.start(exp.name, out)
     grid, nested = grid_rows(results, GRID, DENSITIES), nested_rows(results, MUGS, GRID, OURS)
     report.write_csv(grid, out / "grid.csv")

@@ -11,6 +11,7 @@ from typing import TYPE_CHECKING, Callable, Dict, List, Optional, Sequence
 
 if TYPE_CHECKING:
     from ..loop.context import RunContext
+    from .report import Report
 
 #: The run context's settings an experiment's runs may read, besides the hand, the cache and the
 #: seed that every one reads (``--set episode.FIELD`` is measurement_noise).
@@ -26,8 +27,8 @@ class Experiment:
     method), a one-line description, and three functions:
 
     * ``make_run(experiment, method, ctx)`` -> (series key in the result store, RunFunction);
-    * ``report(experiment, results, out)`` -> summary dict; ``results`` maps method -> [(RunKey, dict)];
-      writes summary.md, summary.json, tables and plots into ``out``;
+    * ``report(experiment, results, out)`` -> :class:`~.report.Report`; ``results`` maps method ->
+      [(RunKey, dict)]; writes summary.md, summary.json, tables and plots into ``out``;
     * ``prepare_object(experiment, object, ctx)`` (optional): what the runs of one object share
       (its models), built before the runs as an engine task per object (in parallel), into the
       disk cache the runs then read;
@@ -47,7 +48,7 @@ class Experiment:
     runs: int
     description: str
     make_run: Callable[["Experiment", str, "RunContext"], tuple]
-    report: Callable[["Experiment", Dict[str, list], Path], dict]
+    report: Callable[["Experiment", Dict[str, list], Path], "Report"]
     methods: Sequence[str] = ("stability",)
     finish: Optional[Callable[["Experiment", List[str], "RunContext", Path], None]] = None
     prepare: Optional[Callable[["Experiment", List[str], "RunContext"], None]] = None

@@ -120,7 +120,7 @@ def _make_run(exp: Experiment, method: str, ctx: RunContext):
 
 
 # ---- report: statistics (single_touch_stats), prose (single_touch_prose), figures (single_touch_plots) ----
-def write_report(exp: Experiment, results: Dict[str, list], out) -> dict:
+def write_report(exp: Experiment, results: Dict[str, list], out) -> report.Report:
     out, md, summary = report.start(exp.name, out)
     md += [__doc__.strip().split("\n")[0], "",
            "Cells: median [25th, 75th percentile] over the runs; errors after the touch, then the initial ones.", ""]
@@ -196,7 +196,7 @@ def _make_variant(exp: Experiment, method: str, ctx: RunContext):
     return f"{exp.name}/{method}", partial(variant_run, method=method, ctx=ctx)
 
 
-def write_variants(exp: Experiment, results: Dict[str, list], out) -> dict:
+def write_variants(exp: Experiment, results: Dict[str, list], out) -> report.Report:
     out, md, summary = report.start(exp.name, out)
     md += ["pub1's 3-DoF problems with the continuous contact term (surface) and with the Robotiq 3F hand.",
            "Cells: median [25th, 75th percentile]; the method column is optimiser/contact term or hand.", ""]

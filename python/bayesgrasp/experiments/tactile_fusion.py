@@ -62,7 +62,7 @@ def prepare(exp: Experiment, objects: List[str], ctx: RunContext) -> None:
     demonstrated(training_models("mug"), task_rule("mug", "top"), ctx)
 
 
-def write_report(exp: Experiment, results: Dict[str, list], out: Path) -> dict:
+def write_report(exp: Experiment, results: Dict[str, list], out: Path) -> report.Report:
     out, md, summary = report.start(exp.name, out)
     t = transitions(results["all"])
     rows = [{"measure": k, "ours": t[k], "thesis": THESIS.get(k, "")} for k in THESIS]
