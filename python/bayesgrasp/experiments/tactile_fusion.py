@@ -31,6 +31,7 @@ from ..planners.fusion import FusionSettings
 from . import report
 from .category_grasping import view
 from .registry import Experiment, register
+from .run_records import FusionRun
 from .tactile_fusion_plots import plot_cumulative_success
 from .tactile_fusion_stats import THESIS, round_rows, transitions
 
@@ -39,14 +40,15 @@ MUGS = tuple(f"mug/{i}" for i in range(7))
 
 # ---- the experiment ------------------------------------------------------------------------------------
 def fusion_run(experiment: str, obj: str, run_index: int, seed: int, *, ctx: RunContext, mode: str,
-               belief: str, task_term: str = "laplace", avoid_failed: bool = False) -> dict:
+               belief: str, task_term: str = "laplace", avoid_failed: bool = False) -> FusionRun:
+    """One trial on the run's view, and the vision-only baseline's grasp: G(0) planned from vision
+    (the trial's own G(0) in mode ``vision``, one more plan in mode ``random``)."""
     pose, eye = view(seed)
     trial = FusionTrial(obj, pose, ctx, eye_offset=eye, seed=seed % (2**31),
                         settings=FusionSettings(belief=belief, task_term=task_term, avoid_failed=avoid_failed))
-    out = trial.run(mode).to_dict()
-    baseline = trial.run("vision", rounds=0).to_dict() if mode == "random" else None
-    out.update({"object": obj, "pose": list(pose), "vision_only": baseline["rounds"][0] if baseline else out["rounds"][0]})
-    return out
+    result = trial.run(mode)
+    baseline = trial.run("vision", rounds=0) if mode == "random" else result
+    return FusionRun(result, obj, pose, baseline.rounds[0])
 
 
 def _make(mode: str, belief: str = "map", task_term: str = "laplace", avoid_failed: bool = False):
