@@ -19,7 +19,7 @@ def test_pub6_writes_csv_tables_and_a_plot(tmp_path):
                        ("c", trial([False, False, False, True], [0.0, 0.0, 0.0, 0.2], False)),
                        ("d", trial([False, False, False, False], [0.0, 0.0, 0.0, 0.0], False))]}
     t = transitions(results["all"])
-    assert (t["unstable_to_stable"], t["stable_to_unstable"], t["cumulative_success_by_round"]) == (1, 1, [1, 2, 2, 3])
+    assert (t.unstable_to_stable, t.stable_to_unstable, t.cumulative_success_by_round) == (1, 1, [1, 2, 2, 3])
     write_report(get_experiment("pub6"), results, tmp_path)
     rows = {r["measure"]: r for r in csv.DictReader(open(tmp_path / "transitions.csv"))}
     assert rows["unstable_to_stable"]["ours"] == "1" and rows["success_after_round_3"]["thesis"] == "78"

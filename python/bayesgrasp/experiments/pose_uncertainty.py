@@ -1,7 +1,7 @@
 """The thesis's experiments on known objects under pose uncertainty (§3.2-3.3, Pub. II-IV).
 
 Each experiment is a set of runs; each run is a pure function of (experiment, object, run
-index, seed) that returns a JSON-ready dict, stored as soon as it finishes
+index, seed) that returns a typed record (:mod:`.run_records`), stored as JSON as soon as it finishes
 (:mod:`bayesgrasp.experiments.runner`); :mod:`.report` writes the tables (Markdown and CSV) and
 the plots. The experiments registered here:
 

@@ -1,13 +1,13 @@
 """The experiments by name. Each module of experiments registers its own (see
 :mod:`.pose_uncertainty`; the package imports every such module); the driver (:mod:`.driver`)
 runs any of them the same way, in three steps: prepare (what the runs share), run one (a
-(method, object, run index) -> a JSON-ready dict, stored), report (tables, prose and figures from
+(method, object, run index) -> a typed record (:mod:`.run_records`) whose ``to_dict()`` is stored), report (tables, prose and figures from
 the stored runs; each experiment's statistics, prose and figures are modules of their own)."""
 from __future__ import annotations
 
 from dataclasses import dataclass
 from pathlib import Path
-from typing import TYPE_CHECKING, Callable, Dict, List, Optional, Sequence
+from typing import TYPE_CHECKING, Any, Callable, Dict, List, Optional, Sequence
 
 if TYPE_CHECKING:
     from ..loop.context import RunContext
@@ -17,8 +17,9 @@ if TYPE_CHECKING:
 #: seed that every one reads (``--set episode.FIELD`` is measurement_noise).
 CONTEXT_SETTINGS = ("success", "lift", "families", "models", "planner", "measurement_noise")
 
-#: (experiment, object, run index, seed) -> a JSON-ready dict; module level (sent to workers).
-RunFunction = Callable[[str, str, int, int], dict]
+#: (experiment, object, run index, seed) -> a record with ``to_dict()`` (or a JSON-ready dict);
+#: module level (sent to workers).
+RunFunction = Callable[[str, str, int, int], Any]
 
 
 @dataclass(frozen=True)

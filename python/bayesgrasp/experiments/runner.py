@@ -1,8 +1,8 @@
 """Run-by-run experiment execution with resume, worker processes and a progress bar.
 
 Every run is a pure function of (experiment, object, run index, seed) and the settings it runs
-under: the runner hands the function those four values, stores what it returns (a
-JSON-serialisable dict) in an SQLite file as soon as the run finishes, and skips runs already
+under: the runner hands the function those four values, stores what it returns (a typed
+record's ``to_dict()``, or a JSON-serialisable dict) in an SQLite file as soon as the run finishes, and skips runs already
 stored when started again. So an interrupted experiment resumes where it stopped and loses
 nothing, and the same runs go to any engine (:mod:`.engines`: local processes or Ray tasks)
 without touching the planners.

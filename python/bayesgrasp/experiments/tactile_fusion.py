@@ -67,28 +67,28 @@ def prepare(exp: Experiment, objects: List[str], ctx: RunContext) -> None:
 def write_report(exp: Experiment, results: Dict[str, list], out: Path) -> report.Report:
     out, md, summary = report.start(exp.name, out)
     t = transitions(results["all"])
-    rows = [{"measure": k, "ours": t[k], "thesis": THESIS.get(k, "")} for k in THESIS]
-    rows += [{"measure": "cumulative success by round 0/1/2/3", "ours": " / ".join(map(str, t["cumulative_success_by_round"])),
+    rows = [{"measure": k, "ours": getattr(t, k), "thesis": THESIS.get(k, "")} for k in THESIS]
+    rows += [{"measure": "cumulative success by round 0/1/2/3", "ours": " / ".join(map(str, t.cumulative_success_by_round)),
               "thesis": ""},
-             {"measure": "vision-only success", "ours": t["vision_only_success"], "thesis": "3 of 19 (robot)"}]
+             {"measure": "vision-only success", "ours": t.vision_only_success, "thesis": "3 of 19 (robot)"}]
     targets = [
-        {"target": "unstable -> stable above stable -> unstable", "holds": t["unstable_to_stable"] > t["stable_to_unstable"]},
-        {"target": "cumulative success never falls", "holds": all(np.diff(t["cumulative_success_by_round"]) >= 0)},
-        {"target": "combined above vision-only", "holds": t["success_after_round_3"] > t["vision_only_success"]},
-        {"target": f"success after round 3 >= 78 of {t['trials']} scaled to 100",
-         "holds": t["success_after_round_3"] >= 0.78 * t["trials"]},
+        {"target": "unstable -> stable above stable -> unstable", "holds": t.unstable_to_stable > t.stable_to_unstable},
+        {"target": "cumulative success never falls", "holds": all(np.diff(t.cumulative_success_by_round) >= 0)},
+        {"target": "combined above vision-only", "holds": t.success_after_round_3 > t.vision_only_success},
+        {"target": f"success after round 3 >= 78 of {t.trials} scaled to 100",
+         "holds": t.success_after_round_3 >= 0.78 * t.trials},
         {"target": "our target: success after round 3 >= 88 of 105 (scaled to the trials)",
-         "holds": t["success_after_round_3"] >= 88 / 105 * t["trials"]}]
+         "holds": t.success_after_round_3 >= 88 / 105 * t.trials}]
     report.write_csv(rows, out / "transitions.csv")
     report.write_csv(targets, out / "targets.csv")
     report.write_csv(round_rows(results["all"]), out / "rounds.csv")
     png = plot_cumulative_success(t, out / "cumulative_success.png", exp.name)
-    md += [f"{t['trials']} trials. Success = lifted. After round 3: {t['success_after_round_3']} "
-           f"(95% CI {t['ci_after_round_3'][0]:.2f}-{t['ci_after_round_3'][1]:.2f}); vision only: "
-           f"{t['vision_only_success']} (CI {t['ci_vision_only'][0]:.2f}-{t['ci_vision_only'][1]:.2f}).", "",
+    md += [f"{t.trials} trials. Success = lifted. After round 3: {t.success_after_round_3} "
+           f"(95% CI {t.ci_after_round_3[0]:.2f}-{t.ci_after_round_3[1]:.2f}); vision only: "
+           f"{t.vision_only_success} (CI {t.ci_vision_only[0]:.2f}-{t.ci_vision_only[1]:.2f}).", "",
            report.markdown(rows, ("measure", "ours", "thesis")), "", report.markdown(targets, ("target", "holds")), "",
            f"![cumulative success]({png.name})", ""]
-    summary.update({"transitions": t, "targets": targets})
+    summary.update({"transitions": t.to_dict(), "targets": targets})
     return report.finish(out, md, summary)
 
 
