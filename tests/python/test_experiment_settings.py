@@ -208,11 +208,11 @@ def test_config_tables_reach_the_planner_the_episode_and_the_sweep(tmp_path):
 
 @pytest.mark.parametrize("key, option", [("models.success", "--success"), ("models.family", "--families")])
 def test_a_setting_with_an_option_of_its_own_is_refused_by_set(key, option):
-    from bayesgrasp.cli.args import CliError, parse_set
+    from bayesgrasp.cli.args import CliError, SetOverrides, parse_set
 
     with pytest.raises(CliError, match=f"{key} is set by {option}"):
         parse_set([f"{key}=epsilon"])
-    assert parse_set(["models.n_samples=300"]) == {"models": {"n_samples": 300}}
+    assert parse_set(["models.n_samples=300"]) == SetOverrides(models={"n_samples": 300})
 
 
 @pytest.mark.parametrize("other", ["0.02", "0.01"])
@@ -246,22 +246,23 @@ def test_an_option_the_experiment_does_not_read_is_refused(tmp_path, argv, refus
 
 def test_the_closed_loop_experiments_read_every_run_setting():
     from bayesgrasp.cli import build_parser
-    from bayesgrasp.cli.args import given_settings
+    from bayesgrasp.cli.args import GivenSetting, given_settings
     from bayesgrasp.experiments import get_experiment
 
     args = build_parser().parse_args(["experiment", "pub2", "--families", "top,side", "--success", "epsilon",
                                       "--no-lift", "--set", "planner.n_particles=100",
                                       "--sweep", "episode.measurement_noise=0,0.01", "--set", "models.n_samples=300"])
-    given = given_settings(args)
+    given = {g.setting: g.option for g in given_settings(args)}
+    assert len(given) == len(given_settings(args))      # each setting once
     assert set(given) == {"families", "success", "lift", "planner", "measurement_noise", "models"}
     assert given["lift"] == "--no-lift" and given["planner"] == "--set planner.n_particles"
     for name in ("pub2", "baselines", "pub4"):
         assert set(get_experiment(name).reads) == set(given)
     # options at the context's defaults are not given; a --set is given even at its default value
     at_defaults = build_parser().parse_args(["experiment", "pub5", "--families", "top", "--success", "lift"])
-    assert given_settings(at_defaults) == {}
+    assert given_settings(at_defaults) == ()
     assert given_settings(build_parser().parse_args(["experiment", "pub5", "--set", "planner.n_particles=500"])) \
-        == {"planner": "--set planner.n_particles"}
+        == (GivenSetting("planner", "--set planner.n_particles"),)
     with pytest.raises(ValueError, match="not run-context settings"):
         from bayesgrasp.experiments.registry import Experiment
         Experiment("x", ("cube",), 1, "", None, None, reads=("threads",))

@@ -80,15 +80,19 @@ def _final_belief_dict(f: dict, snapshot) -> dict:
             "position_error": f["position_error"], "yaw_error": f["yaw_error"], **belief_json(*snapshot)}
 
 
-def plan_document(r, object_name: str, units: Optional[str], criterion: str) -> dict:
+def plan_document(r, object_name: str, units: Optional[str], criterion: str, vision: Optional[dict] = None) -> dict:
     """``bayesgrasp plan``'s JSON of an episode run with ``keep_planner`` (its snapshots give each
     attempt the belief it was planned from): ``object_name`` as the user gave it, the mesh's
-    ``units``, the success ``criterion``. Each attempt carries the executed grasp in the grasp
-    schema and its contacts with the object (with parts); the aliases are in the module's doc."""
-    return {"object": object_name, "units": units, "method": r.method, "true_pose": _list(r.true_pose),
-            "estimate": _list(r.estimate), "success_criterion": criterion, "success": r.success,
-            "attempts": [_plan_attempt_dict(a, s) for a, s in zip(r.attempts, r.snapshots)],
-            "final_belief": _final_belief_dict(r.final_belief, r.snapshots[-1])}
+    ``units``, the success ``criterion``; ``vision`` (:func:`vision_dict`) when the belief came
+    from camera data. Each attempt carries the executed grasp in the grasp schema and its
+    contacts with the object (with parts); the aliases are in the module's doc."""
+    doc = {"object": object_name, "units": units, "method": r.method, "true_pose": _list(r.true_pose),
+           "estimate": _list(r.estimate), "success_criterion": criterion, "success": r.success,
+           "attempts": [_plan_attempt_dict(a, s) for a, s in zip(r.attempts, r.snapshots)],
+           "final_belief": _final_belief_dict(r.final_belief, r.snapshots[-1])}
+    if vision is not None:
+        doc["vision"] = vision
+    return doc
 
 
 def vision_dict(start, scene: str, object_points) -> dict:
