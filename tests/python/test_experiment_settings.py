@@ -106,9 +106,14 @@ def _episode(experiment, obj, run_index, seed):
 def test_attempts_become_rows_with_real_columns(tmp_path):
     store = ResultStore(tmp_path / "results.sqlite")
     run_experiment("e", ["cube", "mug"], 3, _episode, store, progress=False, settings={"lift": True})
-    assert store.flatten() == {"run_rows": 6, "attempts": 12}
+    store.flatten()
     store.close()
     db = sqlite3.connect(str(tmp_path / "results.sqlite"))
+    # one row per run, one per attempt of a run, and no table for anything else
+    assert db.execute("SELECT COUNT(*) FROM run_rows").fetchone()[0] == 6
+    assert db.execute("SELECT COUNT(*) FROM attempts").fetchone()[0] == 12
+    assert {r[0] for r in db.execute("SELECT name FROM sqlite_master WHERE type = 'table'")} \
+        == {"runs", "settings", "run_rows", "attempts"}
     # plain SQL, no JSON functions: the share lifted at the second attempt, per object
     rows = db.execute("SELECT object, AVG(lifted), COUNT(*) FROM attempts WHERE position = 1 GROUP BY object"
                       " ORDER BY object").fetchall()

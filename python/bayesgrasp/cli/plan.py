@@ -205,8 +205,9 @@ def plan(args) -> int:
         _belief_png(r, png)
     if fmt == "ros":
         from ..io.grasp_schema import to_ros
+        from ..io.results import attempt_grasp
 
-        print(json.dumps({"attempts": [to_ros(a.grasp, grasp_id=f"attempt-{a.number}", quality=a.plan.predicted_stability)
+        print(json.dumps({"attempts": [to_ros(attempt_grasp(a), grasp_id=f"attempt-{a.number}", quality=a.plan.predicted_stability)
                                        for a in r.attempts]}))
     if fmt == "json" or args.view is not None:   # plan's JSON, with the vision start when there is one
         from ..io.results import plan_document, vision_dict

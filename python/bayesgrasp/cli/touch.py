@@ -48,7 +48,7 @@ def _case(args) -> str:
 
 
 def run(args) -> int:
-    from ..io.results import touch_document
+    from ..io.results import touch_document, touch_grasp
     from ..loop.touch_trial import touch_once
     from ..planners import touch as T
 
@@ -73,7 +73,7 @@ def run(args) -> int:
     if fmt == "ros":
         from ..io.grasp_schema import to_ros
 
-        print(json.dumps(to_ros(trial.grasp, grasp_id=f"{args.object}-touch")))
+        print(json.dumps(to_ros(touch_grasp(trial), grasp_id=f"{args.object}-touch")))
     elif fmt == "json":
         print(json.dumps(out))
     else:

@@ -13,12 +13,7 @@ from typing import Dict, Optional, Sequence, Tuple
 import numpy as np
 from scipy import stats
 
-from ..io.results import fusion_dict, fusion_round_dict, pose_errors_dict, task_grasp_dict
-
-
-def _tasks_dict(tasks: Dict[str, Dict[str, object]]) -> dict:
-    """{task: {method: TaskGraspResult}} as stored."""
-    return {t: {m: task_grasp_dict(r) for m, r in by_method.items()} for t, by_method in tasks.items()}
+from ..io.results import fusion_dict, fusion_round_dict, pose_errors_dict, tasks_dict
 
 
 # ---- pub5, pub5_complete, pub5_scales (category_grasping, category_scales) -----------------------------
@@ -47,7 +42,7 @@ class CategoryRun:
         return {"object": self.object, "category": self.category, "pose": list(self.pose),
                 "eye_offset": list(self.eye_offset), "complete": self.complete, "cloud_points": self.cloud_points,
                 "registrations": [{"model": r.model, "phi": r.phi, "success": r.success} for r in self.registrations],
-                "tasks": _tasks_dict(self.tasks)}
+                "tasks": tasks_dict(self.tasks)}
 
 
 @dataclass(frozen=True)
@@ -63,7 +58,7 @@ class ScalesRun:
 
     def to_dict(self) -> dict:
         return {"object": self.object, "category": self.category, "pose": list(self.pose),
-                "scales": list(self.scales), "tasks": _tasks_dict(self.tasks)}
+                "scales": list(self.scales), "tasks": tasks_dict(self.tasks)}
 
 
 # ---- entropy_order, landscapes, the entropy gain (pose_uncertainty) ------------------------------------

@@ -93,11 +93,11 @@ class ResultStore:
             " ORDER BY object, run_index", (experiment,))
         return [(RunKey(*r[:4]), json.loads(r[4])) for r in rows]
 
-    def flatten(self) -> dict:
+    def flatten(self) -> None:
         """Rebuilds the plain SQL tables derived from the runs (:mod:`.flat_tables`): run_rows and
-        one table per list of records (attempts, ...). Returns rows per table."""
+        one table per list of records (attempts, ...)."""
         from .flat_tables import flatten
-        return flatten(self._db)
+        flatten(self._db)
 
     def close(self) -> None:
         self._db.close()
