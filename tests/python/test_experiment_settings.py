@@ -61,15 +61,15 @@ def test_the_difference_names_nested_and_missing_keys():
 
 
 def test_result_settings_cover_what_changes_a_result():
-    s = RunContext().result_settings()
+    s = RunContext().result_settings().to_dict()
     assert {"bayesgrasp", "cache_version", "hand", "hand_file_sha256", "success", "lift", "models"} <= set(s)
     assert s == json.loads(json.dumps(s))  # plain JSON
-    other = RunContext(success="epsilon", lift=False).result_settings()
+    other = RunContext(success="epsilon", lift=False).result_settings().to_dict()
     diff = settings_difference(s, other)
     assert any(x.startswith("lift:") for x in diff) and any(x.startswith("success:") for x in diff)
     assert any(x.startswith("models.success:") for x in diff)
     robotiq = RunContext(hand="robotiq_3f").result_settings()
-    assert robotiq["hand_file_sha256"] != s["hand_file_sha256"]
+    assert robotiq.hand_file_sha256 != s["hand_file_sha256"] and robotiq.hand.startswith("Robotiq")
 
 
 def test_the_context_carries_its_loaded_hand_and_still_goes_to_workers():
@@ -196,7 +196,7 @@ def test_config_tables_reach_the_planner_the_episode_and_the_sweep(tmp_path):
     assert ctx.planner_settings().n_particles == 120 and tuple(ctx.planner_settings().half_width) == (0.02, 0.02, 0.5)
     assert ctx.measurement_noise == 0.01
     s = ctx.result_settings()
-    assert s["planner"]["n_particles"] == 120 and s["measurement_noise"] == 0.01
+    assert s.planner.n_particles == 120 and s.to_dict()["measurement_noise"] == 0.01
     # the file's sweep axes, the command line's value list winning for the axis it names
     points = sweep_points(args)
     assert [p for p, _ in points] == [{"planner.pso_iter": 5, "models.n_samples": 350},

@@ -60,7 +60,7 @@ def run(name: str, out_dir, ctx: Optional[RunContext] = None, runs: Optional[int
     out = Path(out_dir)
     worker_ctx = ctx.for_workers()
     runs_of = {method: exp.make_run(exp, method, worker_ctx) for method in exp.methods}  # (series, fn)
-    settings = ctx.result_settings()
+    settings = ctx.result_settings().to_dict()
     store = ResultStore(out / "results.sqlite")
     try:
         # Refuse a resume under other settings before building anything.

@@ -83,7 +83,7 @@ def run_sweep(name: str, out_dir, points: Sequence[Point], runs=None, objects=No
     plans = []  # (point, {method: series name}, [Series])
     try:
         for p in points:
-            settings = {**p.ctx.result_settings(), "sweep": {k: _plain(v) for k, v in p.params.items()}}
+            settings = {**p.ctx.result_settings().to_dict(), "sweep": {k: _plain(v) for k, v in p.params.items()}}
             names, series = {}, []
             for method in exp.methods:
                 base, fn = exp.make_run(exp, method, p.ctx.for_workers())
