@@ -84,7 +84,7 @@ def _loop(args, ctx, pose, attempts: int = EpisodeSettings.attempts, estimate=No
     if noise and "measurement_noise" in parse_set(getattr(args, "set", [])).episode:
         raise CliError("--noise and --set episode.measurement_noise: two names for one setting; give one")
     obj = args.object if obj is None else obj
-    World.single(obj, pose=pose, hand=ctx.hand)  # a clear error for an unknown object or a pose off the table
+    World.single(obj, pose=pose, hand=ctx.hand_model)  # a clear error for an unknown object or a pose off the table
     models = ctx.family_models(obj)
     ctx = replace(ctx, planner=started(ctx.planner_settings(), start), measurement_noise=noise or ctx.measurement_noise)
     episode = EpisodeSettings(method=args.method, attempts=attempts)

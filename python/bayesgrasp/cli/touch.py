@@ -64,7 +64,7 @@ def run(args) -> int:
     given = {k: getattr(args, k) for k in ("optimizer", "budget", "contact_term") if getattr(args, k) is not None}
     settings = T.TouchSettings(unknowns=case, seed=ctx.seed, spread=args.spread, threads=0, **given)
     obj = object_arg(args)                          # in --units, read once
-    trial = touch_once(T.TouchPlanner(obj, guess, settings, hand=ctx.hand), obj, truth)
+    trial = touch_once(T.TouchPlanner(obj, guess, settings, hand=ctx.hand_model), obj, truth)
     out = touch_document(trial, args.object, args.units, case)
     landscape = _landscape(trial, png, args) if png else None
     if landscape is not None:

@@ -81,7 +81,7 @@ def entropy_order_run(experiment: str, obj: str, run_index: int, seed: int, *, c
     h, se = planner.expected_entropy(cands, n_samples=200, seed=1)
     particles = planner.belief.particles.copy()
     order = np.argsort(h)
-    world = World.single(obj, pose=pose, hand=ctx.hand)
+    world = World.single(obj, pose=pose, hand=ctx.hand_model)
     picks = []
     for name, i in zip(PICKS, (order[0], order[len(order) // 2], order[-1])):
         realised, _ = _reweighted(planner, models, world, pose, cands[i])
@@ -109,7 +109,7 @@ def entropy_gain_run(obj: str, run_index: int, ctx: Optional[RunContext] = None,
     pose, models, planner, rng, _ = _initial_planner(
         obj, ctx, run_seed(ctx.seed, "entropy_gain", obj, run_index), models,
         PlannerSettings(explore_stability_weight=0.0))  # Eq. 3.2 alone
-    world = World.single(obj, pose=pose, hand=ctx.hand)
+    world = World.single(obj, pose=pose, hand=ctx.hand_model)
     informative, _, _ = planner.minimise_entropy()
     low, high = planner.action_bounds()
     random_action = rng.uniform(low, high)

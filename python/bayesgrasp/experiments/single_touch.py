@@ -89,7 +89,7 @@ def _second_grasp(obj: str, planner: TouchPlanner, truth, ctx: RunContext) -> Se
     """Fig. 2.1: the most stable grasp planned on the initial guess and on the updated model,
     each executed on the true object."""
     models = ctx.models(obj)
-    world = World.single(obj, pose=truth[:3], hand=ctx.hand)
+    world = World.single(obj, pose=truth[:3], hand=ctx.hand_model)
     tried = []
     for estimate in (planner.initial, planner.estimate):
         action = TouchPlanner(planner.model, estimate, planner.settings, models=models).plan().action
@@ -152,7 +152,7 @@ def planned_on_truth(exp: Experiment, objects: List[str], ctx: RunContext, out) 
         models = ctx.models(o)
         wins = []
         for truth in truths:
-            world = World.single(o, pose=truth[:3], hand=ctx.hand)
+            world = World.single(o, pose=truth[:3], hand=ctx.hand_model)
             action = TouchPlanner(touch_model(o, ctx.hand), truth, models=models).plan().action
             wins.append(execute(world, models, action, truth[:3], ctx).success)
         rows.append({"object": o, "runs": len(truths), "success_on_truth": float(np.mean(wins))})
