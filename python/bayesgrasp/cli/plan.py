@@ -8,16 +8,14 @@ from pathlib import Path
 import numpy as np
 
 from ..loop.episode import EpisodeSettings
-from ..planners.registry import PLANNERS
+from ..planners.registry import PLANNERS, methods_help
 from . import camera_input
 from .args import (CliError, add_context_options, add_families_option, add_format_options, add_object_options,
                    add_view_option, bounded_int, context, floats, object_arg, out_dir, output_file, output_format,
                    parse_set)
 
 METHODS = list(PLANNERS)
-METHOD_HELP = ("stability: the most stable grasp (Eq. 3.1); explore: informative grasps while none is likely to hold "
-               "(Eq. 3.2); ml_pose: the most stable grasp at the most likely pose; open_loop: the most stable grasp "
-               "at the estimate, no update")
+METHOD_HELP = methods_help(METHODS)
 
 
 def add(sub) -> None:
