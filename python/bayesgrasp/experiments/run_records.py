@@ -8,12 +8,18 @@ database; the reports read the stored dicts. The loop's own results inside (a
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Dict, Optional, Sequence, Tuple
+from typing import TYPE_CHECKING, Dict, Optional, Sequence, Tuple
 
 import numpy as np
 from scipy import stats
 
 from ..io.results import fusion_dict, fusion_round_dict, pose_errors_dict, tasks_dict
+
+if TYPE_CHECKING:
+    from ..loop.category_result import TaskGraspResult
+    from ..loop.fusion_result import FusionResult, FusionRound
+    from ..loop.touch_trial import PoseErrors, TouchTrial
+    from ..vision import RegistrationResult
 
 
 # ---- pub5, pub5_complete, pub5_scales (category_grasping, category_scales) -----------------------------
@@ -25,7 +31,7 @@ class CategoryRun:
     pose : tuple — the table pose (x, y, yaw); eye_offset : tuple — the camera from the object's centre
     complete : bool — the whole surface as the cloud (pub5_complete)
     cloud_points : int
-    registrations : sequence — each training model's registration (model, phi, success)
+    registrations : sequence of RegistrationResult — each training model's (model, phi, success)
     tasks : {task: {method: TaskGraspResult}}
     """
 
@@ -35,8 +41,8 @@ class CategoryRun:
     eye_offset: tuple
     complete: bool
     cloud_points: int
-    registrations: Sequence
-    tasks: Dict[str, Dict[str, object]]
+    registrations: Sequence["RegistrationResult"]
+    tasks: Dict[str, Dict[str, "TaskGraspResult"]]
 
     def to_dict(self) -> dict:
         return {"object": self.object, "category": self.category, "pose": list(self.pose),
@@ -54,7 +60,7 @@ class ScalesRun:
     category: str
     pose: tuple
     scales: Tuple[float, float]
-    tasks: Dict[str, Dict[str, object]]
+    tasks: Dict[str, Dict[str, "TaskGraspResult"]]
 
     def to_dict(self) -> dict:
         return {"object": self.object, "category": self.category, "pose": list(self.pose),
@@ -188,9 +194,9 @@ class TouchCase:
 
     truth: np.ndarray
     initial: np.ndarray
-    trial: object            # the TouchTrial
-    before: object           # PoseErrors of the guess
-    after: object            # PoseErrors of the estimate
+    trial: "TouchTrial"
+    before: "PoseErrors"     # of the guess
+    after: "PoseErrors"      # of the estimate
 
     def to_dict(self) -> dict:
         t, r = self.trial, self.trial.fit
@@ -253,10 +259,10 @@ class FusionRun:
     """One pub6 trial: the FusionResult, the held-out object and its table pose, and the
     vision-only baseline's grasp (a FusionRound: G(0) planned from vision)."""
 
-    result: object
+    result: "FusionResult"
     object: str
     pose: tuple
-    vision_only: object
+    vision_only: "FusionRound"
 
     def to_dict(self) -> dict:
         return {**fusion_dict(self.result), "object": self.object, "pose": list(self.pose),
