@@ -44,7 +44,7 @@ def add(sub) -> None:
 
 
 def run(args) -> int:
-    from ..io.results import fuse_document, fuse_rounds
+    from ..io.results import fuse_document, fuse_rounds, round_grasp
     from ..loop.fusion_trial import FusionTrial
     from ..planners.fusion import FusionSettings
 
@@ -66,15 +66,15 @@ def run(args) -> int:
     fmt = output_format(args)
     r = trial.run(args.start, rounds=args.rounds, on_round=None if fmt != "text" else _print_round(trial.names),
                   stop_at_lift=True)
-    rounds = fuse_rounds(r, [x.grasp(ctx.hand_model, trial.spread) for x in r.rounds])
+    grasps = [round_grasp(x, ctx.hand_model, trial.spread) for x in r.rounds]
+    rounds = fuse_rounds(r, grasps)
     scene = (args.cloud or args.depth) if view is not None else "simulated view"
     doc = fuse_document(r, rounds, trial.episode, settings, category=args.category, task=args.task, units=args.units,
                         scene=scene)
     if fmt == "ros":
         from ..io.grasp_schema import to_ros
 
-        print(json.dumps({"rounds": [to_ros(x.grasp(ctx.hand_model, trial.spread), grasp_id=f"round-{x.number}")
-                                     for x in r.rounds]}))
+        print(json.dumps({"rounds": [to_ros(g, grasp_id=f"round-{x.number}") for x, g in zip(r.rounds, grasps)]}))
     elif fmt == "json":
         print(json.dumps(doc))
     else:
