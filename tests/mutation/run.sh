@@ -3,8 +3,9 @@
 # against their unit tests. A measurement, not a CI step:
 #   bash tests/mutation/run.sh [WORKDIR]        (default /tmp/bayesgrasp-mutation)
 #   then: cd WORKDIR && ../path/.venv/bin/mutmut results
-# mutmut mutates a copy of the source tree; here that copy is the package installed in .venv
-# (with its compiled core) under WORKDIR/src, and the tests are copied beside it. Workers start by
+# mutmut mutates a copy of the source tree: the tree's python/bayesgrasp with the compiled core of
+# the package installed in .venv (`make` keeps the two in step) under WORKDIR/src, and the tests
+# copied beside it. Workers start by
 # forkserver: plain fork hangs inside OpenMP. The 17 s lift-criterion loop test is deselected to
 # keep the run inside an hour on 2 cores (its planner code is covered by the other planner tests).
 set -euo pipefail
@@ -14,7 +15,8 @@ PY=$ROOT/.venv/bin/python
 "$PY" -m pip install -q "mutmut==3.8.1"
 SITE=$("$PY" -c "import bayesgrasp, os; print(os.path.dirname(bayesgrasp.__file__))")
 rm -rf "$W" && mkdir -p "$W/src" "$W/tests"
-cp -r "$SITE" "$W/src/bayesgrasp"
+cp -r "$ROOT/python/bayesgrasp" "$W/src/bayesgrasp"
+cp "$SITE"/_core*.so "$W/src/bayesgrasp/"
 find "$W/src" -name __pycache__ -prune -exec rm -rf {} +
 cp -r "$ROOT/tests/python" "$W/tests/python"
 cat > "$W/pyproject.toml" <<'EOF'

@@ -94,3 +94,25 @@ def test_grasp_hand_pose_old_spelling(capsys, tmp_path):
     assert "--pose is deprecated" in err and "use --hand-pose" in err
     assert main(["grasp", "--object", "cube", "--hand-pose", str(f), "--json"]) == 0
     assert json.loads(capsys.readouterr().out)["joint_angles"] == json.loads(out)["joint_angles"]
+
+
+@pytest.mark.parametrize("command, declared, help_of", [
+    ("plan", "bayesgrasp.planners.registry:PLANNERS", "bayesgrasp.planners.registry:METHOD_HELP"),
+    ("demo", "bayesgrasp.planners.registry:PLANNERS", "bayesgrasp.planners.registry:METHOD_HELP"),
+    ("category", "bayesgrasp.planners.category:METHODS", "bayesgrasp.planners.category:METHOD_HELP")])
+def test_method_choices_and_their_help_come_from_the_planners_declaration(command, declared, help_of):
+    """Each planner family declares its methods and their help once; --method offers exactly those
+    and its help is each method's declared line (a method added to the family reaches the parser)."""
+    import importlib
+
+    def attr(spec):
+        module, name = spec.split(":")
+        return getattr(importlib.import_module(module), name)
+
+    methods, helps = list(attr(declared)), attr(help_of)
+    assert list(helps) == methods                        # every method has its line, none more
+    parser = next(p for n, p, _ in ALL if n == f"bayesgrasp {command}")
+    option = next(a for a in parser._actions if "--method" in a.option_strings)
+    assert list(option.choices) == methods
+    for m in methods:
+        assert f"{m}: {helps[m]}" in option.help

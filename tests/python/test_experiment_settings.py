@@ -61,15 +61,15 @@ def test_the_difference_names_nested_and_missing_keys():
 
 
 def test_result_settings_cover_what_changes_a_result():
-    s = RunContext().result_settings()
+    s = RunContext().result_settings().to_dict()
     assert {"bayesgrasp", "cache_version", "hand", "hand_file_sha256", "success", "lift", "models"} <= set(s)
     assert s == json.loads(json.dumps(s))  # plain JSON
-    other = RunContext(success="epsilon", lift=False).result_settings()
+    other = RunContext(success="epsilon", lift=False).result_settings().to_dict()
     diff = settings_difference(s, other)
     assert any(x.startswith("lift:") for x in diff) and any(x.startswith("success:") for x in diff)
     assert any(x.startswith("models.success:") for x in diff)
     robotiq = RunContext(hand="robotiq_3f").result_settings()
-    assert robotiq["hand_file_sha256"] != s["hand_file_sha256"]
+    assert robotiq.hand_file_sha256 != s["hand_file_sha256"] and robotiq.hand.startswith("Robotiq")
 
 
 def test_the_context_carries_its_loaded_hand_and_still_goes_to_workers():
@@ -106,9 +106,14 @@ def _episode(experiment, obj, run_index, seed):
 def test_attempts_become_rows_with_real_columns(tmp_path):
     store = ResultStore(tmp_path / "results.sqlite")
     run_experiment("e", ["cube", "mug"], 3, _episode, store, progress=False, settings={"lift": True})
-    assert store.flatten() == {"run_rows": 6, "attempts": 12}
+    store.flatten()
     store.close()
     db = sqlite3.connect(str(tmp_path / "results.sqlite"))
+    # one row per run, one per attempt of a run, and no table for anything else
+    assert db.execute("SELECT COUNT(*) FROM run_rows").fetchone()[0] == 6
+    assert db.execute("SELECT COUNT(*) FROM attempts").fetchone()[0] == 12
+    assert {r[0] for r in db.execute("SELECT name FROM sqlite_master WHERE type = 'table'")} \
+        == {"runs", "settings", "run_rows", "attempts"}
     # plain SQL, no JSON functions: the share lifted at the second attempt, per object
     rows = db.execute("SELECT object, AVG(lifted), COUNT(*) FROM attempts WHERE position = 1 GROUP BY object"
                       " ORDER BY object").fetchall()
@@ -191,7 +196,7 @@ def test_config_tables_reach_the_planner_the_episode_and_the_sweep(tmp_path):
     assert ctx.planner_settings().n_particles == 120 and tuple(ctx.planner_settings().half_width) == (0.02, 0.02, 0.5)
     assert ctx.measurement_noise == 0.01
     s = ctx.result_settings()
-    assert s["planner"]["n_particles"] == 120 and s["measurement_noise"] == 0.01
+    assert s.planner.n_particles == 120 and s.to_dict()["measurement_noise"] == 0.01
     # the file's sweep axes, the command line's value list winning for the axis it names
     points = sweep_points(args)
     assert [p for p, _ in points] == [{"planner.pso_iter": 5, "models.n_samples": 350},
@@ -208,11 +213,11 @@ def test_config_tables_reach_the_planner_the_episode_and_the_sweep(tmp_path):
 
 @pytest.mark.parametrize("key, option", [("models.success", "--success"), ("models.family", "--families")])
 def test_a_setting_with_an_option_of_its_own_is_refused_by_set(key, option):
-    from bayesgrasp.cli.args import CliError, parse_set
+    from bayesgrasp.cli.args import CliError, SetOverrides, parse_set
 
     with pytest.raises(CliError, match=f"{key} is set by {option}"):
         parse_set([f"{key}=epsilon"])
-    assert parse_set(["models.n_samples=300"]) == {"models": {"n_samples": 300}}
+    assert parse_set(["models.n_samples=300"]) == SetOverrides(models={"n_samples": 300})
 
 
 @pytest.mark.parametrize("other", ["0.02", "0.01"])
@@ -246,22 +251,23 @@ def test_an_option_the_experiment_does_not_read_is_refused(tmp_path, argv, refus
 
 def test_the_closed_loop_experiments_read_every_run_setting():
     from bayesgrasp.cli import build_parser
-    from bayesgrasp.cli.args import given_settings
+    from bayesgrasp.cli.args import GivenSetting, given_settings
     from bayesgrasp.experiments import get_experiment
 
     args = build_parser().parse_args(["experiment", "pub2", "--families", "top,side", "--success", "epsilon",
                                       "--no-lift", "--set", "planner.n_particles=100",
                                       "--sweep", "episode.measurement_noise=0,0.01", "--set", "models.n_samples=300"])
-    given = given_settings(args)
+    given = {g.setting: g.option for g in given_settings(args)}
+    assert len(given) == len(given_settings(args))      # each setting once
     assert set(given) == {"families", "success", "lift", "planner", "measurement_noise", "models"}
     assert given["lift"] == "--no-lift" and given["planner"] == "--set planner.n_particles"
     for name in ("pub2", "baselines", "pub4"):
         assert set(get_experiment(name).reads) == set(given)
     # options at the context's defaults are not given; a --set is given even at its default value
     at_defaults = build_parser().parse_args(["experiment", "pub5", "--families", "top", "--success", "lift"])
-    assert given_settings(at_defaults) == {}
+    assert given_settings(at_defaults) == ()
     assert given_settings(build_parser().parse_args(["experiment", "pub5", "--set", "planner.n_particles=500"])) \
-        == {"planner": "--set planner.n_particles"}
+        == (GivenSetting("planner", "--set planner.n_particles"),)
     with pytest.raises(ValueError, match="not run-context settings"):
         from bayesgrasp.experiments.registry import Experiment
         Experiment("x", ("cube",), 1, "", None, None, reads=("threads",))

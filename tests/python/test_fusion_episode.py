@@ -68,11 +68,11 @@ def test_the_accounting_of_transitions_by_hand():
            trial([False, False, False, True], [0.0, 0.0, 0.0, 0.1]),   # same, stable in round 3
            trial([False, False, True], [0.0, 0.0, 0.2])]               # same, stable in round 2
     t = transitions(res)
-    assert (t["better"], t["worse"], t["same_both_unstable"]) == (1, 1, 2)
-    assert (t["unstable_to_stable"], t["stable_to_unstable"]) == (1, 1)
-    assert t["still_unstable_after_round_1"] == 2
-    assert (t["became_stable_round_2"], t["became_stable_round_3"]) == (1, 1)
-    assert t["cumulative_success_by_round"] == [1, 2, 3, 4] and t["vision_only_success"] == 1
+    assert (t.better, t.worse, t.same_both_unstable) == (1, 1, 2)
+    assert (t.unstable_to_stable, t.stable_to_unstable) == (1, 1)
+    assert t.still_unstable_after_round_1 == 2
+    assert (t.became_stable_round_2, t.became_stable_round_3) == (1, 1)
+    assert t.cumulative_success_by_round == [1, 2, 3, 4] and t.vision_only_success == 1
 
 
 def small_models_and_grasps(grasps, tmp_path) -> list:

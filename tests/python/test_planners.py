@@ -172,9 +172,9 @@ def test_informative_grasp_shrinks_the_pose_error_and_beats_a_random_grasp(cube)
 
     r = [entropy_gain_run("cube", i, models=cube) for i in range(6)]
     # the pose error of the posterior mean after the informative grasp is below the prior's
-    assert np.mean([x["error_after_informative"] for x in r]) < np.mean([x["error_before"] for x in r])
+    assert np.mean([x.error_after_informative for x in r]) < np.mean([x.error_before for x in r])
     # and its realised posterior entropy is below that of a random grasp from the same belief
-    assert np.mean([x["entropy_informative"] for x in r]) < np.mean([x["entropy_random"] for x in r])
+    assert np.mean([x.entropy_informative for x in r]) < np.mean([x.entropy_random for x in r])
 
 
 def test_lift_criterion_loop_stops_at_a_lifted_grasp_and_learns_from_dropped_ones(cache):

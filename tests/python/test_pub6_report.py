@@ -19,7 +19,7 @@ def test_pub6_writes_csv_tables_and_a_plot(tmp_path):
                        ("c", trial([False, False, False, True], [0.0, 0.0, 0.0, 0.2], False)),
                        ("d", trial([False, False, False, False], [0.0, 0.0, 0.0, 0.0], False))]}
     t = transitions(results["all"])
-    assert (t["unstable_to_stable"], t["stable_to_unstable"], t["cumulative_success_by_round"]) == (1, 1, [1, 2, 2, 3])
+    assert (t.unstable_to_stable, t.stable_to_unstable, t.cumulative_success_by_round) == (1, 1, [1, 2, 2, 3])
     write_report(get_experiment("pub6"), results, tmp_path)
     rows = {r["measure"]: r for r in csv.DictReader(open(tmp_path / "transitions.csv"))}
     assert rows["unstable_to_stable"]["ours"] == "1" and rows["success_after_round_3"]["thesis"] == "78"
@@ -44,8 +44,8 @@ def test_pub5_scales_writes_its_grid_as_a_picture(tmp_path):
 
     results = {name: [(f"{name}-{i}", run(f"mug/{i}", {"laplace"} if k % 2 else {"baseline", "gaussian"}))
                       for i in range(2)] for k, name in enumerate(GRID)}
-    summary = scales_report(get_experiment("pub5_scales"), results, tmp_path)
+    written = scales_report(get_experiment("pub5_scales"), results, tmp_path)
     png = tmp_path / "scales.png"
     assert png.stat().st_size > 5000 and "scales.png" in (tmp_path / "summary.md").read_text()
     assert np.asarray(Image.open(png)).std() > 10                           # drawn, not blank
-    assert {r["laplace"] for r in summary["grid"]} == {0.0, 1.0}
+    assert written.out == tmp_path and {r["laplace"] for r in written.summary["grid"]} == {0.0, 1.0}

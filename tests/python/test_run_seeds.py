@@ -10,6 +10,7 @@ import pytest
 
 from bayesgrasp.experiments import driver, pose_uncertainty, tactile_fusion
 from bayesgrasp.experiments.registry import EXPERIMENTS, Experiment, get_experiment
+from bayesgrasp.experiments.report import Report
 from bayesgrasp.experiments.runner import run_seed
 from bayesgrasp.loop.context import RUN_SEEDS, RunContext
 
@@ -23,7 +24,7 @@ def _toy(exp, method, ctx):
 
 
 def _report(exp, results, out):
-    return {m: [(k.seed, r["seed"]) for k, r in rs] for m, rs in results.items()}
+    return Report(out, {m: [(k.seed, r["seed"]) for k, r in rs] for m, rs in results.items()})
 
 
 @pytest.fixture
@@ -38,7 +39,7 @@ def test_each_stored_seed_is_the_one_the_run_was_given_and_shared_by_the_seed_na
     a = driver.run("toy_a", tmp_path / "a", ctx)
     b = driver.run("toy_b", tmp_path / "b", ctx)
     want = sorted(run_seed(11, "toy", o, i) for o in ("cube", "mug") for i in range(2))
-    for summary in (a, b):
+    for summary in (a.summary, b.summary):
         for method in ("m1", "m2"):
             assert all(stored == used for stored, used in summary[method])
             assert sorted(s for s, _ in summary[method]) == want   # every method and both experiments
@@ -80,9 +81,8 @@ def test_a_fusion_run_uses_its_seed_for_the_view_and_the_trial(monkeypatch):
         def run(self, mode, rounds=None):
             return Rounds()
 
-    class Rounds:       # a FusionResult's serialised shape, no rounds run
-        def to_dict(self):
-            return {"rounds": [{}]}
+    class Rounds:       # a FusionResult with no round run
+        rounds = [None]
 
     monkeypatch.setattr(tactile_fusion, "FusionTrial", Trial)
     tactile_fusion.fusion_run("pub6/all", "mug/1", 0, 2**40 + 7, ctx=RunContext(), mode="vision", belief="map")

@@ -152,8 +152,12 @@ def test_bad_input(cube):
 
 def test_pub1_runs_and_reports_without_the_loop(tmp_path, monkeypatch):
     # three runs of each optimiser on the cube, the second grasp replaced (it needs grasp models)
-    monkeypatch.setattr(S, "_second_grasp", lambda obj, planner, truth, ctx: {
-        "initial": {"success": False}, "updated": {"success": True}})
+    from bayesgrasp.experiments.run_records import PlannedGrasp, SecondGrasp
+
+    def second_grasp(obj, planner, truth, ctx):
+        return SecondGrasp(PlannedGrasp(np.zeros(3), False, 0.0, False), PlannedGrasp(np.zeros(3), True, 0.1, True))
+
+    monkeypatch.setattr(S, "_second_grasp", second_grasp)
     monkeypatch.setattr(S, "BUDGET", 200)
     exp = get_experiment("pub1")
     from bayesgrasp.experiments import RunContext
@@ -162,11 +166,12 @@ def test_pub1_runs_and_reports_without_the_loop(tmp_path, monkeypatch):
     for opt in exp.methods:
         series, fn = exp.make_run(exp, opt, ctx)
         seeds = [run_seed(0, exp.seeds, "cube", i) for i in range(3)]
-        results[opt] = [(RunKey(series, "cube", i, s), fn(series, "cube", i, s)) for i, s in enumerate(seeds)]
+        results[opt] = [(RunKey(series, "cube", i, s), fn(series, "cube", i, s).to_dict())
+                        for i, s in enumerate(seeds)]
     # every optimiser saw the same problems
     truths = {opt: [r["cases"]["pose"]["truth"] for _, r in res] for opt, res in results.items()}
     assert all(t == truths["pso"] for t in truths.values())
-    summary = exp.report(exp, results, tmp_path)
+    summary = exp.report(exp, results, tmp_path).summary
     for case in S.CASES:
         assert (tmp_path / f"errors_{case}.png").exists()
         assert {r["optimizer"] for r in summary[case]} == set(S.OPTIMIZERS)

@@ -5,12 +5,12 @@
 #define PCL_NO_PRECOMPILE
 #include "bayesgrasp/vision/segmentation.hpp"
 
-#include <pcl/ModelCoefficients.h>
 #include <pcl/point_cloud.h>
 #include <pcl/point_types.h>
+#include <pcl/sample_consensus/ransac.h>
+#include <pcl/sample_consensus/sac_model_plane.h>
 #include <pcl/search/kdtree.h>
 #include <pcl/segmentation/extract_clusters.h>
-#include <pcl/segmentation/sac_segmentation.h>
 
 #include <algorithm>
 #include <cmath>
@@ -47,24 +47,32 @@ SegmentationResult segment_table(const Points& cloud, const SegmentationOptions&
   c->height = 1;
   if (c->size() < 3) throw std::invalid_argument("cloud: has fewer than 3 finite points");
 
-  pcl::SACSegmentation<pcl::PointXYZ> seg;
-  seg.setOptimizeCoefficients(true);
-  seg.setModelType(pcl::SACMODEL_PLANE);
-  seg.setMethodType(pcl::SAC_RANSAC);
-  seg.setDistanceThreshold(P.plane_threshold);
-  seg.setMaxIterations(P.plane_iterations);
-  seg.setInputCloud(c);
-  pcl::PointIndices inl;
-  pcl::ModelCoefficients coef;
-  seg.segment(inl, coef);
-  if (inl.indices.empty() || coef.values.size() != 4) throw std::invalid_argument("cloud: no plane found");
+  // The plane by RANSAC on the plane model alone (pcl::SACSegmentation would instantiate every
+  // sample-consensus model under PCL_NO_PRECOMPILE: the longest compile of the build). The same
+  // steps as SACSegmentation::segment with SACMODEL_PLANE, SAC_RANSAC and optimised coefficients:
+  // RANSAC (probability 0.99, fixed sampling seed), a least-squares refit on its inliers, the
+  // inliers re-selected within the threshold of the refitted plane.
+  pcl::SampleConsensusModelPlane<pcl::PointXYZ>::Ptr model(
+      new pcl::SampleConsensusModelPlane<pcl::PointXYZ>(c, /*random=*/false));
+  pcl::RandomSampleConsensus<pcl::PointXYZ> ransac(model, P.plane_threshold);
+  ransac.setProbability(0.99);
+  ransac.setMaxIterations(P.plane_iterations);
+  pcl::Indices inliers;
+  Eigen::VectorXf coarse(4), refined(4);
+  if (ransac.computeModel(0)) {
+    ransac.getInliers(inliers);
+    ransac.getModelCoefficients(coarse);
+    model->optimizeModelCoefficients(inliers, coarse, refined);
+    model->selectWithinDistance(refined, P.plane_threshold, inliers);
+  }
+  if (inliers.empty()) throw std::invalid_argument("cloud: no plane found");
 
   SegmentationResult out;
-  Eigen::Vector4d pl(coef.values[0], coef.values[1], coef.values[2], coef.values[3]);
+  Eigen::Vector4d pl = refined.cast<double>();
   pl /= pl.head<3>().norm();
   if (pl.head<3>().dot(P.up) < 0) pl = -pl;
   out.plane = pl;
-  for (auto i : inl.indices) out.plane_inliers.push_back(rows[i]);
+  for (auto i : inliers) out.plane_inliers.push_back(rows[i]);
 
   pcl::PointCloud<pcl::PointXYZ>::Ptr above(new pcl::PointCloud<pcl::PointXYZ>);
   std::vector<int> above_rows;

@@ -5,8 +5,9 @@ from __future__ import annotations
 import argparse
 import math
 import re
+from dataclasses import dataclass, field
 from pathlib import Path
-from typing import List, Optional, Sequence
+from typing import List, Optional, Sequence, Tuple
 
 from .. import DEFAULT_HAND
 
@@ -226,29 +227,38 @@ CONTEXT_OPTIONS = {"lift": "--no-lift", "success": "--success", "families": "--f
 GROUP_SETTING = {"models": "models", "planner": "planner", "episode": "measurement_noise"}
 
 
-def given_settings(args: argparse.Namespace) -> dict:
-    """The run-context settings the command line gives: {setting: the option that gives it} for an
-    option set to another value than the context's default, and for any --set or --sweep of a
-    setting's group (given is given, even at the default value)."""
+@dataclass(frozen=True)
+class GivenSetting:
+    """A run-context setting the command line gives, and the option that gives it (e.g.
+    ``planner``, ``--set planner.n_particles``)."""
+
+    setting: str
+    option: str
+
+
+def given_settings(args: argparse.Namespace) -> Tuple[GivenSetting, ...]:
+    """The run-context settings the command line gives, each once with the first option that
+    gives it: an option set to another value than the context's default, and any --set or --sweep
+    of a setting's group (given is given, even at the default value)."""
     from ..loop.context import RunContext
 
-    values = {"success": getattr(args, "success", RunContext.success), "lift": not getattr(args, "no_lift", False),
-              "families": families_arg(getattr(args, "families", ",".join(RunContext.families)))}
-    given = {s: CONTEXT_OPTIONS[s] for s, v in values.items() if v != getattr(RunContext, s)}
+    values = (("success", getattr(args, "success", RunContext.success)), ("lift", not getattr(args, "no_lift", False)),
+              ("families", families_arg(getattr(args, "families", ",".join(RunContext.families)))))
+    given = [GivenSetting(s, CONTEXT_OPTIONS[s]) for s, v in values if v != getattr(RunContext, s)]
     for option, assignments in (("--set", getattr(args, "set", [])), ("--sweep", getattr(args, "sweep", []))):
         for a in assignments:
             group = a.partition("=")[0].partition(".")[0]
-            if group in GROUP_SETTING:
-                given.setdefault(GROUP_SETTING[group], f"{option} {a.partition('=')[0]}")
-    return given
+            if group in GROUP_SETTING and all(g.setting != GROUP_SETTING[group] for g in given):
+                given.append(GivenSetting(GROUP_SETTING[group], f"{option} {a.partition('=')[0]}"))
+    return tuple(given)
 
 
 def refuse_unread(args: argparse.Namespace, reads, what: str) -> None:
     """A run setting that ``what`` does not read (not in ``reads``) is refused, not silently dropped."""
-    unread = {s: o for s, o in given_settings(args).items() if s not in reads}
+    unread = [g for g in given_settings(args) if g.setting not in reads]
     if unread:
-        raise CliError(f"{', '.join(unread.values())}: {what} does not read {', '.join(unread)} (of the run "
-                       f"settings it reads: {', '.join(reads) or 'none'})")
+        raise CliError(f"{', '.join(g.option for g in unread)}: {what} does not read "
+                       f"{', '.join(g.setting for g in unread)} (of the run settings it reads: {', '.join(reads) or 'none'})")
 
 
 def context(args: argparse.Namespace, progress: bool = True, reads: Optional[Sequence[str]] = None):
@@ -270,8 +280,8 @@ def context(args: argparse.Namespace, progress: bool = True, reads: Optional[Seq
                           planner=planner_settings(getattr(args, "set", [])),
                           measurement_noise=measurement_noise(getattr(args, "set", [])))
     except ValueError as e:
-        field, _, why = str(e).partition(": ")
-        raise CliError(f"{CONTEXT_OPTIONS.get(field, '--' + field)}: {why}") from None
+        which, _, why = str(e).partition(": ")
+        raise CliError(f"{CONTEXT_OPTIONS.get(which, '--' + which)}: {why}") from None
 
 
 def families_arg(text):
@@ -288,12 +298,27 @@ def families_arg(text):
 SET_BY_OPTION = {"models.success": "--success", "models.family": "--families"}
 
 
-def _set_classes():
+#: The groups --set reaches, each a settings class: models (ModelSettings), planner
+#: (PlannerSettings), episode (EpisodeOverrides).
+SET_GROUPS = ("models", "planner", "episode")
+
+
+def _set_class(group: str):
+    """The settings class of a --set group (None for another name)."""
     from ..loop.context import EpisodeOverrides
     from ..models import ModelSettings
     from ..planners import PlannerSettings
 
-    return {"models": ModelSettings, "planner": PlannerSettings, "episode": EpisodeOverrides}
+    return {"models": ModelSettings, "planner": PlannerSettings, "episode": EpisodeOverrides}.get(group)
+
+
+@dataclass(frozen=True)
+class SetOverrides:
+    """The --set overrides read, per group: {field: value} (each value its field's type)."""
+
+    models: dict = field(default_factory=dict)
+    planner: dict = field(default_factory=dict)
+    episode: dict = field(default_factory=dict)
 
 
 def _read_value(default, text: str, name: str):
@@ -312,28 +337,27 @@ def _read_value(default, text: str, name: str):
     return text
 
 
-def parse_set(assignments) -> dict:
-    """``GROUP.FIELD=VALUE`` overrides (--set) as {group: {field: value}}, each value read as its
-    field's type; a CliError names a wrong group, field or value."""
+def parse_set(assignments) -> SetOverrides:
+    """``GROUP.FIELD=VALUE`` overrides (--set), each value read as its field's type; a CliError
+    names a wrong group, field or value."""
     import dataclasses
 
-    classes = _set_classes()
-    out: dict = {}
+    out = SetOverrides()
     for a in assignments:
         key, sep, text = a.partition("=")
         group, _, name = key.partition(".")
-        cls = classes.get(group)
+        cls = _set_class(group)
         fields = {f.name for f in dataclasses.fields(cls)} if cls else set()
         if not sep or name not in fields:
-            known = "; ".join(f"{g}: {', '.join(sorted(f.name for f in dataclasses.fields(c)))}"
-                              for g, c in classes.items())
+            known = "; ".join(f"{g}: {', '.join(sorted(f.name for f in dataclasses.fields(_set_class(g))))}"
+                              for g in SET_GROUPS)
             raise CliError(f"--set: expected models.FIELD=VALUE, planner.FIELD=VALUE or episode.FIELD=VALUE with "
                            f"FIELD one of ({known}); got {a!r}")
         if key in SET_BY_OPTION:
             raise CliError(f"--set: {key} is set by {SET_BY_OPTION[key]}; give it there")
         default = getattr(cls(), name)
         try:
-            out.setdefault(group, {})[name] = _read_value(default, text, name)
+            getattr(out, group)[name] = _read_value(default, text, name)
         except (ValueError, KeyError):
             raise CliError(f"--set: {key}: cannot read {text!r} as {type(default).__name__}") from None
     return out
@@ -343,7 +367,7 @@ def model_settings(assignments, success: str):
     """ModelSettings from the ``models.FIELD=VALUE`` overrides (None when there are none)."""
     from ..models import ModelSettings
 
-    values = parse_set(assignments).get("models")
+    values = parse_set(assignments).models
     if not values:
         return None
     try:
@@ -356,7 +380,7 @@ def planner_settings(assignments):
     """PlannerSettings from the ``planner.FIELD=VALUE`` overrides (None when there are none)."""
     from ..planners import PlannerSettings
 
-    values = parse_set(assignments).get("planner")
+    values = parse_set(assignments).planner
     if not values:
         return None
     try:
@@ -367,7 +391,7 @@ def planner_settings(assignments):
 
 def measurement_noise(assignments) -> float:
     """episode.measurement_noise from the overrides (0 when not given)."""
-    return float(parse_set(assignments).get("episode", {}).get("measurement_noise", 0.0))
+    return float(parse_set(assignments).episode.get("measurement_noise", 0.0))
 
 
 FORMATS = ("text", "json", "ros")

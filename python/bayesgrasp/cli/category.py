@@ -10,7 +10,8 @@ import json
 
 import numpy as np
 
-from ..planners.category import METHODS
+from ..planners.category import METHOD_HELP, METHODS
+from ..planners.registry import methods_help
 from . import camera_input
 from .args import (CliError, Renamed, add_category_options, add_context_options, add_robot_options, context, floats,
                    output_file, output_format, robot_arm, task_grasps_arg)
@@ -26,9 +27,7 @@ def add(sub) -> None:
                         "simulated stand-in the grasp is executed on (at --object-pose, in the table frame)")
     c.add_argument("--object-pose", "--pose", dest="object_pose", action=Renamed, old=["--pose"], default="0,0,0",
                    metavar="X,Y,YAW", help="its pose on the table (--pose: the old spelling, deprecated)")
-    c.add_argument("--method", default="laplace", choices=list(METHODS),
-                   help="Eq. 4.1's density, the best-single-grasp baseline, or part-aware (Eq. 4.1's candidates "
-                        "closed on every registered model and re-ranked by where the fingers land)")
+    c.add_argument("--method", default="laplace", choices=list(METHODS), help=methods_help(METHODS, METHOD_HELP))
     c.add_argument("--complete", action="store_true", help="use the object's whole surface as the cloud")
     add_category_options(c, "the cloud, the registered models and the hand")
     add_context_options(c)

@@ -114,7 +114,7 @@ def sweep_points(args) -> list:
         values = []
         for t in text.split(","):
             try:
-                v = parse_set([f"{key}={t}"])[group][field]
+                v = getattr(parse_set([f"{key}={t}"]), group)[field]
             except CliError as e:
                 raise CliError(str(e).replace("--set", "--sweep", 1)) from None
             if isinstance(v, tuple):

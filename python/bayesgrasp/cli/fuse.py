@@ -45,7 +45,7 @@ def add(sub) -> None:
 
 
 def run(args) -> int:
-    from ..io.results import fuse_document, fuse_rounds
+    from ..io.results import fuse_document, fuse_rounds, round_grasp
     from ..loop.fusion_trial import FusionTrial
     from ..planners.fusion import FusionSettings
 
@@ -70,7 +70,7 @@ def run(args) -> int:
         trial.reach = _top_reach(arm, ctx.hand_model, trial.episode.observation.cloud)
     r = trial.run(args.start, rounds=args.rounds, on_round=None if fmt != "text" else _print_round(trial.names),
                   stop_at_lift=True)
-    grasps = [x.grasp(ctx.hand_model, trial.spread) for x in r.rounds]
+    grasps = [round_grasp(x, ctx.hand_model, trial.spread) for x in r.rounds]
     if arm is not None:
         _arm_checks(arm, grasps, trial)
     rounds = fuse_rounds(r, grasps)

@@ -19,13 +19,16 @@ from __future__ import annotations
 import json
 from dataclasses import dataclass
 from pathlib import Path
-from typing import List, Optional
+from typing import TYPE_CHECKING, List, Optional, Tuple
 
 import numpy as np
 
 from ..io.results import mass_source
 from .args import (CliError, Renamed, add_format_options, add_hand_option, add_object_options, add_robot_options,
                    add_view_option, floats, object_arg, output_file, output_format, robot_arm)
+
+if TYPE_CHECKING:
+    from ..lift_trace import LiftTrace
 
 
 def add(sub) -> None:
@@ -99,7 +102,10 @@ def run(args) -> int:
     if arm is not None:
         out["grasp"]["arm"] = _arm_check(arm, world, grasp, out["grasp"]["pregrasp"]["distance"])
     if args.lift_trace:
-        out["lift_trace"] = _lift_trace(world, args, grasp)
+        from ..io.view_fields import lift_trace_json
+
+        trace, lifted = _lift_trace(world, args, grasp)
+        out["lift_trace"] = lift_trace_json(trace, grasp.hand_pose, lifted)
     fmt = output_format(args)
     if fmt == "ros":
         print(json.dumps(to_ros(out["grasp"], grasp_id=f"{args.object}-{request.mode}", quality=grasp.epsilon)))
@@ -133,18 +139,15 @@ def _arm_check(arm, world, g, pregrasp_distance: float) -> dict:
     return arm_record(arm, r, 0)
 
 
-def _lift_trace(world, args, g) -> dict:
+def _lift_trace(world, args, g) -> Tuple["LiftTrace", bool]:
     """The lift test run again with its trace recorded (same hand pose, joints and physics, so the
-    same verdict as the grasp's), as the object's path in the hand."""
-    from ..io.view_fields import lift_trace_json
+    same verdict as the grasp's): (its trace, lifted)."""
     from ..lift_trace import LiftTrace
 
     if args.no_lift:
         raise CliError("--lift-trace: not with --no-lift")
     r = world.lift_tester().run(np.asarray(g.hand_pose), np.asarray(g.joint_angles), trace_every=10)
-    doc = lift_trace_json(LiftTrace.from_core(r.trace), g.hand_pose)
-    doc["lifted"] = bool(r.lifted) and not g.collision_at_start
-    return doc
+    return LiftTrace.from_core(r.trace), bool(r.lifted) and not g.collision_at_start
 
 
 def _request(args) -> GraspRequest:

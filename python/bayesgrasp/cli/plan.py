@@ -8,16 +8,14 @@ from pathlib import Path
 import numpy as np
 
 from ..loop.episode import EpisodeSettings
-from ..planners.registry import PLANNERS
+from ..planners.registry import PLANNERS, methods_help
 from . import camera_input
 from .args import (CliError, add_context_options, add_families_option, add_format_options, add_object_options,
                    add_robot_options, add_view_option, bounded_int, context, floats, object_arg, out_dir, output_file,
                    output_format, parse_set, robot_arm)
 
 METHODS = list(PLANNERS)
-METHOD_HELP = ("stability: the most stable grasp (Eq. 3.1); explore: informative grasps while none is likely to hold "
-               "(Eq. 3.2); ml_pose: the most stable grasp at the most likely pose; open_loop: the most stable grasp "
-               "at the estimate, no update")
+METHOD_HELP = methods_help(METHODS)
 
 
 def add(sub) -> None:
@@ -82,10 +80,10 @@ def _loop(args, ctx, pose, attempts: int = EpisodeSettings.attempts, estimate=No
 
     if attempts < 1:
         raise CliError(f"--attempts: must be at least 1, got {attempts}")
-    if noise and "measurement_noise" in parse_set(getattr(args, "set", [])).get("episode", {}):
+    if noise and "measurement_noise" in parse_set(getattr(args, "set", [])).episode:
         raise CliError("--noise and --set episode.measurement_noise: two names for one setting; give one")
     obj = args.object if obj is None else obj
-    World.single(obj, pose=pose, hand=ctx.hand)  # a clear error for an unknown object or a pose off the table
+    World.single(obj, pose=pose, hand=ctx.hand_model)  # a clear error for an unknown object or a pose off the table
     models = ctx.family_models(obj)
     ctx = replace(ctx, planner=started(ctx.planner_settings(), start), measurement_noise=noise or ctx.measurement_noise)
     episode = EpisodeSettings(method=args.method, attempts=attempts)
@@ -213,12 +211,23 @@ def plan(args) -> int:
         _belief_png(r, png)
     if fmt == "ros":
         from ..io.grasp_schema import to_ros
+        from ..io.results import attempt_grasp
 
-        print(json.dumps({"attempts": [to_ros(a.grasp, grasp_id=f"attempt-{a.number}", quality=a.plan.predicted_stability)
-                                       for a in r.attempts]}))
-    elif fmt == "json":
-        print(json.dumps(_plan_doc(args, ctx, r, start, view, arms)))
-    else:
+        grasps = [attempt_grasp(a) for a in r.attempts]
+        for g, rec in zip(grasps, arms or []):      # with --robot: each grasp in the arm's terms
+            g["arm"] = rec
+        print(json.dumps({"attempts": [to_ros(g, grasp_id=f"attempt-{a.number}", quality=a.plan.predicted_stability)
+                                       for a, g in zip(r.attempts, grasps)]}))
+    if fmt == "json" or args.view is not None:   # plan's JSON, with the vision start when there is one
+        from ..io.results import plan_document, vision_dict
+
+        vision = None if start is None else vision_dict(start, args.cloud or args.depth, view.object_points)
+        doc = plan_document(r, args.object, args.units, ctx.success, vision=vision)
+        for a, rec in zip(doc["attempts"], arms or []):   # with --robot: each attempt's grasp in the arm's terms
+            a["grasp"]["arm"] = rec
+    if fmt == "json":
+        print(json.dumps(doc))
+    elif fmt == "text":
         print(f"{'success' if r.success else 'no successful grasp'} after {len(r.attempts)} attempt(s)")
         if arms is not None:
             k = sum(a["reachable"] for a in arms)
@@ -227,7 +236,7 @@ def plan(args) -> int:
     if args.view is not None:
         from .view import show_result
 
-        show_result(args, _plan_doc(args, ctx, r, start, view, arms))
+        show_result(args, doc)
     return 0
 
 
@@ -246,19 +255,6 @@ def _arm_records(arm, obj, pose, r, hand) -> list:
     return [arm_record(arm, res, i) for i in range(len(P))]
 
 
-def _plan_doc(args, ctx, r, start, view, arms=None) -> dict:
-    """plan's JSON, with the vision start (and its cloud) when the belief came from camera data, and
-    each attempt's grasp in the arm's terms with --robot."""
-    from ..io.results import plan_document, vision_dict
-
-    doc = plan_document(r, args.object, args.units, ctx.success)
-    if start is not None:
-        doc["vision"] = vision_dict(start, args.cloud or args.depth, view.object_points)
-    for a, rec in zip(doc["attempts"], arms or []):
-        a["grasp"]["arm"] = rec
-    return doc
-
-
 def started(settings, start):
     """The planner settings with the vision start's belief spread (``start`` None: as they are)."""
     return settings if start is None else settings.with_(half_width=tuple(start.half_width.tolist()))
@@ -272,7 +268,7 @@ def _vision_start(args, obj, estimate, quiet: bool, seed: int):
         return None, None
     if estimate is not None:
         raise CliError("--estimate: not with --cloud or --depth (the estimate comes from registering to them)")
-    if "half_width" in parse_set(getattr(args, "set", [])).get("planner", {}):
+    if "half_width" in parse_set(getattr(args, "set", [])).planner:
         raise CliError("--set planner.half_width: not with --cloud or --depth (the belief's spread comes from "
                        "registering to them)")
     from ..loop.vision_start import vision_start

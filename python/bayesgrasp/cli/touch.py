@@ -48,7 +48,7 @@ def _case(args) -> str:
 
 
 def run(args) -> int:
-    from ..io.results import touch_document
+    from ..io.results import touch_document, touch_grasp
     from ..loop.touch_trial import touch_once
     from ..planners import touch as T
 
@@ -64,7 +64,7 @@ def run(args) -> int:
     given = {k: getattr(args, k) for k in ("optimizer", "budget", "contact_term") if getattr(args, k) is not None}
     settings = T.TouchSettings(unknowns=case, seed=ctx.seed, spread=args.spread, threads=0, **given)
     obj = object_arg(args)                          # in --units, read once
-    trial = touch_once(T.TouchPlanner(obj, guess, settings, hand=ctx.hand), obj, truth)
+    trial = touch_once(T.TouchPlanner(obj, guess, settings, hand=ctx.hand_model), obj, truth)
     out = touch_document(trial, args.object, args.units, case)
     landscape = _landscape(trial, png, args) if png else None
     if landscape is not None:
@@ -73,7 +73,7 @@ def run(args) -> int:
     if fmt == "ros":
         from ..io.grasp_schema import to_ros
 
-        print(json.dumps(to_ros(trial.grasp, grasp_id=f"{args.object}-touch")))
+        print(json.dumps(to_ros(touch_grasp(trial), grasp_id=f"{args.object}-touch")))
     elif fmt == "json":
         print(json.dumps(out))
     else:

@@ -24,6 +24,7 @@ from . import report
 from .category_plots import plot_success
 from .category_stats import orderings, outcome_rows
 from .registry import Experiment, register
+from .run_records import CategoryRun
 
 #: The tasks of each held-out category.
 TASKS = {"mug": ("top", "side", "handle"), "bottle": ("side",), "knife": ("handle",)}
@@ -40,16 +41,16 @@ def view(seed: int):
     return pose, eye
 
 
-def category_run(experiment: str, obj: str, run_index: int, seed: int, *, ctx: RunContext, complete: bool) -> dict:
+def category_run(experiment: str, obj: str, run_index: int, seed: int, *, ctx: RunContext,
+                 complete: bool) -> CategoryRun:
+    """One view of the held-out ``obj`` and every method (Eq. 4.1's densities, the baseline) planned
+    and executed for each of its category's tasks."""
     cat = obj.split("/")[0]
     pose, eye = view(seed)
     ep = see(obj, pose, cat, exclude=(obj,), eye_offset=eye, seed=seed % (2**31), complete=complete)
-    tasks = {t: {m: plan_and_execute(ep, cat, t, m, ctx, seed=seed % (2**31)).to_dict() for m in METHODS}
+    tasks = {t: {m: plan_and_execute(ep, cat, t, m, ctx, seed=seed % (2**31)) for m in METHODS}
              for t in TASKS[cat]}
-    return {"object": obj, "category": cat, "pose": list(pose), "eye_offset": list(eye), "complete": complete,
-            "cloud_points": int(len(ep.observation.cloud)),
-            "registrations": [{"model": r.model, "phi": r.phi, "success": r.success} for r in ep.registrations],
-            "tasks": tasks}
+    return CategoryRun(obj, cat, pose, eye, complete, int(len(ep.observation.cloud)), tuple(ep.registrations), tasks)
 
 
 def prepare_task_grasps(exp: Experiment, objects: List[str], ctx: RunContext) -> None:
@@ -72,7 +73,7 @@ COLS = ("category", "task", "method", "runs", "success", "ci_low", "ci_high", "l
         "epsilon") + FAILURES
 
 
-def write_report(exp: Experiment, results: Dict[str, list], out: Path) -> dict:
+def write_report(exp: Experiment, results: Dict[str, list], out: Path) -> report.Report:
     out, md, summary = report.start(exp.name, out)
     rows = outcome_rows(results["all"])
     report.write_csv(rows, out / "outcomes.csv")

@@ -24,6 +24,7 @@ from .category_grasping import TASKS, prepare_task_grasps, view
 from .category_plots import plot_scale_grid
 from .category_stats import grid_rows, nested_rows
 from .registry import Experiment, register
+from .run_records import ScalesRun
 
 MUGS = tuple(f"mug/{i}" for i in range(7))
 TRANSLATION_CM = (0.5, 1.0, 2.0)
@@ -39,23 +40,23 @@ def series_name(t_cm: float, r_deg: float) -> str:
 GRID = {series_name(t, r): (t / 100.0, float(np.radians(r))) for t in TRANSLATION_CM for r in ROTATION_DEG}
 
 
-def scales_run(experiment: str, obj: str, run_index: int, seed: int, *, ctx: RunContext, scales: tuple) -> dict:
+def scales_run(experiment: str, obj: str, run_index: int, seed: int, *, ctx: RunContext, scales: tuple) -> ScalesRun:
     """One view of ``obj`` (the same for every grid point) and the four methods at ``scales``."""
     cat = obj.split("/")[0]
     pose, eye = view(seed)
     ep = see(obj, pose, cat, exclude=(obj,), eye_offset=eye, seed=seed % (2**31))
     t, r = scales
     tasks = {task: {m: plan_and_execute(ep, cat, task, m, ctx, seed=seed % (2**31),
-                                        settings=CategorySettings(method=m, translation_scale=t, rotation_scale=r)).to_dict()
+                                        settings=CategorySettings(method=m, translation_scale=t, rotation_scale=r))
                     for m in DENSITIES} for task in TASKS[cat]}
-    return {"object": obj, "category": cat, "pose": list(pose), "scales": [t, r], "tasks": tasks}
+    return ScalesRun(obj, cat, pose, (t, r), tasks)
 
 
 def _make(exp: Experiment, method: str, ctx: RunContext):
     return method, partial(scales_run, ctx=ctx, scales=GRID[method])
 
 
-def write_report(exp: Experiment, results: Dict[str, list], out: Path) -> dict:
+def write_report(exp: Experiment, results: Dict[str, list], out: Path) -> report.Report:
     out, md, summary = report.start(exp.name, out)
     grid, nested = grid_rows(results, GRID, DENSITIES), nested_rows(results, MUGS, GRID, OURS)
     report.write_csv(grid, out / "grid.csv")

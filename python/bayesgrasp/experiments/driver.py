@@ -11,6 +11,7 @@ from typing import Dict, Optional, Sequence
 from ..loop.context import RunContext
 from .engines import LocalEngine
 from .registry import get_experiment
+from .report import Report
 from .runner import ResultStore, Series, run_all
 
 
@@ -40,10 +41,10 @@ def prepare(exp, objects: Sequence[str], ctx: RunContext, engine) -> None:
 
 
 def run(name: str, out_dir, ctx: Optional[RunContext] = None, runs: Optional[int] = None, workers: int = 1,
-        objects: Optional[Sequence[str]] = None, engine=None) -> dict:
+        objects: Optional[Sequence[str]] = None, engine=None) -> Report:
     """Runs (or resumes) experiment ``name`` into ``out_dir`` and writes its tables and plots.
-    ``engine``: where the runs go (default: ``workers`` local processes; not both). Returns the summary
-    dict (also written as summary.json). Progress (model building, the progress bar) is shown
+    ``engine``: where the runs go (default: ``workers`` local processes; not both). Returns the report's
+    :class:`~.report.Report` (where it was written, and summary.json's content). Progress (model building, the progress bar) is shown
     when ``ctx.progress`` is set."""
     exp = get_experiment(name)
     ctx = ctx or RunContext()
@@ -59,7 +60,7 @@ def run(name: str, out_dir, ctx: Optional[RunContext] = None, runs: Optional[int
     out = Path(out_dir)
     worker_ctx = ctx.for_workers()
     runs_of = {method: exp.make_run(exp, method, worker_ctx) for method in exp.methods}  # (series, fn)
-    settings = ctx.result_settings()
+    settings = ctx.result_settings().to_dict()
     store = ResultStore(out / "results.sqlite")
     try:
         # Refuse a resume under other settings before building anything.
@@ -72,7 +73,7 @@ def run(name: str, out_dir, ctx: Optional[RunContext] = None, runs: Optional[int
         store.flatten()
     finally:
         store.close()
-    summary = exp.report(exp, results, out)
+    written = exp.report(exp, results, out)
     if exp.finish is not None:
         exp.finish(exp, objects, ctx, out)
-    return summary
+    return written

@@ -49,8 +49,8 @@ def _table(db: sqlite3.Connection, name: str, keys: List[str], columns: List[str
         db.executemany(f'INSERT INTO "{name}" VALUES ({marks})', rows)
 
 
-def flatten(db: sqlite3.Connection) -> Dict[str, int]:
-    """Rebuilds ``run_rows`` and the per-record tables from ``runs``; returns rows per table."""
+def flatten(db: sqlite3.Connection) -> None:
+    """Rebuilds ``run_rows`` and the per-record tables from ``runs``."""
     runs = db.execute("SELECT experiment, object, run_index, seed, result FROM runs"
                       " ORDER BY experiment, object, run_index").fetchall()
     scalars: Dict[str, None] = {}
@@ -76,7 +76,6 @@ def flatten(db: sqlite3.Connection) -> Dict[str, int]:
         named = {_name(k): v for k, v in r.items()}
         rows.append(key + tuple(_cell(named.get(c)) for c in scalar_cols))
     _table(db, "run_rows", list(KEY_COLUMNS), scalar_cols, rows)
-    counts = {"run_rows": len(rows)}
     for t, cols in records.items():
         cols = [c for c in cols if c not in RESERVED]
         trows = []
@@ -87,6 +86,4 @@ def flatten(db: sqlite3.Connection) -> Dict[str, int]:
                         named = {_name(f): x for f, x in rec.items()}
                         trows.append(key + (i,) + tuple(_cell(named.get(c)) for c in cols))
         _table(db, t, list(KEY_COLUMNS) + ["position"], cols, trows)
-        counts[t] = len(trows)
     db.commit()
-    return counts

@@ -1,7 +1,7 @@
 """The thesis's experiments on known objects under pose uncertainty (§3.2-3.3, Pub. II-IV).
 
 Each experiment is a set of runs; each run is a pure function of (experiment, object, run
-index, seed) that returns a JSON-ready dict, stored as soon as it finishes
+index, seed) that returns a typed record (:mod:`.run_records`), stored as JSON as soon as it finishes
 (:mod:`bayesgrasp.experiments.runner`); :mod:`.report` writes the tables (Markdown and CSV) and
 the plots. The experiments registered here:
 
@@ -27,7 +27,6 @@ from pathlib import Path
 from typing import List, Optional
 
 import numpy as np
-from scipy import stats
 
 from ..belief import relative_planar_pose, weight_entropy
 from ..loop.context import RunContext
@@ -39,6 +38,7 @@ from ..world import World
 from .pose_uncertainty_plots import plot_belief_evolution
 from .pose_uncertainty_report import write_entropy_order, write_episodes, write_landscapes
 from .registry import Experiment, register
+from .run_records import PICKS, EntropyGain, EntropyOrderRun, EntropyPick, LandscapesRun, OneDof
 from .runner import run_seed
 
 FIVE = ("cube", "cylinder", "mug", "mug2", "pitcher")
@@ -73,27 +73,20 @@ def _initial_planner(obj: str, ctx: RunContext, seed: int, models=None, settings
 
 
 def entropy_order_run(experiment: str, obj: str, run_index: int, seed: int, *, ctx: RunContext,
-                      grid: int = 15) -> dict:
-    """Predict the expected entropy of a grid of grasps from the initial belief, execute the best,
-    the median and the worst, and compare the realised weight entropies after reweighting."""
+                      grid: int = 15) -> EntropyOrderRun:
+    """Predict the expected entropy (Eq. 3.2) of a grid of grasps from the initial belief, execute
+    the best, the median and the worst, and realise their weight entropies after reweighting."""
     pose, models, planner, _, _ = _initial_planner(obj, ctx, seed)
     cands = _grid_actions(planner, grid, yaw=planner.belief.mean()[2])
     h, se = planner.expected_entropy(cands, n_samples=200, seed=1)
+    particles = planner.belief.particles.copy()
     order = np.argsort(h)
-    picks = {"best": order[0], "good": order[len(order) // 2], "worst": order[-1]}
-    world = World.single(obj, pose=pose, hand=ctx.hand)
-    out = {"true_pose": pose.tolist(), "predicted": {}, "realised": {}, "actions": {}, "grid": grid,
-           "landscape": h.tolist(), "candidates": cands.tolist(), "particles": planner.belief.particles.tolist()}
-    for name, i in picks.items():
-        out["predicted"][name] = float(h[i])
-        out["realised"][name], _ = _reweighted(planner, models, world, pose, cands[i])
-        out["actions"][name] = cands[i].tolist()
-    pr = [out["predicted"][k] for k in ("best", "good", "worst")]
-    re = [out["realised"][k] for k in ("best", "good", "worst")]
-    out["order_kept"] = bool(np.all(np.argsort(re) == np.argsort(pr)))
-    out["best_below_worst"] = bool(re[0] < re[2])
-    out["kendall_tau"] = float(stats.kendalltau(pr, re).statistic)
-    return out
+    world = World.single(obj, pose=pose, hand=ctx.hand_model)
+    picks = []
+    for name, i in zip(PICKS, (order[0], order[len(order) // 2], order[-1])):
+        realised, _ = _reweighted(planner, models, world, pose, cands[i])
+        picks.append(EntropyPick(name, cands[i], float(h[i]), realised))
+    return EntropyOrderRun(pose, grid, cands, h, particles, tuple(picks))
 
 
 def _reweighted(planner, models, world, pose, action):
@@ -108,7 +101,7 @@ def _reweighted(planner, models, world, pose, action):
     return weight_entropy(lw), float(np.hypot(*(w @ P[:, :2] - pose[:2])))
 
 
-def entropy_gain_run(obj: str, run_index: int, ctx: Optional[RunContext] = None, models=None) -> dict:
+def entropy_gain_run(obj: str, run_index: int, ctx: Optional[RunContext] = None, models=None) -> EntropyGain:
     """From one initial belief: the planner's most informative grasp (Eq. 3.2) and a random grasp
     in the same search box, each executed at the true pose; realised posterior weight entropies
     and posterior-mean position errors (before: the prior's)."""
@@ -116,7 +109,7 @@ def entropy_gain_run(obj: str, run_index: int, ctx: Optional[RunContext] = None,
     pose, models, planner, rng, _ = _initial_planner(
         obj, ctx, run_seed(ctx.seed, "entropy_gain", obj, run_index), models,
         PlannerSettings(explore_stability_weight=0.0))  # Eq. 3.2 alone
-    world = World.single(obj, pose=pose, hand=ctx.hand)
+    world = World.single(obj, pose=pose, hand=ctx.hand_model)
     informative, _, _ = planner.minimise_entropy()
     low, high = planner.action_bounds()
     random_action = rng.uniform(low, high)
@@ -124,9 +117,7 @@ def entropy_gain_run(obj: str, run_index: int, ctx: Optional[RunContext] = None,
     err0 = float(np.hypot(*(w0 @ planner.belief.particles[:, :2] - pose[:2])))
     h_i, e_i = _reweighted(planner, models, world, pose, informative)
     h_r, e_r = _reweighted(planner, models, world, pose, random_action)
-    return {"true_pose": pose.tolist(), "error_before": err0, "entropy_before": float(np.log(len(w0))),
-            "entropy_informative": h_i, "error_after_informative": e_i, "entropy_random": h_r,
-            "error_after_random": e_r, "informative": informative.tolist(), "random": random_action.tolist()}
+    return EntropyGain(pose, err0, float(np.log(len(w0))), np.asarray(informative), h_i, e_i, random_action, h_r, e_r)
 
 
 def _grid_actions(planner, n: int, yaw: float) -> np.ndarray:
@@ -138,16 +129,14 @@ def _grid_actions(planner, n: int, yaw: float) -> np.ndarray:
 
 
 def landscapes_run(experiment: str, obj: str, run_index: int, seed: int, *, ctx: RunContext,
-                   grid: int = 21) -> dict:
+                   grid: int = 21) -> LandscapesRun:
     """Weight vs kernel expected-entropy landscapes over (x, y) at the belief's mean yaw; for the
     cube also the 1-D (x only) uncertainty case with 1,000 and 10,000 measurement samples."""
     pose, models, planner, rng, s = _initial_planner(obj, ctx, seed)
     cands = _grid_actions(planner, grid, yaw=planner.belief.mean()[2])
     hw, _ = planner.expected_entropy(cands, n_samples=200, seed=3, method="weight")
     hk, _ = planner.expected_entropy(cands, n_samples=200, seed=3, method="kernel")
-    out = {"true_pose": pose.tolist(), "grid": grid, "actions": cands.tolist(), "weight": hw.tolist(),
-           "kernel": hk.tolist(), "pearson": float(stats.pearsonr(hw, hk).statistic),
-           "spearman": float(stats.spearmanr(hw, hk).statistic)}
+    one_dof = None
     if obj == "cube":
         # 1-DOF: the belief varies in x only (the thesis's cube experiment).
         s1 = s.with_(half_width=(0.04, 1e-6, 1e-6))
@@ -157,15 +146,8 @@ def landscapes_run(experiment: str, obj: str, run_index: int, seed: int, *, ctx:
         acts = np.column_stack([xs, np.full_like(xs, pose[1]), np.full_like(xs, pose[2])])
         h1, _ = p1.expected_entropy(acts, n_samples=1000, seed=5)
         h10, _ = p1.expected_entropy(acts, n_samples=10000, seed=5)
-
-        def rough(h):
-            return float(np.mean(np.abs(np.diff(h, 2))))
-
-        out["one_dof"] = {"x": xs.tolist(), "h1000": h1.tolist(), "h10000": h10.tolist(),
-                          "roughness_1000": rough(h1), "roughness_10000": rough(h10),
-                          "argmin_gap": float(abs(xs[np.argmin(h1)] - xs[np.argmin(h10)])),
-                          "correlation": float(stats.pearsonr(h1, h10).statistic)}
-    return out
+        one_dof = OneDof(xs, np.asarray(h1), np.asarray(h10))
+    return LandscapesRun(pose, grid, cands, np.asarray(hw), np.asarray(hk), one_dof)
 
 
 # ---- the registered experiments ---------------------------------------------------------------------

@@ -10,7 +10,7 @@ import numpy as np
 from .pose_uncertainty_plots import (plot_landscape, plot_one_dof, plot_per_attempt,
                                      plot_weight_vs_kernel)
 from .pose_uncertainty_stats import average_rows, episode_table
-from .report import by_object, finish, markdown, start, write_csv
+from .report import Report, by_object, finish, markdown, start, write_csv
 
 
 EPISODE_COLS = ("object", "attempt", "runs", "success", "lifted", "stable", "force_closure", "success_at_attempt",
@@ -18,7 +18,7 @@ EPISODE_COLS = ("object", "attempt", "runs", "success", "lifted", "stable", "for
                 "plan_ms_median")
 
 
-def write_episodes(exp, results: Dict[str, list], out: Path) -> dict:
+def write_episodes(exp, results: Dict[str, list], out: Path) -> Report:
     """Closed-loop experiments (pub2, baselines, pub4): per-attempt tables per method and a plot."""
     out, md, summary = start(exp.name, out)
     name = exp.name
@@ -53,7 +53,7 @@ def write_episodes(exp, results: Dict[str, list], out: Path) -> dict:
     return finish(out, md, summary)
 
 
-def write_entropy_order(exp, results: Dict[str, list], out: Path) -> dict:
+def write_entropy_order(exp, results: Dict[str, list], out: Path) -> Report:
     """Fig. 3.6: does the realised entropy keep the predicted order of three grasps?"""
     out, md, summary = start(exp.name, out)
     groups = by_object(results["explore"])
@@ -78,7 +78,7 @@ def write_entropy_order(exp, results: Dict[str, list], out: Path) -> dict:
     return finish(out, md, summary)
 
 
-def write_landscapes(exp, results: Dict[str, list], out: Path) -> dict:
+def write_landscapes(exp, results: Dict[str, list], out: Path) -> Report:
     """Weight vs kernel expected-entropy landscapes and the 1-DOF sample-count comparison."""
     out, md, summary = start(exp.name, out)
     rows = []

@@ -1,23 +1,25 @@
 """The experiments by name. Each module of experiments registers its own (see
 :mod:`.pose_uncertainty`; the package imports every such module); the driver (:mod:`.driver`)
 runs any of them the same way, in three steps: prepare (what the runs share), run one (a
-(method, object, run index) -> a JSON-ready dict, stored), report (tables, prose and figures from
+(method, object, run index) -> a typed record (:mod:`.run_records`) whose ``to_dict()`` is stored), report (tables, prose and figures from
 the stored runs; each experiment's statistics, prose and figures are modules of their own)."""
 from __future__ import annotations
 
 from dataclasses import dataclass
 from pathlib import Path
-from typing import TYPE_CHECKING, Callable, Dict, List, Optional, Sequence
+from typing import TYPE_CHECKING, Any, Callable, Dict, List, Optional, Sequence
 
 if TYPE_CHECKING:
     from ..loop.context import RunContext
+    from .report import Report
 
 #: The run context's settings an experiment's runs may read, besides the hand, the cache and the
 #: seed that every one reads (``--set episode.FIELD`` is measurement_noise).
 CONTEXT_SETTINGS = ("success", "lift", "families", "models", "planner", "measurement_noise")
 
-#: (experiment, object, run index, seed) -> a JSON-ready dict; module level (sent to workers).
-RunFunction = Callable[[str, str, int, int], dict]
+#: (experiment, object, run index, seed) -> a record with ``to_dict()`` (or a JSON-ready dict);
+#: module level (sent to workers).
+RunFunction = Callable[[str, str, int, int], Any]
 
 
 @dataclass(frozen=True)
@@ -26,8 +28,8 @@ class Experiment:
     method), a one-line description, and three functions:
 
     * ``make_run(experiment, method, ctx)`` -> (series key in the result store, RunFunction);
-    * ``report(experiment, results, out)`` -> summary dict; ``results`` maps method -> [(RunKey, dict)];
-      writes summary.md, summary.json, tables and plots into ``out``;
+    * ``report(experiment, results, out)`` -> :class:`~.report.Report`; ``results`` maps method ->
+      [(RunKey, dict)]; writes summary.md, summary.json, tables and plots into ``out``;
     * ``prepare_object(experiment, object, ctx)`` (optional): what the runs of one object share
       (its models), built before the runs as an engine task per object (in parallel), into the
       disk cache the runs then read;
@@ -47,7 +49,7 @@ class Experiment:
     runs: int
     description: str
     make_run: Callable[["Experiment", str, "RunContext"], tuple]
-    report: Callable[["Experiment", Dict[str, list], Path], dict]
+    report: Callable[["Experiment", Dict[str, list], Path], "Report"]
     methods: Sequence[str] = ("stability",)
     finish: Optional[Callable[["Experiment", List[str], "RunContext", Path], None]] = None
     prepare: Optional[Callable[["Experiment", List[str], "RunContext"], None]] = None

@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import csv
 import json
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Dict, List, Sequence
 
@@ -61,6 +62,21 @@ def write_csv(rows: List[dict], path: Path) -> None:
         w.writerows(rows)
 
 
+@dataclass(frozen=True)
+class Report:
+    """What an experiment's report step wrote.
+
+    out : Path — the directory holding summary.md, summary.json, the tables and the figures
+    summary : dict — the content of summary.json (its keys differ per experiment)
+    """
+
+    out: Path
+    summary: dict
+
+    def to_dict(self) -> dict:
+        return self.summary
+
+
 def start(name: str, out) -> tuple:
     """(output directory, the summary.md lines so far, the summary dict) of experiment ``name``."""
     out = Path(out)
@@ -68,8 +84,8 @@ def start(name: str, out) -> tuple:
     return out, [f"# Experiment `{name}`", ""], {"experiment": name}
 
 
-def finish(out: Path, md: list, summary: dict) -> dict:
-    """Writes summary.md and summary.json; returns the summary."""
+def finish(out: Path, md: list, summary: dict) -> Report:
+    """Writes summary.md and summary.json; returns what was written where."""
     (out / "summary.md").write_text("\n".join(md))
     (out / "summary.json").write_text(json.dumps(summary, indent=1))
-    return summary
+    return Report(out, summary)

@@ -1,8 +1,8 @@
 """Run-by-run experiment execution with resume, worker processes and a progress bar.
 
 Every run is a pure function of (experiment, object, run index, seed) and the settings it runs
-under: the runner hands the function those four values, stores what it returns (a
-JSON-serialisable dict) in an SQLite file as soon as the run finishes, and skips runs already
+under: the runner hands the function those four values, stores what it returns (a typed
+record's ``to_dict()``, or a JSON-serialisable dict) in an SQLite file as soon as the run finishes, and skips runs already
 stored when started again. So an interrupted experiment resumes where it stopped and loses
 nothing, and the same runs go to any engine (:mod:`.engines`: local processes or Ray tasks)
 without touching the planners.
@@ -93,11 +93,11 @@ class ResultStore:
             " ORDER BY object, run_index", (experiment,))
         return [(RunKey(*r[:4]), json.loads(r[4])) for r in rows]
 
-    def flatten(self) -> dict:
+    def flatten(self) -> None:
         """Rebuilds the plain SQL tables derived from the runs (:mod:`.flat_tables`): run_rows and
-        one table per list of records (attempts, ...). Returns rows per table."""
+        one table per list of records (attempts, ...)."""
         from .flat_tables import flatten
-        return flatten(self._db)
+        flatten(self._db)
 
     def close(self) -> None:
         self._db.close()

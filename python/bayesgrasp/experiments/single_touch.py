@@ -34,6 +34,7 @@ from ..planners.touch import TouchModel, TouchPlanner, TouchSettings
 from ..world import World
 from . import report
 from .registry import Experiment, register
+from .run_records import PlannedGrasp, SecondGrasp, TouchCase, TouchRun
 from .runner import ResultStore
 from .single_touch_plots import plot_errors
 from .single_touch_prose import findings, markdown_case
@@ -74,45 +75,38 @@ def problem(case: str, rng: np.random.Generator):
 
 
 def _one_case(obj: str, case: str, optimizer: str, rng: np.random.Generator, seed: int, ctx: RunContext,
-              contact_term: str = "flags", hand: Optional[str] = None):
+              contact_term: str = "flags", hand: Optional[str] = None) -> TouchCase:
+    """One case's problem drawn from ``rng``, touched and fitted by ``optimizer``."""
     truth, initial = problem(case, rng)
     model = touch_model(obj, hand or ctx.hand)
     settings = TouchSettings(optimizer=optimizer, unknowns=case, budget=BUDGET, seed=seed,
                              box=(ERROR_XY, ERROR_YAW, SCALES[0], SCALES[1]), contact_term=contact_term)
     t = touch_once(TouchPlanner(model, initial, settings), obj, truth)
-    r = t.fit
-    rec = {"truth": truth.tolist(), "initial": initial.tolist(), "estimate": t.estimate.tolist(),
-           "status": r.status.name, "contacts": int(t.readings.contact_count), "fitness": r.fitness,
-           "initial_fitness": r.initial_fitness, "evaluations": int(r.evaluations), "seconds": r.seconds,
-           "cpu_seconds": r.cpu_seconds,
-           "trace": [list(map(int, r.trace_evaluations[::10])), list(r.trace_fitness[::10])],
-           "before": pose_errors(obj, initial, truth).to_dict(), "after": pose_errors(obj, t.estimate, truth).to_dict()}
-    return rec, t.planner, truth
+    return TouchCase(truth, initial, t, pose_errors(obj, initial, truth), pose_errors(obj, t.estimate, truth))
 
 
-def _second_grasp(obj: str, planner: TouchPlanner, truth, ctx: RunContext) -> dict:
+def _second_grasp(obj: str, planner: TouchPlanner, truth, ctx: RunContext) -> SecondGrasp:
     """Fig. 2.1: the most stable grasp planned on the initial guess and on the updated model,
     each executed on the true object."""
     models = ctx.models(obj)
-    world = World.single(obj, pose=truth[:3], hand=ctx.hand)
-    out = {}
-    for name, estimate in (("initial", planner.initial), ("updated", planner.estimate)):
+    world = World.single(obj, pose=truth[:3], hand=ctx.hand_model)
+    tried = []
+    for estimate in (planner.initial, planner.estimate):
         action = TouchPlanner(planner.model, estimate, planner.settings, models=models).plan().action
         ex = execute(world, models, action, truth[:3], ctx)
-        out[name] = {"action": action.tolist(), "success": ex.success, "epsilon": ex.epsilon, "lifted": ex.lifted}
-    return out
+        tried.append(PlannedGrasp(action, ex.success, ex.epsilon, ex.lifted))
+    return SecondGrasp(*tried)
 
 
-def touch_run(experiment: str, obj: str, run_index: int, seed: int, *, optimizer: str, ctx: RunContext) -> dict:
+def touch_run(experiment: str, obj: str, run_index: int, seed: int, *, optimizer: str, ctx: RunContext) -> TouchRun:
     """One run: the three cases on problems (and optimiser seeds) shared by every optimiser."""
     rng = np.random.default_rng(seed)
-    out = {"object": obj, "optimizer": optimizer, "cases": {}}
+    cases, second = {}, None
     for case in CASES:
-        rec, planner, truth = _one_case(obj, case, optimizer, rng, seed, ctx)
-        out["cases"][case] = rec
-        if case == "pose":
-            out["second_grasp"] = _second_grasp(obj, planner, truth, ctx)
-    return out
+        c = cases[case] = _one_case(obj, case, optimizer, rng, seed, ctx)
+        if case == "pose":   # Fig. 2.1's loop on the 3-DoF problem
+            second = _second_grasp(obj, c.trial.planner, c.truth, ctx)
+    return TouchRun(obj, "optimizer", optimizer, cases, second)
 
 
 def _make_run(exp: Experiment, method: str, ctx: RunContext):
@@ -120,7 +114,7 @@ def _make_run(exp: Experiment, method: str, ctx: RunContext):
 
 
 # ---- report: statistics (single_touch_stats), prose (single_touch_prose), figures (single_touch_plots) ----
-def write_report(exp: Experiment, results: Dict[str, list], out) -> dict:
+def write_report(exp: Experiment, results: Dict[str, list], out) -> report.Report:
     out, md, summary = report.start(exp.name, out)
     md += [__doc__.strip().split("\n")[0], "",
            "Cells: median [25th, 75th percentile] over the runs; errors after the touch, then the initial ones.", ""]
@@ -158,7 +152,7 @@ def planned_on_truth(exp: Experiment, objects: List[str], ctx: RunContext, out) 
         models = ctx.models(o)
         wins = []
         for truth in truths:
-            world = World.single(o, pose=truth[:3], hand=ctx.hand)
+            world = World.single(o, pose=truth[:3], hand=ctx.hand_model)
             action = TouchPlanner(touch_model(o, ctx.hand), truth, models=models).plan().action
             wins.append(execute(world, models, action, truth[:3], ctx).success)
         rows.append({"object": o, "runs": len(truths), "success_on_truth": float(np.mean(wins))})
@@ -185,18 +179,18 @@ VARIANTS = {"pso/flags": ("pso", "flags", None), "pso/surface": ("pso", "surface
             "pso/robotiq_3f": ("pso", "flags", "robotiq_3f")}
 
 
-def variant_run(experiment: str, obj: str, run_index: int, seed: int, *, method: str, ctx: RunContext) -> dict:
+def variant_run(experiment: str, obj: str, run_index: int, seed: int, *, method: str, ctx: RunContext) -> TouchRun:
     """pub1's 3-DoF problem of the same run index, with another contact term or hand."""
     optimizer, term, hand = VARIANTS[method]
-    rec, _, _ = _one_case(obj, "pose", optimizer, np.random.default_rng(seed), seed, ctx, term, hand)
-    return {"object": obj, "method": method, "cases": {"pose": rec}}
+    case = _one_case(obj, "pose", optimizer, np.random.default_rng(seed), seed, ctx, term, hand)
+    return TouchRun(obj, "method", method, {"pose": case})
 
 
 def _make_variant(exp: Experiment, method: str, ctx: RunContext):
     return f"{exp.name}/{method}", partial(variant_run, method=method, ctx=ctx)
 
 
-def write_variants(exp: Experiment, results: Dict[str, list], out) -> dict:
+def write_variants(exp: Experiment, results: Dict[str, list], out) -> report.Report:
     out, md, summary = report.start(exp.name, out)
     md += ["pub1's 3-DoF problems with the continuous contact term (surface) and with the Robotiq 3F hand.",
            "Cells: median [25th, 75th percentile]; the method column is optimiser/contact term or hand.", ""]

@@ -3,7 +3,8 @@ errors before and after the touch, of the fitness, evaluations and time; Fig. 2.
 success rates."""
 from __future__ import annotations
 
-from typing import Dict, List
+from dataclasses import asdict, dataclass
+from typing import Dict, List, Optional
 
 import numpy as np
 
@@ -13,12 +14,29 @@ from .report import by_object
 CASES = ("pose", "pose_and_scale", "orientation")
 
 
-def quartiles(values) -> dict:
+@dataclass(frozen=True)
+class Quartiles:
+    """The median and the 25th and 75th percentiles of some values (all None: no values)."""
+
+    median: Optional[float]
+    q25: Optional[float]
+    q75: Optional[float]
+
+    def scaled(self, k: float) -> "Quartiles":
+        """The same quartiles in other units (each times ``k``)."""
+        return Quartiles(*(None if v is None else v * k for v in (self.median, self.q25, self.q75)))
+
+    def to_dict(self) -> dict:
+        return asdict(self)
+
+
+def quartiles(values) -> Quartiles:
+    """The quartiles of ``values``, None entries left out."""
     v = np.asarray([x for x in values if x is not None], dtype=float)
     if v.size == 0:
-        return {"median": None, "q25": None, "q75": None}
+        return Quartiles(None, None, None)
     q = np.percentile(v, [25, 50, 75])
-    return {"median": float(q[1]), "q25": float(q[0]), "q75": float(q[2])}
+    return Quartiles(float(q[1]), float(q[0]), float(q[2]))
 
 
 def case_rows(results: Dict[str, list], case: str) -> List[dict]:
@@ -31,21 +49,17 @@ def case_rows(results: Dict[str, list], case: str) -> List[dict]:
             row = {"optimizer": opt, "object": obj, "runs": len(recs),
                    "no_contact": int(sum(c["status"] != "estimated" for c in recs))}
             for when in ("before", "after"):
-                row[f"position_mm_{when}"] = scaled(quartiles(c[when]["position_error"] for c in recs), 1e3)
+                row[f"position_mm_{when}"] = quartiles(c[when]["position_error"] for c in recs).scaled(1e3).to_dict()
                 yaw = [c[when]["orientation_error"] for c in recs]
                 row[f"orientation_deg_{when}"] = (None if all(y is None for y in yaw)
-                                                  else scaled(quartiles(yaw), 180 / np.pi))
-                row[f"size_pct_{when}"] = scaled(quartiles(c[when]["size_error"] for c in recs), 100)
-            row["fitness"] = quartiles(c["fitness"] for c in recs)
-            row["evaluations"] = quartiles(c["evaluations"] for c in recs)
-            row["seconds"] = quartiles(c["seconds"] for c in recs)
-            row["cpu_seconds"] = quartiles(c.get("cpu_seconds", c["seconds"]) for c in recs)
+                                                  else quartiles(yaw).scaled(180 / np.pi).to_dict())
+                row[f"size_pct_{when}"] = quartiles(c[when]["size_error"] for c in recs).scaled(100).to_dict()
+            row["fitness"] = quartiles(c["fitness"] for c in recs).to_dict()
+            row["evaluations"] = quartiles(c["evaluations"] for c in recs).to_dict()
+            row["seconds"] = quartiles(c["seconds"] for c in recs).to_dict()
+            row["cpu_seconds"] = quartiles(c.get("cpu_seconds", c["seconds"]) for c in recs).to_dict()
             rows.append(row)
     return rows
-
-
-def scaled(s: dict, k: float) -> dict:
-    return {a: (None if v is None else v * k) for a, v in s.items()}
 
 
 def median_of(rows, opt, obj, field):

@@ -83,7 +83,7 @@ def run_sweep(name: str, out_dir, points: Sequence[Point], runs=None, objects=No
     plans = []  # (point, {method: series name}, [Series])
     try:
         for p in points:
-            settings = {**p.ctx.result_settings(), "sweep": {k: _plain(v) for k, v in p.params.items()}}
+            settings = {**p.ctx.result_settings().to_dict(), "sweep": {k: _plain(v) for k, v in p.params.items()}}
             names, series = {}, []
             for method in exp.methods:
                 base, fn = exp.make_run(exp, method, p.ctx.for_workers())
@@ -102,8 +102,8 @@ def run_sweep(name: str, out_dir, points: Sequence[Point], runs=None, objects=No
         store.close()
     rows = []
     for p, names, _ in plans:
-        summary = exp.report(exp, {m: done[s] for m, s in names.items()}, out / p.label)
-        rows.append({**p.params, **_headline(summary), "dir": p.label})
+        written = exp.report(exp, {m: done[s] for m, s in names.items()}, out / p.label)
+        rows.append({**p.params, **_headline(written.summary), "dir": p.label})
     _write_summary(name, rows, list(points[0].params), out)
     return rows
 

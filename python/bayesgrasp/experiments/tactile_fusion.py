@@ -31,6 +31,7 @@ from ..planners.fusion import FusionSettings
 from . import report
 from .category_grasping import view
 from .registry import Experiment, register
+from .run_records import FusionRun
 from .tactile_fusion_plots import plot_cumulative_success
 from .tactile_fusion_stats import THESIS, round_rows, transitions
 
@@ -39,14 +40,15 @@ MUGS = tuple(f"mug/{i}" for i in range(7))
 
 # ---- the experiment ------------------------------------------------------------------------------------
 def fusion_run(experiment: str, obj: str, run_index: int, seed: int, *, ctx: RunContext, mode: str,
-               belief: str, task_term: str = "laplace", avoid_failed: bool = False) -> dict:
+               belief: str, task_term: str = "laplace", avoid_failed: bool = False) -> FusionRun:
+    """One trial on the run's view, and the vision-only baseline's grasp: G(0) planned from vision
+    (the trial's own G(0) in mode ``vision``, one more plan in mode ``random``)."""
     pose, eye = view(seed)
     trial = FusionTrial(obj, pose, ctx, eye_offset=eye, seed=seed % (2**31),
                         settings=FusionSettings(belief=belief, task_term=task_term, avoid_failed=avoid_failed))
-    out = trial.run(mode).to_dict()
-    baseline = trial.run("vision", rounds=0).to_dict() if mode == "random" else None
-    out.update({"object": obj, "pose": list(pose), "vision_only": baseline["rounds"][0] if baseline else out["rounds"][0]})
-    return out
+    result = trial.run(mode)
+    baseline = trial.run("vision", rounds=0) if mode == "random" else result
+    return FusionRun(result, obj, pose, baseline.rounds[0])
 
 
 def _make(mode: str, belief: str = "map", task_term: str = "laplace", avoid_failed: bool = False):
@@ -62,31 +64,31 @@ def prepare(exp: Experiment, objects: List[str], ctx: RunContext) -> None:
     demonstrated(training_models("mug"), task_rule("mug", "top"), ctx)
 
 
-def write_report(exp: Experiment, results: Dict[str, list], out: Path) -> dict:
+def write_report(exp: Experiment, results: Dict[str, list], out: Path) -> report.Report:
     out, md, summary = report.start(exp.name, out)
     t = transitions(results["all"])
-    rows = [{"measure": k, "ours": t[k], "thesis": THESIS.get(k, "")} for k in THESIS]
-    rows += [{"measure": "cumulative success by round 0/1/2/3", "ours": " / ".join(map(str, t["cumulative_success_by_round"])),
+    rows = [{"measure": k, "ours": getattr(t, k), "thesis": THESIS.get(k, "")} for k in THESIS]
+    rows += [{"measure": "cumulative success by round 0/1/2/3", "ours": " / ".join(map(str, t.cumulative_success_by_round)),
               "thesis": ""},
-             {"measure": "vision-only success", "ours": t["vision_only_success"], "thesis": "3 of 19 (robot)"}]
+             {"measure": "vision-only success", "ours": t.vision_only_success, "thesis": "3 of 19 (robot)"}]
     targets = [
-        {"target": "unstable -> stable above stable -> unstable", "holds": t["unstable_to_stable"] > t["stable_to_unstable"]},
-        {"target": "cumulative success never falls", "holds": all(np.diff(t["cumulative_success_by_round"]) >= 0)},
-        {"target": "combined above vision-only", "holds": t["success_after_round_3"] > t["vision_only_success"]},
-        {"target": f"success after round 3 >= 78 of {t['trials']} scaled to 100",
-         "holds": t["success_after_round_3"] >= 0.78 * t["trials"]},
+        {"target": "unstable -> stable above stable -> unstable", "holds": t.unstable_to_stable > t.stable_to_unstable},
+        {"target": "cumulative success never falls", "holds": all(np.diff(t.cumulative_success_by_round) >= 0)},
+        {"target": "combined above vision-only", "holds": t.success_after_round_3 > t.vision_only_success},
+        {"target": f"success after round 3 >= 78 of {t.trials} scaled to 100",
+         "holds": t.success_after_round_3 >= 0.78 * t.trials},
         {"target": "our target: success after round 3 >= 88 of 105 (scaled to the trials)",
-         "holds": t["success_after_round_3"] >= 88 / 105 * t["trials"]}]
+         "holds": t.success_after_round_3 >= 88 / 105 * t.trials}]
     report.write_csv(rows, out / "transitions.csv")
     report.write_csv(targets, out / "targets.csv")
     report.write_csv(round_rows(results["all"]), out / "rounds.csv")
     png = plot_cumulative_success(t, out / "cumulative_success.png", exp.name)
-    md += [f"{t['trials']} trials. Success = lifted. After round 3: {t['success_after_round_3']} "
-           f"(95% CI {t['ci_after_round_3'][0]:.2f}-{t['ci_after_round_3'][1]:.2f}); vision only: "
-           f"{t['vision_only_success']} (CI {t['ci_vision_only'][0]:.2f}-{t['ci_vision_only'][1]:.2f}).", "",
+    md += [f"{t.trials} trials. Success = lifted. After round 3: {t.success_after_round_3} "
+           f"(95% CI {t.ci_after_round_3[0]:.2f}-{t.ci_after_round_3[1]:.2f}); vision only: "
+           f"{t.vision_only_success} (CI {t.ci_vision_only[0]:.2f}-{t.ci_vision_only[1]:.2f}).", "",
            report.markdown(rows, ("measure", "ours", "thesis")), "", report.markdown(targets, ("target", "holds")), "",
            f"![cumulative success]({png.name})", ""]
-    summary.update({"transitions": t, "targets": targets})
+    summary.update({"transitions": t.to_dict(), "targets": targets})
     return report.finish(out, md, summary)
 
 

@@ -3,13 +3,47 @@ unstable -> stable, cumulative success by round, the vision-only baseline) besid
 one row per trial and round."""
 from __future__ import annotations
 
-from typing import List
+from dataclasses import asdict, dataclass
+from typing import List, Tuple
 
 from ..loop.fusion_trial import ROUNDS
 from .category_stats import wilson
 
 
-def transitions(results: list) -> dict:
+@dataclass(frozen=True)
+class Transitions:
+    """The thesis's accounting of pub6's trials (Pub. VI), counts of trials:
+
+    trials : int
+    better, worse, same_both_unstable : int — round 1's grasp against G(0) (lifted, then epsilon)
+    unstable_to_stable, stable_to_unstable : int — G(0) -> round 1
+    still_unstable_after_round_1 : int; became_stable_round_2, became_stable_round_3 : int — of those
+    cumulative_success_by_round : list of int — trials lifted by round 0, 1, 2, 3
+    vision_only_success : int — the vision-only baseline's grasp lifted
+    success_after_round_3 : int
+    ci_after_round_3, ci_vision_only : (float, float) — 95% Wilson intervals of the two rates
+    """
+
+    trials: int
+    better: int
+    worse: int
+    same_both_unstable: int
+    unstable_to_stable: int
+    stable_to_unstable: int
+    still_unstable_after_round_1: int
+    became_stable_round_2: int
+    became_stable_round_3: int
+    cumulative_success_by_round: List[int]
+    vision_only_success: int
+    success_after_round_3: int
+    ci_after_round_3: Tuple[float, float]
+    ci_vision_only: Tuple[float, float]
+
+    def to_dict(self) -> dict:
+        return asdict(self)
+
+
+def transitions(results: list) -> Transitions:
     """The thesis's accounting over trials (Pub. VI): after round 1, better / worse / same (both
     unstable); unstable -> stable, stable -> unstable; of the still unstable, how many became
     stable in rounds 2 and 3; cumulative success by round; the vision-only baseline."""
@@ -32,12 +66,8 @@ def transitions(results: list) -> dict:
     still = [r for _, r in results if not any(x["lifted"] for x in r["rounds"][:2])]
     later = [sum(any(x["lifted"] for x in r["rounds"][2:t + 1]) for r in still) for t in (2, 3)]
     vision = sum(r["vision_only"]["lifted"] for _, r in results)
-    return {"trials": n, "better": better, "worse": worse, "same_both_unstable": same,
-            "unstable_to_stable": up, "stable_to_unstable": down, "still_unstable_after_round_1": len(still),
-            "became_stable_round_2": later[0], "became_stable_round_3": later[1] - later[0],
-            "cumulative_success_by_round": cumulative, "vision_only_success": vision,
-            "success_after_round_3": cumulative[-1], "ci_after_round_3": wilson(cumulative[-1], n),
-            "ci_vision_only": wilson(vision, n)}
+    return Transitions(n, better, worse, same, up, down, len(still), later[0], later[1] - later[0], cumulative,
+                       vision, cumulative[-1], wilson(cumulative[-1], n), wilson(vision, n))
 
 
 THESIS = {"better": 45, "worse": 34, "same_both_unstable": 21, "unstable_to_stable": 25, "stable_to_unstable": 21,

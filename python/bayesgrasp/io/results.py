@@ -6,6 +6,7 @@ attributes and writes the published shapes, which the CLI, the viewer, the episo
 results database read:
 
     episode_dict(result)          # an episode: the experiments' stored record (results database)
+    attempt_grasp(attempt)        # an episode's executed grasp in the grasp schema (also round_grasp, touch_grasp)
     plan_document(result, ...)    # ``bayesgrasp plan`` / ``demo``: the same episode for the user and the viewer
     task_grasp_dict(result)       # a category plan and its execution (a TaskGraspResult), as stored
     category_document(result, ...)   # ``bayesgrasp category``: the same for the user and the viewer
@@ -32,6 +33,12 @@ from .view_fields import belief_json, cloud_json
 
 def _list(a) -> Optional[list]:
     return None if a is None else np.asarray(a).tolist()
+
+
+def attempt_grasp(a) -> dict:
+    """An episode attempt's executed grasp (an :class:`Attempt`) in the grasp schema (world frame,
+    where the hand closed)."""
+    return hand_grasp_record(a.hand, a.execution.hand_pose, a.execution.joint_angles, a.variant.spread)
 
 
 def episode_attempt_dict(a) -> dict:
@@ -66,7 +73,7 @@ def _plan_attempt_dict(a, snapshot) -> dict:
     action = _list(plan.action)
     return {"plan_type": plan.kind, "family": plan.family, "variant": a.variant.as_dict(),
             "top_grasp": action if plan.family == "top" else None,
-            "action": action, "grasp": a.grasp, "predicted_stability": float(plan.predicted_stability),
+            "action": action, "grasp": attempt_grasp(a), "predicted_stability": float(plan.predicted_stability),
             "expected_entropy": plan.expected_entropy, "entropy": a.belief_before["kde_entropy"],
             "epsilon": ex.epsilon, "stable": ex.stable, "lifted": ex.lifted,
             "success": ex.success, "outcome": "success" if ex.success else "failure",
@@ -80,15 +87,19 @@ def _final_belief_dict(f: dict, snapshot) -> dict:
             "position_error": f["position_error"], "yaw_error": f["yaw_error"], **belief_json(*snapshot)}
 
 
-def plan_document(r, object_name: str, units: Optional[str], criterion: str) -> dict:
+def plan_document(r, object_name: str, units: Optional[str], criterion: str, vision: Optional[dict] = None) -> dict:
     """``bayesgrasp plan``'s JSON of an episode run with ``keep_planner`` (its snapshots give each
     attempt the belief it was planned from): ``object_name`` as the user gave it, the mesh's
-    ``units``, the success ``criterion``. Each attempt carries the executed grasp in the grasp
-    schema and its contacts with the object (with parts); the aliases are in the module's doc."""
-    return {"object": object_name, "units": units, "method": r.method, "true_pose": _list(r.true_pose),
-            "estimate": _list(r.estimate), "success_criterion": criterion, "success": r.success,
-            "attempts": [_plan_attempt_dict(a, s) for a, s in zip(r.attempts, r.snapshots)],
-            "final_belief": _final_belief_dict(r.final_belief, r.snapshots[-1])}
+    ``units``, the success ``criterion``; ``vision`` (:func:`vision_dict`) when the belief came
+    from camera data. Each attempt carries the executed grasp in the grasp schema and its
+    contacts with the object (with parts); the aliases are in the module's doc."""
+    doc = {"object": object_name, "units": units, "method": r.method, "true_pose": _list(r.true_pose),
+           "estimate": _list(r.estimate), "success_criterion": criterion, "success": r.success,
+           "attempts": [_plan_attempt_dict(a, s) for a, s in zip(r.attempts, r.snapshots)],
+           "final_belief": _final_belief_dict(r.final_belief, r.snapshots[-1])}
+    if vision is not None:
+        doc["vision"] = vision
+    return doc
 
 
 def vision_dict(start, scene: str, object_points) -> dict:
@@ -109,6 +120,11 @@ def task_grasp_dict(r) -> dict:
     task and the number of demonstrated grasps."""
     return {**task_grasp_outcome_dict(r.outcome), **r.plan.to_dict(), "method": r.method, "task": r.task,
             "task_grasps": r.task_grasps}
+
+
+def tasks_dict(tasks) -> dict:
+    """{task: {method: TaskGraspResult}} (a category run's plans for every task and method) as stored."""
+    return {t: {m: task_grasp_dict(r) for m, r in by_method.items()} for t, by_method in tasks.items()}
 
 
 def _registered_models(r, models: Sequence[str], registrations) -> list:
@@ -141,6 +157,12 @@ def pose_errors_dict(e) -> dict:
     return {"position_error": e.position_error, "orientation_error": e.orientation_error, "size_error": e.size_error}
 
 
+def touch_grasp(t) -> dict:
+    """A :class:`~bayesgrasp.loop.touch_trial.TouchTrial`'s executed touch in the grasp schema
+    (world frame, where the hand closed)."""
+    return hand_grasp_record(t.planner.model.hand, t.readings.hand_pose, t.readings.joints, t.touch.spread)
+
+
 #: the fit's fields a touch document leaves out (the guess and estimate are given once, timing aside)
 _FIT_LEFT_OUT = ("initial", "state", "stopped", "cpu_seconds")
 
@@ -160,11 +182,17 @@ def touch_document(t, object_name: str, units: Optional[str], case: str) -> dict
         "contact_term": settings.contact_term,
         "true_state": _list(t.truth), "initial": _list(t.initial), "estimate": _list(t.estimate),
         "top_grasp": {"x": g.x, "y": g.y, "yaw": g.yaw, "spread": g.spread},
-        "grasp": t.grasp, "readings": _touch_readings(t),
+        "grasp": touch_grasp(t), "readings": _touch_readings(t),
         **{k: v for k, v in t.fit.to_dict().items() if k not in _FIT_LEFT_OUT},
         "errors_before": pose_errors_dict(t.errors_before),
         "errors_after": pose_errors_dict(t.errors_after),
     }
+
+
+def round_grasp(x, hand, spread: float) -> dict:
+    """A :class:`~bayesgrasp.loop.fusion_result.FusionRound`'s executed grasp in the grasp schema
+    (world frame, where ``hand`` closed at ``spread``)."""
+    return hand_grasp_record(hand, x.execution.hand_pose, x.execution.joint_angles, spread)
 
 
 def fusion_round_dict(r) -> dict:

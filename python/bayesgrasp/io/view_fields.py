@@ -8,6 +8,8 @@ JSON readable.
 """
 from __future__ import annotations
 
+from typing import Optional
+
 import numpy as np
 
 MAX_CLOUD_POINTS = 2000
@@ -31,15 +33,19 @@ def belief_json(particles, weights, max_particles: int = MAX_PARTICLES) -> dict:
     return {"n": int(len(X)), "particles": np.round(X[top, :3], 5).tolist(), "weights": w[top].tolist()}
 
 
-def lift_trace_json(trace, hand_pose) -> dict:
+def lift_trace_json(trace, hand_pose, lifted: Optional[bool] = None) -> dict:
     """A lift trace (:class:`bayesgrasp.lift_trace.LiftTrace`) as the object's path in the hand:
     the object frame's origin at each sample, placed at the grasp (``hand_pose``, world), so that
     a drawn path shows how far the object slipped in the hand; and the last sample's motion of the
-    object relative to the hand (4x4, world frame: object pose at the end = this @ at the grasp)."""
+    object relative to the hand (4x4, world frame: object pose at the end = this @ at the grasp);
+    ``lifted``: the lift test's verdict on the traced run, added when given."""
     H = np.asarray(hand_pose, dtype=float)
     P = trace.object_pose                                   # (S, 4, 4) in the palm frame
     path = P[:, :3, 3] @ H[:3, :3].T + H[:3, 3]
     rel = H @ P[-1] @ np.linalg.inv(trace.reference_pose) @ np.linalg.inv(H)
-    return {"time": np.round(trace.time, 4).tolist(), "path": np.round(path, 5).tolist(),
-            "phase_ends": np.asarray(trace.phase_ends, float).tolist(),
-            "displacement": np.round(trace.displacement, 5).tolist(), "slip": rel.tolist()}
+    doc = {"time": np.round(trace.time, 4).tolist(), "path": np.round(path, 5).tolist(),
+           "phase_ends": np.asarray(trace.phase_ends, float).tolist(),
+           "displacement": np.round(trace.displacement, 5).tolist(), "slip": rel.tolist()}
+    if lifted is not None:
+        doc["lifted"] = bool(lifted)
+    return doc

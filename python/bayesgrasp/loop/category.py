@@ -99,7 +99,7 @@ def execute(obj, pose, plan: CategoryPlan, rule: TaskRule, ctx: RunContext) -> T
     if not plan.ok:
         return TaskGraspOutcome(False, plan.reason, lifted=False, task_ok=False, success=False, epsilon=0.0,
                                 force_closure=False, failure="no contact")
-    world = World.single(obj, pose=pose, hand=ctx.hand, table=rule.table)
+    world = World.single(obj, pose=pose, hand=ctx.hand_model, table=rule.table)
     A = plan.pose
     g = world.approach(A[:3, 2], A[:3, 3], Hand.approach_roll(A), spread=plan.spread, frame="world", lift=True)
     parts = [c.part for c in g.contacts if not c.on_table]
@@ -165,7 +165,7 @@ def plan_and_execute(ep: CategoryEpisode, category_name: str, task: str, method:
     grasps = [g for g in grasps if g.task == task]
     s = replace(settings or CategorySettings(method=method), table=rule.table)
     key = (s.warp_samples, s.clearance_voxel, seed)
-    planner = CategoryPlanner(ctx.hand, grasps, ep.registrations, cloud=ep.observation.cloud, settings=s, seed=seed,
+    planner = CategoryPlanner(ctx.hand_model, grasps, ep.registrations, cloud=ep.observation.cloud, settings=s, seed=seed,
                               rule=rule, warped=ep.warps.get(key))
     planner.reach = reach
     plan = planner.plan()

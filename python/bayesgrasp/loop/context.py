@@ -14,17 +14,12 @@ from ..models import GraspModels, ModelSettings, get_models, parse_families
 from ..models.settings import SUCCESS_CRITERIA
 from ..objects import ObjectModel
 from ..planners import PlannerSettings
+from .result_settings import ResultSettings
 
 #: How the run seeds are made, stored with the results: each run is given run_seed(--seed, the
 #: experiment's seed name, object, run index) and uses it (stores without it derived seeds from
 #: the series name and cannot be resumed: their stored seeds are not the ones the runs used).
 RUN_SEEDS = "run_seed(seed, seed_name, object, run_index)"
-
-
-def _plain(v):
-    """A settings value as JSON would give it back (tuples as lists, numpy scalars as numbers)."""
-    import json
-    return json.loads(json.dumps(v, default=lambda o: o.tolist() if hasattr(o, "tolist") else str(o)))
 
 
 @functools.lru_cache(maxsize=8)
@@ -141,13 +136,13 @@ class RunContext:
         """The planners' settings of this context (the defaults when none were given)."""
         return self.planner or PlannerSettings()
 
-    def result_settings(self) -> dict:
-        """Every setting of this context that changes a run's result, as plain JSON values: the
-        package and cache versions, the hand (its name and a digest of its file), the success
-        criterion, the lift test on or off, the effective model settings and how run seeds are made. Stored beside an
-        experiment's results; a resume with different values is refused (runner.ResultStore)."""
+    def result_settings(self) -> ResultSettings:
+        """Every setting of this context that changes a run's result: the package and cache
+        versions, the hand (its name and a digest of its file), the success criterion, the lift test
+        on or off, the effective model and planner settings and how run seeds are made. Stored
+        beside an experiment's results (``to_dict``); a resume with different values is refused
+        (runner.ResultStore)."""
         import hashlib
-        from dataclasses import asdict
         from pathlib import Path
 
         from .. import __version__
@@ -155,13 +150,10 @@ class RunContext:
 
         hand = self.hand_model
         text = Path(hand.path).read_bytes() if getattr(hand, "path", None) else hand.name.encode()
-        models = self.model_settings or ModelSettings(success=self.success)
-        return {"bayesgrasp": __version__, "cache_version": CACHE_VERSION, "hand": hand.name,
-                "hand_file_sha256": hashlib.sha256(text).hexdigest()[:16], "success": self.success,
-                "lift": self.lift, "families": list(self.families),
-                "models": {k: _plain(v) for k, v in models.as_stored().items()},
-                "planner": {k: _plain(v) for k, v in asdict(self.planner_settings()).items()},
-                "measurement_noise": float(self.measurement_noise), "run_seeds": RUN_SEEDS}
+        return ResultSettings(__version__, CACHE_VERSION, hand.name, hashlib.sha256(text).hexdigest()[:16],
+                              self.success, self.lift, tuple(self.families),
+                              self.model_settings or ModelSettings(success=self.success), self.planner_settings(),
+                              float(self.measurement_noise), RUN_SEEDS)
 
     def for_workers(self) -> "RunContext":
         """The same context without the progress callable (worker processes get it pickled)."""

@@ -113,7 +113,7 @@ def run_episode(obj: Union[str, ObjectModel], true_pose: Sequence[float], episod
     ctx = ctx or RunContext()
     obj_model = load_object(obj) if isinstance(obj, str) else obj
     true_pose = _check_pose(true_pose)
-    world = World.single(obj_model, pose=true_pose, hand=ctx.hand)  # raises if off the table
+    world = World.single(obj_model, pose=true_pose, hand=ctx.hand_model)  # raises if off the table
     models = models or ctx.family_models(obj if isinstance(obj, str) else obj_model)
     rng = np.random.default_rng(seed)
     settings = ctx.planner_settings()

@@ -8,7 +8,6 @@ from typing import List, Optional, Tuple
 import numpy as np
 
 from ..hand import Hand
-from ..io.grasp_schema import hand_grasp_record
 from ..io.results import episode_attempt_dict, episode_dict
 from ..models.families import Variant
 from ..planners import Plan, Planner
@@ -42,7 +41,7 @@ class Attempt:
     execution : Execution — the grasp at the true pose: epsilon, stability, lift verdict, the
         simulator's joint angles, hand pose and contacts (with parts)
     measured : np.ndarray — the joint angles the planner read (the modelled ones, with noise)
-    hand : Hand — the hand that grasped (:attr:`grasp` is its grasp record)
+    hand : Hand — the hand that grasped (its grasp record: :func:`bayesgrasp.io.results.attempt_grasp`)
     belief_before : dict — the planner's belief summary the plan was made from
     belief_after : dict or None — the summary after the planner observed the attempt (None when
         the episode stopped at it)
@@ -60,12 +59,6 @@ class Attempt:
     @property
     def success(self) -> bool:
         return self.execution.success
-
-    @property
-    def grasp(self) -> dict:
-        """The executed grasp in the grasp schema (world frame, where the hand closed)."""
-        return hand_grasp_record(self.hand, self.execution.hand_pose, self.execution.joint_angles,
-                                 self.variant.spread)
 
     @property
     def lifted(self) -> Optional[bool]:

@@ -7,8 +7,6 @@ from typing import List, Optional
 
 import numpy as np
 
-from ..hand import Hand
-from ..io.grasp_schema import hand_grasp_record
 from ..io.results import fusion_dict, fusion_round_dict
 from ..planners.fusion import FusionPlan
 
@@ -53,11 +51,6 @@ class FusionRound:
     @property
     def lifted(self) -> bool:
         return self.execution.lifted
-
-    def grasp(self, hand: Hand, spread: float) -> dict:
-        """The executed grasp in the grasp schema (world frame, where the hand closed)."""
-        e = self.execution
-        return hand_grasp_record(hand, e.hand_pose, e.joint_angles, spread)
 
     def to_dict(self) -> dict:
         return fusion_round_dict(self)

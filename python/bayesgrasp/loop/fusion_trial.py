@@ -76,7 +76,7 @@ class FusionTrial:
         self.w0 = np.array([r.phi if r.success else 0.0 for r in regs])
         self.p0 = np.array([planar_pose(r.transform) for r in regs])
         self.settings = settings or FusionSettings()
-        self.world = None if obj is None else World.single(obj, pose=pose, hand=ctx.hand)
+        self.world = None if obj is None else World.single(obj, pose=pose, hand=ctx.hand_model)
         self.spread = float(np.median([m.spread for m in self.models]))
         self._warped: Optional[list] = None     # the models warped onto the view, when first needed
         #: the planner's reach (:attr:`FusionPlanner.reach`: the top grasps an arm reaches), or None

@@ -10,7 +10,6 @@ from typing import Optional
 
 import numpy as np
 
-from ..io.grasp_schema import hand_grasp_record
 from ..io.results import pose_errors_dict
 from ..planners.touch import TouchPlanner, orientation_error, read, symmetry_order, touch_world
 
@@ -68,12 +67,6 @@ class TouchTrial:
     @property
     def errors_after(self) -> PoseErrors:
         return pose_errors(self.planner.model.object, self.estimate, self.truth)
-
-    @property
-    def grasp(self) -> dict:
-        """The executed touch in the grasp schema (world frame, where the hand closed)."""
-        return hand_grasp_record(self.planner.model.hand, self.readings.hand_pose, self.readings.joints,
-                                 self.touch.spread)
 
     @property
     def contact_links(self) -> list:

@@ -56,6 +56,13 @@ METHODS = ("laplace", "regularised", "gaussian", "baseline", "part-aware", "warp
 #: or on the models warped onto the cloud (vision.deform: Coherent Point Drift)
 PART_METHODS = ("part-aware", "warped")
 THESIS_METHODS = METHODS[:4]
+#: What each method does, in one line (the command line's help reads it). Every method needs the
+#: view's registrations and the task grasps; the PART_METHODS also the task's rule.
+METHOD_HELP = {"laplace": "Eq. 4.1 with the Laplace density", "regularised": "Eq. 4.1 with the regularised Gaussian",
+               "gaussian": "Eq. 4.1 with the basic Gaussian", "baseline": "the best single demonstrated grasp",
+               "part-aware": "Eq. 4.1's candidates closed on every registered model and re-ranked by where the "
+                             "fingers land (needs the task's rule)",
+               "warped": "part-aware on the models warped onto the cloud (Coherent Point Drift)"}
 
 
 @dataclass(frozen=True)
