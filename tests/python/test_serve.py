@@ -13,6 +13,7 @@ import subprocess
 import sys
 import threading
 import time
+from pathlib import Path
 
 import httpx
 import numpy as np
@@ -279,3 +280,38 @@ def _try(f):
         return f()
     except Exception as e:   # the connection dies with the server
         return e
+
+
+# ---- the README's exchange ----------------------------------------------------------------------
+def readme_exchange() -> str:
+    text = (Path(__file__).resolve().parents[2] / "README.md").read_text()
+    start = text.index("```bash\n.venv/bin/bayesgrasp serve") + len("```bash\n")
+    return text[start:text.index("```", start)]
+
+
+def test_the_readme_s_curl_exchange_runs_as_written(tmp_path):
+    """The README's block in a fresh directory (our interpreter for .venv/bin/bayesgrasp, a free
+    port for 8765): the grasps are the README transcript's, the call without a token is refused."""
+    port = free_port()
+    script = readme_exchange().replace(".venv/bin/bayesgrasp", f"{sys.executable} -m bayesgrasp.cli") \
+        .replace("8765", str(port))
+    assert f"--port {port}" in script
+    env = dict(os.environ, PYTHONPATH=os.pathsep.join(   # absolute: the block runs elsewhere
+        str(Path(p).resolve()) for p in os.environ.get("PYTHONPATH", "").split(os.pathsep) if p))
+    p = subprocess.Popen(["bash", "-c", script], cwd=tmp_path, stdout=subprocess.PIPE, stderr=subprocess.PIPE,
+                         text=True, env=env, start_new_session=True)
+    try:
+        out, err = p.communicate(timeout=180)
+    finally:
+        try:
+            os.killpg(p.pid, signal.SIGKILL)      # the block's server too, if it is still there
+        except ProcessLookupError:
+            pass
+    assert p.returncode == 0, err
+    new, observed, shown, health = [json.loads(line) for line in out.splitlines()]
+    assert new["id"] == "ep1" and new["status"] == "open"
+    np.testing.assert_allclose(new["next"]["top_grasp"], [0.0386, -0.0389, -2.3817], atol=5e-5)   # the README's
+    np.testing.assert_allclose(observed["next"]["top_grasp"], [0.0393, -0.0242, -0.6219], atol=5e-5)
+    assert observed["attempts_made"] == 1 and len(shown["steps"]) == 1 and shown["status"] == "open"
+    assert health["error"]["code"] == "unauthorized"
+    assert (tmp_path / "episodes" / "ep1" / "episode.json").is_file()
