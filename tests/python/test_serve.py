@@ -8,6 +8,7 @@ The objects are the cylinder with the default model settings, whose models ship 
 import json
 import os
 import signal
+import ssl
 import stat
 import subprocess
 import sys
@@ -34,9 +35,9 @@ START_SECONDS = 120
 class Server:
     """``bayesgrasp serve`` in a subprocess (this process's environment: the same core and path)."""
 
-    def __init__(self, episodes, token_file, port=None, extra=()):
+    def __init__(self, episodes, token_file, port=None, extra=(), verify=True):
         self.port = port or free_port()
-        self.url = f"http://127.0.0.1:{self.port}"
+        self.url = f"{'https' if '--certfile' in extra else 'http'}://127.0.0.1:{self.port}"
         self.episodes, self.token_file = episodes, token_file
         self.log = open(episodes.parent / f"server-{self.port}.log", "ab")
         self.proc = subprocess.Popen([sys.executable, "-m", "bayesgrasp.cli", "serve", "--port", str(self.port),
@@ -46,7 +47,7 @@ class Server:
         while True:
             assert self.proc.poll() is None, self.output()
             try:
-                if httpx.get(self.url + "/v1/health", timeout=2).status_code == 401:
+                if httpx.get(self.url + "/v1/health", timeout=2, verify=verify).status_code == 401:
                     break
             except httpx.TransportError:
                 pass
@@ -226,6 +227,91 @@ def test_the_token_is_made_once_with_owner_only_permissions(tmp_path):
     assert created and len(token) >= 32
     assert stat.S_IMODE(os.stat(tmp_path / "t" / "token").st_mode) == 0o600
     assert load_or_create_token(tmp_path / "t" / "token") == (token, False)
+
+
+# ---- episodes at once, and the episode command beside the service -----------------------------
+def test_concurrent_episodes_each_get_the_grasps_of_a_lone_one(client):
+    """Six episodes observed from six threads at once, and two observations of one episode sent
+    together: every episode ends as the same episode driven alone, each reading applied once."""
+    readings = [GOOD["joints"], [0.7854, 1.4316, 1.2102, 1.3176, 1.1722, 1.4873, 1.2288]]
+    alone = client.new_episode(**new_body("stability", 4, id="alone"))
+    for k, q in enumerate(readings):
+        alone = client.observe("alone", q, False, request_id=f"alone-{k}")
+    ids = [client.new_episode(**new_body("stability", 4, id=f"conc-{i}"))["id"] for i in range(6)]
+    out = {}
+
+    def run(eid):
+        for k, q in enumerate(readings):
+            out[eid] = client.observe(eid, q, False, request_id=f"{eid}-{k}")
+
+    threads = [threading.Thread(target=run, args=(eid,)) for eid in ids]
+    for t in threads:
+        t.start()
+    for t in threads:
+        t.join(300)
+    assert all(out[eid] == {**alone, "id": eid} for eid in ids)
+    # one episode, two observations at once: the lock puts them one after the other, both applied once
+    client.new_episode(**new_body("stability", 4, id="same"))
+    replies = {}
+    pair = [threading.Thread(target=lambda k=k: replies.update({k: client.observe("same", readings[k], False,
+                                                                                  request_id=f"same-{k}")}))
+            for k in range(2)]
+    for t in pair:
+        t.start()
+    for t in pair:
+        t.join(300)
+    steps = client.episode("same")["steps"]
+    assert len(steps) == 2 and sorted(r["attempts_made"] for r in replies.values()) == [1, 2]
+    assert sorted(s["joints"] for s in steps) == sorted(readings)
+
+
+def test_the_episode_command_and_the_service_continue_each_other_s_episode(capsys, server, client):
+    """A step by `bayesgrasp episode observe` on the server's directory, the next through the API
+    (the warm episode is reopened from disk): the same as two steps through the API."""
+    second = [0.7854, 1.4316, 1.2102, 1.3176, 1.1722, 1.4873, 1.2288]
+    client.new_episode(**new_body("stability", 4, id="api-only"))
+    client.observe("api-only", GOOD["joints"], False, request_id="a1")
+    ref = client.observe("api-only", second, False, request_id="a2")
+    client.new_episode(**new_body("stability", 4, id="mixed"))
+    cli_json(capsys, "episode", "observe", server.episodes / "mixed", "--joints", ",".join(map(str, GOOD["joints"])),
+             "--lifted", "no", "--json")
+    assert client.observe("mixed", second, False, request_id="m2") == {**ref, "id": "mixed"}
+    assert client.episode("mixed")["belief"] == client.episode("api-only")["belief"]
+
+
+# ---- TLS and the command's own refusals ---------------------------------------------------------
+def test_with_a_certificate_and_key_it_serves_https_only(tmp_path):
+    cert, key = tmp_path / "cert.pem", tmp_path / "key.pem"
+    subprocess.run(["openssl", "req", "-x509", "-newkey", "rsa:2048", "-nodes", "-keyout", str(key), "-out",
+                    str(cert), "-days", "1", "-subj", "/CN=127.0.0.1", "-addext", "subjectAltName=IP:127.0.0.1"],
+                   check=True, capture_output=True)
+    (tmp_path / "token").write_text(TOKEN)
+    s = Server(tmp_path / "episodes", tmp_path / "token", extra=("--certfile", str(cert), "--keyfile", str(key)),
+               verify=ssl.create_default_context(cafile=str(cert)))
+    try:
+        assert s.url.startswith("https://")
+        assert Client(s.url, TOKEN, cafile=str(cert)).health()["status"] == "ok"
+        with pytest.raises(httpx.TransportError):            # plain HTTP gets no answer
+            httpx.get(f"http://127.0.0.1:{s.port}/v1/health", timeout=10)
+        with pytest.raises(httpx.TransportError):            # nor does a client that does not trust the cert
+            httpx.get(s.url + "/v1/health", timeout=10)
+    finally:
+        s.stop()
+
+
+@pytest.mark.parametrize("argv, needle", [
+    (["--certfile", "c.pem"], "--certfile, --keyfile: give both"),
+    (["--certfile", "c.pem", "--keyfile", "k.pem"], "--certfile: no such file"),
+    (["--token-file", "short"], "must hold one token of at least 16 characters"),
+])
+def test_the_command_refuses_bad_options_before_serving(capsys, tmp_path, monkeypatch, argv, needle):
+    from bayesgrasp.cli import main
+
+    monkeypatch.chdir(tmp_path)
+    (tmp_path / "short").write_text("abc\n")
+    assert main(["serve", "--episodes", "eps", "--port", str(free_port()), *argv]) == 2
+    err = capsys.readouterr().err
+    assert needle in err and len(err.strip().splitlines()) == 1, err
 
 
 # ---- a SIGKILL in the middle of an observation --------------------------------------------------
