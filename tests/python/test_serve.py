@@ -198,6 +198,7 @@ def test_a_bad_episode_start_is_refused_and_leaves_no_directory(server, client):
     for body, needle in [(new_body("stability", 2, id="bad1", object="../../etc/passwd"), "object"),
                          (new_body("stability", 2, id="bad2", object="no_such_thing"), "not a built-in object"),
                          (new_body("grip", 2, id="bad3"), "method"),
+                         (new_body("stability", 2, id="bad5", hand="token"), "not a built-in hand"),
                          (new_body("stability", 2, id="bad4", models={"n_sampels": 5}), "models.n_sampels")]:
         with pytest.raises(ServiceError) as e:
             client.new_episode(**body)

@@ -26,7 +26,7 @@ import numpy as np
 
 from .. import __version__
 from ..cache import atomic_write_text
-from ..hand import Hand
+from ..hand import Hand, builtin_hands
 from ..io.grasp_schema import hand_grasp_record
 from ..models import GraspModels, ModelSettings, relative_top_grasps
 from ..objects import ObjectModel, load_object, object_params
@@ -109,6 +109,13 @@ def check_builtin_object(name: str, what: str = "object") -> str:
     """``name`` if it is a built-in object's (``mug``, ``mug/3``): never a file."""
     if not isinstance(name, str) or object_params(name) is None:
         raise EpisodeError(f"{what}: not a built-in object name, got {name!r} (see `bayesgrasp objects`)")
+    return name
+
+
+def check_builtin_hand(name: str, what: str = "hand") -> str:
+    """``name`` if it is a built-in hand's (``barrett_bh8``, ``barrett_bh8.urdf``): never a file."""
+    if name not in builtin_hands():
+        raise EpisodeError(f"{what}: not a built-in hand, got {name!r} (built-in: {', '.join(builtin_hands())})")
     return name
 
 

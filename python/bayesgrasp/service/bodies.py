@@ -33,7 +33,7 @@ class Planning(_Body):
     viewpoint: Optional[Triple] = Field(None, min_length=3, max_length=3, description="the camera centre (m)")
     exclude: Optional[List[str]] = None
     seed: int = Field(0, ge=0, le=2**63 - 1)
-    hand: str = Field(RunContext.hand, pattern=NAME, description="built-in hand name")
+    hand: str = Field(RunContext.hand, pattern=NAME[:-1] + r"(\.urdf)?$", description="built-in hand name")
     models: Dict[str, Union[int, float, bool, str, None, List[float]]] = Field(
         default_factory=dict, description="ModelSettings overrides (as --set models.FIELD=VALUE)")
     planner: Dict[str, Union[int, float, bool, str, None, List[float]]] = Field(

@@ -10,7 +10,7 @@ import numpy as np
 
 from ..loop.category import Observation, observe
 from ..loop.context import context_from_plain
-from ..loop.outside_loop import METHODS as POSE_METHODS, PoseEpisode, check_builtin_object
+from ..loop.outside_loop import METHODS as POSE_METHODS, PoseEpisode, check_builtin_hand, check_builtin_object
 from ..loop.outside_loop_category import CATEGORY_METHODS, CategoryTaskEpisode, FusionEpisode
 from .bodies import NewEpisode, Planning
 from .errors import ApiError
@@ -24,6 +24,7 @@ def _context(body: Planning, cache_dir: Optional[str], reads=("models", "planner
     for group in ("models", "planner"):
         if getattr(body, group) and group not in reads:
             _refuse(group, "this kind of episode does not read these settings")
+    check_builtin_hand(body.hand)
     try:
         return context_from_plain(body.hand, cache_dir, body.seed, body.models, body.planner)
     except ValueError as e:
