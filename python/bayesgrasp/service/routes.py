@@ -47,10 +47,13 @@ def new_episode(body: NewEpisode, request: Request):
     with store.lock(eid):
         d = store.directory(eid)
         if (d / STATE_FILE).is_file():
-            record = RequestLog(d).get(CREATE)
-            if body.id and record and record["digest"] == digest and record["reply"] is not None:
-                return JSONResponse(record["reply"], status_code=200)   # a retried creation
-            raise ApiError(409, "episode_exists", f"episode {eid!r} exists (started with another body)")
+            warm = store.get(eid)
+            record = warm.log.get(CREATE)
+            if not (body.id and record and record["digest"] == digest):
+                raise ApiError(409, "episode_exists", f"episode {eid!r} exists (started with another body)")
+            if record["reply"] is None:                   # created before a crash; the reply was not recorded
+                warm.log.finish(CREATE, episode_reply(eid, warm.episode))
+            return JSONResponse(warm.log.get(CREATE)["reply"], status_code=200)   # a retried creation
         fresh = not d.exists()
         log = RequestLog(d)
         with store.creating:
