@@ -145,11 +145,13 @@ def in_process(root: Path, steps: int) -> dict:
     return {"observations": steps, "median_ms": 1e3 * statistics.median(times), "p99_ms": 1e3 * pct(times, 99)}
 
 
-def faults(server: Server, n: int, total: int, kill_every: float) -> dict:
-    """`total` observations over `n` episodes while the server is killed every `kill_every` s."""
-    c = Client(f"http://127.0.0.1:{server.port}", TOKEN, timeout=120, retries=12, backoff=0.25)
+def faults(server: Server, n: int, total: int, kill_every: float, max_kills: int) -> dict:
+    """`total` observations over `n` episodes while the server is killed every `kill_every` s (at
+    most `max_kills` times: the run stays bounded even when restarts outlast the interval)."""
+    c = Client(f"http://127.0.0.1:{server.port}", TOKEN, timeout=120, retries=60, backoff=0.25, max_backoff=2.0)
     ids = [c.new_episode(**BODY, attempts=1000, id=f"fault-{i}")["id"] for i in range(n)]
     answered = {e: [] for e in ids}
+    waits: list = []                  # s from sending an observation to its answer, retries included
     per = [total // n + (1 if i < total % n else 0) for i in range(n)]
     errors: dict = {}                 # episode -> why its client gave up (its last observation unanswered)
     done = threading.Event()
@@ -157,7 +159,9 @@ def faults(server: Server, n: int, total: int, kill_every: float) -> dict:
     def run(eid, count):
         try:
             for k in range(count):
+                t0 = time.perf_counter()
                 reply = c.observe(eid, READINGS[k % len(READINGS)], False, request_id=f"{eid}-{k}")
+                waits.append(time.perf_counter() - t0)
                 assert reply["attempts_made"] == k + 1, (eid, k, reply["attempts_made"])
                 answered[eid].append(k)
         except Exception as e:   # counted: an observation the client gave up on
@@ -167,7 +171,7 @@ def faults(server: Server, n: int, total: int, kill_every: float) -> dict:
 
     def killer():
         nonlocal kills
-        while not done.wait(kill_every):
+        while kills < max_kills and not done.wait(kill_every):
             server.kill()
             kills += 1
             restarts.append(server.start())
@@ -194,7 +198,8 @@ def faults(server: Server, n: int, total: int, kill_every: float) -> dict:
                 dup += 1
     return {"episodes": n, "observations": sum(len(a) for a in answered.values()), "kills": kills,
             "restart_s_median": statistics.median(restarts) if restarts else None, "lost": lost,
-            "duplicated": dup, "client_errors": len(errors), "wall_s": wall, "errors": list(errors.values())[:3]}
+            "duplicated": dup, "client_errors": len(errors),
+            "answer_s_median": statistics.median(waits) if waits else None, "answer_s_max": max(waits, default=None), "wall_s": wall, "errors": list(errors.values())[:3]}
 
 
 def main() -> int:
@@ -205,6 +210,7 @@ def main() -> int:
     p.add_argument("--fault-episodes", type=int, default=32)
     p.add_argument("--fault-observations", type=int, default=500)
     p.add_argument("--kill-every", type=float, default=20.0, help="seconds between SIGKILLs of the server")
+    p.add_argument("--max-kills", type=int, default=10, help="kills at most (the fault run stays bounded)")
     p.add_argument("--no-faults", action="store_true")
     p.add_argument("--no-latency", action="store_true")
     a = p.parse_args()
@@ -228,7 +234,8 @@ def main() -> int:
                 out["cli"] = cli_steps(root, a.cli_steps)
                 say(f"episode command: median {out['cli']['median_ms']:.0f} ms per step")
             if not a.no_faults:
-                out["faults"] = faults(server, a.fault_episodes, a.fault_observations, a.kill_every)
+                out["faults"] = faults(server, a.fault_episodes, a.fault_observations, a.kill_every,
+                                       a.max_kills)
                 f = out["faults"]
                 say(f"faults: {f['observations']} observations, {f['kills']} kills, lost {f['lost']}, "
                     f"duplicated {f['duplicated']}, client errors {f['client_errors']}")

@@ -33,12 +33,16 @@ class ServiceError(Exception):
 class Client:
     """``base_url``: e.g. ``http://127.0.0.1:8765``; ``token``: the server's bearer token;
     ``cafile``: the certificate to trust for an HTTPS server with a self-signed one; ``retries``,
-    ``backoff``: how often and how long (s, doubling) to retry an observation that got no answer."""
+    ``backoff``, ``max_backoff``: how often to retry an observation that got no answer, and how
+    long to wait before each retry (s, doubling from ``backoff`` up to ``max_backoff``)."""
 
     def __init__(self, base_url: str, token: str, timeout: float = 60.0, cafile: Optional[str] = None,
-                 retries: int = 5, backoff: float = 0.5):
+                 retries: int = 5, backoff: float = 0.5, max_backoff: float = 5.0):
+        if retries < 0 or not 0 < backoff <= max_backoff:
+            raise ValueError(f"retries >= 0 and 0 < backoff <= max_backoff, got {retries}, {backoff}, {max_backoff}")
         self.base = base_url.rstrip("/") + "/v1"
-        self.token, self.timeout, self.retries, self.backoff = token, timeout, retries, backoff
+        self.token, self.timeout, self.retries = token, timeout, retries
+        self.backoff, self.max_backoff = backoff, max_backoff
         self.context = ssl.create_default_context(cafile=cafile) if cafile else None
 
     def _call(self, method: str, path: str, body: Optional[dict] = None) -> dict:
@@ -77,7 +81,7 @@ class Client:
             except (urllib.error.URLError, ConnectionError, TimeoutError):
                 if i == self.retries:
                     raise
-                time.sleep(self.backoff * 2 ** i)
+                time.sleep(min(self.backoff * 2 ** i, self.max_backoff))
 
     def episode(self, episode_id: str) -> dict:
         """``GET /v1/episodes/{id}``: the history and the belief."""
