@@ -350,9 +350,14 @@ def test_a_server_killed_mid_observation_and_restarted_loses_and_repeats_nothing
         t.join(60)
         assert isinstance(result["reply"], Exception)       # the client got no reply: it retries
         s.stop()
-        s = Server(episodes, token_file, port=s.port)
-        c = Client(s.url, token)
+        # the client retries while the server restarts (its start takes seconds), the same request id
+        restarted = {}
+        starter = threading.Thread(target=lambda: restarted.update(s=Server(episodes, token_file, port=s.port)))
+        starter.start()
+        c = Client(s.url, token, retries=400, backoff=0.1, max_backoff=0.5)
         reply = c.observe(eid, GOOD["joints"], False, request_id="kill-1")
+        starter.join(START_SECONDS)
+        s = restarted["s"]
         assert reply == {**expected, "id": eid}
         assert c.observe(eid, GOOD["joints"], False, request_id="kill-1") == reply
         steps = c.episode(eid)["steps"]
