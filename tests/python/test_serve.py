@@ -133,6 +133,16 @@ def test_the_first_grasp_equals_the_episode_command_s_and_the_one_shot_plan_s(ca
     one_shot = client.plan(object=OBJ, estimate=EST, method="stability", seed=SEED)
     assert by_api["next"] == by_cli["next"] == one_shot["next"]
     assert by_api["status"] == "open" and by_api["attempts_made"] == 0
+    from bayesgrasp.io.grasp_schema import validate
+    validate(by_api["next"]["grasp"])                          # the grasp schema's shape
+
+
+def test_the_api_is_described_by_openapi_behind_the_token(server):
+    doc = httpx.get(server.url + "/openapi.json", headers=AUTH, timeout=30).json()
+    assert {"/v1/episodes", "/v1/episodes/{eid}/observations", "/v1/episodes/{eid}", "/v1/plan",
+            "/v1/health"} <= set(doc["paths"])
+    assert set(doc["components"]["schemas"]["Observation"]["required"]) == {"joints", "lifted", "request_id"}
+    assert httpx.get(server.url + "/openapi.json", timeout=30).status_code == 401
 
 
 # ---- refusals -----------------------------------------------------------------------------------
