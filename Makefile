@@ -37,7 +37,7 @@ deps: build/.deps-ok
 $(VENV)/.base: build/.deps-ok Makefile
 	$(PYTHON) -m venv $(VENV)
 	$(PY) -m pip install -q --upgrade pip
-	$(PY) -m pip install -q "scikit-build-core>=0.10" "pybind11>=2.12" ninja numpy scipy matplotlib trimesh manifold3d "coacd>=1.0.14,<1.1" tqdm pytest scikit-learn hypothesis "open3d>=0.18" "jsonschema>=4.0" "viser>=1.0" "selenium>=4.20" "ray>=2.9" "yourdfpy>=0.0.56" "pin>=4.1"
+	$(PY) -m pip install -q "scikit-build-core>=0.10" "pybind11>=2.12" ninja numpy scipy matplotlib trimesh manifold3d "coacd>=1.0.14,<1.1" tqdm pytest scikit-learn hypothesis "open3d>=0.18" "jsonschema>=4.0" "viser>=1.0" "selenium>=4.20" "ray>=2.9" "yourdfpy>=0.0.56" "pin>=4.1" "fastapi>=0.110" "uvicorn>=0.29" "httpx>=0.24"
 	@touch $@
 
 # The package is built by scikit-build-core in build/py (kept between builds, so a second

@@ -4,6 +4,7 @@ Sub-commands:
   demo        the main job: plan, grasp, update the belief, re-plan, on a built-in mug
   plan        the same loop for any object (built-in or mesh file) at a given true pose
   episode     the same loop with your robot executing: new, observe (joints, lifted), show
+  serve       the episode loop as an HTTP JSON service for a robot's stack (token, TLS)
   experiment  the thesis's experiments (pub2, baselines, pub4, entropy_order, landscapes)
   results     an experiment's stored results as SQL tables (--sql QUERY, --csv)
   grasp       close the hand on an object from a top grasp, an approach direction or a hand pose
@@ -23,11 +24,11 @@ import os
 import sys
 import warnings
 
-from . import category, episode, experiment, fuse, grasp, objects, parts, plan, register, results, touch, view
+from . import category, episode, experiment, fuse, grasp, objects, parts, plan, register, results, serve, touch, view
 from .. import __version__
 from .args import CliError, join_negative_values
 
-COMMANDS = (grasp, plan, episode, category, fuse, experiment, results, register, objects, parts, touch, view)
+COMMANDS = (grasp, plan, episode, serve, category, fuse, experiment, results, register, objects, parts, touch, view)
 
 
 class HelpFormatter(argparse.RawDescriptionHelpFormatter):

@@ -158,3 +158,30 @@ class RunContext:
     def for_workers(self) -> "RunContext":
         """The same context without the progress callable (worker processes get it pickled)."""
         return replace(self, progress=None)
+
+
+def context_from_plain(hand: str = DEFAULT_HAND, cache_dir: Optional[str] = None, seed: int = 0,
+                       models: Optional[dict] = None, planner: Optional[dict] = None) -> RunContext:
+    """A lift-judged :class:`RunContext` from plain values (a service's JSON body): ``models`` and
+    ``planner`` are {field: value} overrides of ModelSettings and PlannerSettings (None or {}: the
+    defaults). A wrong field or value is a ValueError naming ``models.FIELD`` or ``planner.FIELD``."""
+    import dataclasses
+
+    def build(cls, group: str, values: dict, **fixed):
+        known = {f.name for f in dataclasses.fields(cls)}
+        unknown = sorted(set(values) - known)
+        for name in fixed:
+            if name in values:
+                raise ValueError(f"{group}.{name}: fixed at {fixed[name]!r} here")
+        if unknown:
+            raise ValueError(f"{group}.{unknown[0]}: no such setting (known: {', '.join(sorted(known))})")
+        for k, v in values.items():   # lists from JSON are the settings' tuples
+            values[k] = tuple(v) if isinstance(v, list) else v
+        try:
+            return cls(**fixed, **values)
+        except (TypeError, ValueError) as e:
+            raise ValueError(f"{group}.{e}") from None
+
+    ms = build(ModelSettings, "models", dict(models), success="lift") if models else None
+    ps = build(PlannerSettings, "planner", dict(planner)) if planner else None
+    return RunContext(hand=hand, cache_dir=cache_dir, seed=int(seed), model_settings=ms, planner=ps)

@@ -26,10 +26,10 @@ import numpy as np
 
 from .. import __version__
 from ..cache import atomic_write_text
-from ..hand import Hand
+from ..hand import Hand, builtin_hands
 from ..io.grasp_schema import hand_grasp_record
 from ..models import GraspModels, ModelSettings, relative_top_grasps
-from ..objects import ObjectModel, load_object
+from ..objects import ObjectModel, load_object, object_params
 from ..planners import PlannerSettings, Reading, make_planner
 from ..world import World
 from .context import RunContext
@@ -103,6 +103,20 @@ def check_joints(joints, hand: Hand) -> np.ndarray:
         raise EpisodeError(f"--joints: {names[i]} = {q[i]:g} lies outside its limits [{lim[i, 0]:.3f}, {lim[i, 1]:.3f}] "
                            "rad (degrees instead of radians?)")
     return q
+
+
+def check_builtin_object(name: str, what: str = "object") -> str:
+    """``name`` if it is a built-in object's (``mug``, ``mug/3``): never a file."""
+    if not isinstance(name, str) or object_params(name) is None:
+        raise EpisodeError(f"{what}: not a built-in object name, got {name!r} (see `bayesgrasp objects`)")
+    return name
+
+
+def check_builtin_hand(name: str, what: str = "hand") -> str:
+    """``name`` if it is a built-in hand's (``barrett_bh8``, ``barrett_bh8.urdf``): never a file."""
+    if name not in builtin_hands():
+        raise EpisodeError(f"{what}: not a built-in hand, got {name!r} (built-in: {', '.join(builtin_hands())})")
+    return name
 
 
 def check_lifted(text: Union[str, bool]) -> bool:
@@ -264,7 +278,22 @@ class PoseEpisode(DiskEpisode):
             planner: Optional[PlannerSettings] = None, units: Optional[str] = None) -> "PoseEpisode":
         """``obj``: a built-in name, a mesh file or an ObjectModel (a file's is stored by its path);
         ``units``: the mesh file's length unit, stored so that a later process reads it alike."""
-        directory = Path(directory)
+        episode = cls._unwritten(Path(directory), obj, estimate, ctx, method, attempts, seed, planner, units)
+        episode._create()
+        return episode
+
+    @classmethod
+    def first_grasp(cls, obj: Union[str, ObjectModel], estimate: Sequence[float], ctx: RunContext,
+                    method: str = "explore", seed: int = 0, planner: Optional[PlannerSettings] = None) -> dict:
+        """The grasp :meth:`new` would plan first (its ``next``), written nowhere: a one-shot question."""
+        episode = cls._unwritten(Path("<one-shot>"), obj, estimate, ctx, method, 1, seed, planner, None)
+        episode._plan_next()
+        return episode.next
+
+    @classmethod
+    def _unwritten(cls, directory: Path, obj, estimate, ctx: RunContext, method: str, attempts: int, seed: int,
+                   planner: Optional[PlannerSettings], units: Optional[str]) -> "PoseEpisode":
+        """The new episode with its planner, before its first plan and before anything is written."""
         if method not in METHODS:
             raise EpisodeError(f"--method: one of {', '.join(METHODS)}; got {method!r}")
         if (directory / STATE_FILE).exists():
@@ -281,9 +310,7 @@ class PoseEpisode(DiskEpisode):
             state["units"] = units
         state.update({"object": stored, "models_key": models.info.get("key"),
                       "method": method, "estimate": est.tolist(), "planner": settings_json(settings)})
-        episode = cls(directory, state, ctx, obj_model)
-        episode._create()
-        return episode
+        return cls(directory, state, ctx, obj_model)
 
     def belief(self) -> dict:
         """The belief now: the summary, and the SHA-256 of its particles and weights (bit-for-bit checks)."""

@@ -1,0 +1,96 @@
+"""A new episode or a one-shot plan from a request body: the kind of episode its fields ask for,
+started through the loop as ``bayesgrasp episode new`` starts it (the same calls, so the same
+grasps), with the server's model cache."""
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Optional
+
+import numpy as np
+
+from ..loop.category import Observation, observe
+from ..loop.context import context_from_plain
+from ..loop.outside_loop import METHODS as POSE_METHODS, PoseEpisode, check_builtin_hand, check_builtin_object
+from ..loop.outside_loop_category import CATEGORY_METHODS, CategoryTaskEpisode, FusionEpisode
+from .bodies import NewEpisode, Planning
+from .errors import ApiError
+
+
+def _refuse(field: str, why: str):
+    raise ApiError(422, "invalid_body", f"{field}: {why}")
+
+
+def _context(body: Planning, cache_dir: Optional[str], reads=("models", "planner")):
+    for group in ("models", "planner"):
+        if getattr(body, group) and group not in reads:
+            _refuse(group, "this kind of episode does not read these settings")
+    check_builtin_hand(body.hand)
+    try:
+        return context_from_plain(body.hand, cache_dir, body.seed, body.models, body.planner)
+    except ValueError as e:
+        _refuse("settings", str(e))
+
+
+def _pose_inputs(body: Planning):
+    if body.object is None:
+        _refuse("object", "needed (the object whose pose is uncertain), or give category and task")
+    if body.estimate is None:
+        _refuse("estimate", "needed: the object's estimated x, y (m) and yaw (rad) on the table")
+    for field in ("cloud", "viewpoint", "exclude"):
+        if getattr(body, field) is not None:
+            _refuse(field, "only with category and task")
+    method = body.method or "explore"
+    if method not in POSE_METHODS:
+        _refuse("method", f"one of {', '.join(POSE_METHODS)} for a pose episode (a category method needs category "
+                          f"and task), got {method!r}")
+    return check_builtin_object(body.object), method
+
+
+def _view(body: Planning, seed: int) -> Observation:
+    """The view to plan from: the client's cloud, or the simulated view of a built-in object."""
+    if body.cloud is not None:
+        if body.viewpoint is None:
+            _refuse("viewpoint", "needed with cloud (the camera centre, m)")
+        return Observation(np.asarray(body.cloud, float), np.asarray(body.viewpoint, float))
+    if body.object is None:
+        _refuse("cloud", "cloud + viewpoint, or object: the view to plan from")
+    return observe(check_builtin_object(body.object), tuple(body.object_pose), seed=seed)
+
+
+def _category_method(body: Planning) -> str:
+    if body.estimate is not None:
+        _refuse("estimate", "not with category (the view's registrations place the models)")
+    method = body.method or "laplace"
+    if method not in CATEGORY_METHODS + ("fusion",):
+        _refuse("method", f"with category one of {', '.join(CATEGORY_METHODS + ('fusion',))}, got {method!r}")
+    return method
+
+
+def start_episode(directory: Path, body: NewEpisode, cache_dir: Optional[str]):
+    """The episode ``body`` asks for, written to ``directory`` with its first grasp planned."""
+    if bool(body.category) != bool(body.task):
+        _refuse("category, task", "give both")
+    if not body.category:
+        obj, method = _pose_inputs(body)
+        ctx = _context(body, cache_dir)
+        return PoseEpisode.new(directory, obj, body.estimate, ctx, method=method, attempts=body.attempts,
+                               seed=ctx.seed, planner=ctx.planner_settings())
+    method = _category_method(body)
+    ctx = _context(body, cache_dir, reads=("models",) if method == "fusion" else ())
+    view = _view(body, ctx.seed)
+    exclude = body.exclude if body.exclude is not None else [m for m in [body.object] if m]   # as the CLI
+    common = dict(exclude=exclude, seed=ctx.seed, grasps=None)
+    if method == "fusion":
+        return FusionEpisode.new(directory, view, body.category, body.task, ctx, attempts=body.attempts, **common)
+    return CategoryTaskEpisode.new(directory, view, body.category, body.task, ctx, method=method, **common)
+
+
+def first_grasp(body: Planning, cache_dir: Optional[str]) -> dict:
+    """The first grasp of the pose episode ``body`` describes (as :func:`start_episode` would plan
+    it), written nowhere."""
+    if body.category or body.task:
+        _refuse("category", "one-shot plans are for pose questions here; start an episode for a category task")
+    obj, method = _pose_inputs(body)
+    ctx = _context(body, cache_dir)
+    return PoseEpisode.first_grasp(obj, body.estimate, ctx, method=method, seed=ctx.seed,
+                                   planner=ctx.planner_settings())
