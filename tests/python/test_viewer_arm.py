@@ -163,3 +163,27 @@ def test_the_matplotlib_fallback_draws_the_arm_as_a_stick_figure(grasp_doc, tmp_
     a, b = np.asarray(mpimg.imread(with_))[..., :3], np.asarray(mpimg.imread(without))[..., :3]
     dark = lambda img: int(np.all(img < 0.25, axis=-1).sum())        # the stick is drawn near-black, 3 px wide
     assert a.shape == b.shape and dark(a) > dark(b) + 300
+
+
+def test_a_link_given_as_a_mesh_file_is_drawn_as_that_mesh(grasp_doc, tmp_path):
+    """One revolute joint at z = 0.1 turning q about z, its link a 0.04 x 0.06 x 0.3 box written
+    as an STL, scaled 2 along z and placed 0.15 m up the joint's z: drawn as that box's 8 corners,
+    0.6 m long, its centre at z = 0.25, turned by q."""
+    import trimesh
+
+    trimesh.creation.box(extents=(0.04, 0.06, 0.3)).export(tmp_path / "link.stl")
+    urdf = tmp_path / "arm.urdf"
+    urdf.write_text('<?xml version="1.0"?><robot name="mesh_arm"><link name="base"/>'
+                    '<joint name="j1" type="revolute"><origin xyz="0 0 0.1"/><axis xyz="0 0 1"/>'
+                    '<limit lower="-3" upper="3" effort="1" velocity="1"/><parent link="base"/><child link="l1"/></joint>'
+                    '<link name="l1"><collision><origin xyz="0 0 0.15"/><geometry>'
+                    '<mesh filename="link.stl" scale="1 1 2"/></geometry></collision></link></robot>')
+    q = 0.3
+    nodes, _ = served_nodes(scene_from_result(with_arm(grasp_doc, record(urdf, np.eye(4), [q]))))
+    link = arm_nodes(nodes)["l1_0-0"]
+    V = np.asarray(link.vertices)
+    assert len(V) == 8
+    np.testing.assert_allclose(np.ptp(V, axis=0), [0.04, 0.06, 0.6], atol=1e-6)
+    T = pose(link)
+    np.testing.assert_allclose(T[:3, 3], [0, 0, 0.25], atol=1e-9)
+    np.testing.assert_allclose(T[:3, :3], Rotation.from_euler("z", q).as_matrix(), atol=1e-9)
