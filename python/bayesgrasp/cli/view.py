@@ -1,7 +1,8 @@
 """``bayesgrasp view FILE.json``: any command's JSON output in 3D in the browser (viser): the
 object with its parts coloured and the table, the camera's cloud, the registered models with their
 weights, and per attempt or round the hand at the grasp (fingers at the read joint angles), the
-pre-grasp, the approach and the contacts with their normals; a slider steps through the attempts,
+pre-grasp, the approach and the contacts with their normals, and the arm (a grasp made with
+``--robot``) holding the hand; a slider steps through the attempts,
 toggles switch the layers. The server listens on localhost (over SSH: ``ssh -L 8080:localhost:8080
 HOST``, then open http://localhost:8080); Ctrl-C stops it."""
 from __future__ import annotations

@@ -6,7 +6,12 @@ toggle per layer. Node names (the tests check them through viser's scene API):
 ``/steps/k/normals``, ``/steps/k/models/<name>``, ``/steps/k/particles`` (one point per particle,
 coloured by weight), ``/steps/k/particle_copies`` (the heaviest as faint copies of the object),
 ``/steps/k/lift_trace`` (the object's path in the hand) and ``/steps/k/lift_end`` (the object where
-the lift left it, relative to the hand).
+the lift left it, relative to the hand). A grasp record with a reachable ``arm`` adds the arm's
+moving collision shapes at the grasp, ``/steps/k/arm/<shape>-<i>`` (each a mesh in the shape's own
+frame, the node posed by the arm's forward kinematics), its base and palm frames
+``/steps/k/arm/base`` and ``/steps/k/arm/palm``, and the same shapes faint at the pre-grasp,
+``/steps/k/arm_pregrasp/<shape>-<i>`` (the "pregrasp" toggle); an unreachable one draws no arm and
+its reason is in the step's text.
 """
 from __future__ import annotations
 
@@ -20,12 +25,14 @@ import numpy as np
 
 from ..hand import Hand, builtin_hands
 from ..viz import shape_mesh
+from .arm import arm_view, link_meshes, stick_points
 from .scene import ResultScene, Step, planar_transform
 
-LAYERS = ("object", "hand", "pregrasp", "approach", "contacts", "models", "particles", "lift trace", "cloud")
+LAYERS = ("object", "hand", "arm", "pregrasp", "approach", "contacts", "models", "particles", "lift trace", "cloud")
 MAX_COPIES = 15       # the heaviest particles drawn as faint copies of the object
 PART_COLOURS = [(230, 150, 60), (70, 140, 220), (90, 180, 90), (200, 80, 160), (160, 160, 60), (90, 200, 200)]
 HAND_COLOUR, PREGRASP_COLOUR, CONTACT_COLOUR = (120, 120, 130), (180, 180, 200), (230, 30, 30)
+ARM_COLOUR = (235, 120, 40)
 TABLE_HALF = 0.25     # m, half side of the drawn table square
 
 
@@ -86,6 +93,8 @@ class SceneView:
     def __init__(self, server, scene: ResultScene):
         self.server, self.scene = server, scene
         self.layers: Dict[Tuple[Optional[int], str], list] = {}
+        self.arm_notes: Dict[int, str] = {}        # per step: the arm drawn, or why none is
+        self._arm_points: List[np.ndarray] = []    # the arms' stick figures, for the camera
         self._add_static()
         for k, step in enumerate(scene.steps):
             self._add_step(k, step)
@@ -131,6 +140,7 @@ class SceneView:
             p1 = np.asarray(g["position"], float)
             self._keep(k, "approach", add.add_arrows(f"{base}/approach", np.array([[p0, p1]]), colors=(20, 20, 20),
                                                      shaft_radius=0.002, head_radius=0.006, head_length=0.012))
+            self._add_arm(k, g)
         if step.contacts:
             P = np.array([c.point for c in step.contacts])
             N = np.array([c.normal for c in step.contacts])
@@ -151,6 +161,28 @@ class SceneView:
             self._add_particles(k, step.belief)
         if step.trace and g is not None:
             self._add_trace(k, step.trace)
+
+    def _add_arm(self, k: int, g: dict) -> None:
+        """The arm of grasp record ``g`` at the grasp ("arm") and faint at the pre-grasp ("pregrasp"),
+        each shape's mesh posed by T_joint(q) M_shape; no arm and a note when it is unreachable."""
+        view = arm_view(g)
+        if view is None:
+            return
+        self.arm_notes[k] = view.note
+        if view.arm is None:
+            return
+        add, base, arm = self.server.scene, f"/steps/{k}", view.arm
+        for name, V, F, T in link_meshes(arm, view.q):
+            self._keep(k, "arm", add.add_mesh_simple(f"{base}/arm/{name}", V, F, color=ARM_COLOUR,
+                                                     wxyz=_wxyz(T[:3, :3]), position=T[:3, 3]))
+        for name, T in (("base", arm.base), ("palm", arm.palm_poses(view.q)[0])):
+            self._keep(k, "arm", add.add_frame(f"{base}/arm/{name}", axes_length=0.08, axes_radius=0.004,
+                                               wxyz=_wxyz(T[:3, :3]), position=T[:3, 3]))
+        self._arm_points.append(stick_points(arm, view.q))
+        if view.q_pre is not None:
+            for name, V, F, T in link_meshes(arm, view.q_pre):
+                self._keep(k, "pregrasp", add.add_mesh_simple(f"{base}/arm_pregrasp/{name}", V, F, color=ARM_COLOUR,
+                                                              opacity=0.25, wxyz=_wxyz(T[:3, :3]), position=T[:3, 3]))
 
     def _add_particles(self, k: int, belief: dict) -> None:
         """The belief's particles: a point each (on the table, coloured by weight) and the heaviest
@@ -196,6 +228,8 @@ class SceneView:
             V = _placed(sc.object.vertices, planar_transform(sc.object_pose))
         else:
             V = np.array([g.grasp["position"] for g in sc.steps if g.grasp] or [[0.0, 0.0, 0.05]])
+        if self._arm_points:                       # the arms too, from their bases to the palms
+            V = np.vstack([V, *self._arm_points])
         centre = 0.5 * (V.min(axis=0) + V.max(axis=0))
         r = max(float(np.linalg.norm(V.max(axis=0) - V.min(axis=0))), 0.1)
         cam = self.server.initial_camera
@@ -228,7 +262,8 @@ class SceneView:
         if self.scene.steps:
             s = self.scene.steps[k]
             self.label.content = f"{s.label}: {s.outcome}" + (
-                "; " + ", ".join(f"{m} {w:.2f}" for m, _, w in s.models) if s.models else "")
+                "; " + ", ".join(f"{m} {w:.2f}" for m, _, w in s.models) if s.models else "") + (
+                "; " + self.arm_notes[k] if k in self.arm_notes else "")
 
 
 def serve(scene: ResultScene, port: int = 8080, host: str = "127.0.0.1", say=None):
