@@ -146,3 +146,33 @@ def test_the_demo_draws_its_pictures_with_matplotlib_when_the_browser_fails(caps
     paths = _attempt_pictures(doc, tmp_path)
     assert [p.name for p in paths] == ["attempt_1.png"] and paths[0].stat().st_size > 1000
     assert "screenshots failed (Message: timeout: Timed out receiving message from renderer" in capsys.readouterr().err
+
+
+def test_the_screenshots_say_they_are_still_working_while_the_browser_is_slow(tmp_path, grasp_doc, monkeypatch):
+    """A browser that takes long to start (a loaded machine: 80 s of silence in a demo once) is
+    covered by "still working" lines; none come once the screenshots are over."""
+    import time as _time
+
+    from selenium.common.exceptions import TimeoutException
+
+    import bayesgrasp.viewer.snapshot as snap
+
+    def slow_driver(size):
+        _time.sleep(0.5)
+        raise TimeoutException("renderer timed out")
+
+    monkeypatch.setattr(snap, "HEARTBEAT_EVERY", 0.1)
+    monkeypatch.setattr(snap, "_driver", slow_driver)
+    said = []
+    scene = scene_from_result({"scene_object": "mug/3", "object_pose": [0, 0, 0],
+                               "rounds": [{"round": 0, "grasp": grasp_doc["grasp"], "lifted": grasp_doc["lifted"],
+                                           "weights": {}, "poses": {}}]})
+    port = free_port()
+    with pytest.raises(TimeoutException):
+        snap.snapshot_steps(scene, {0: tmp_path / "a.png"}, port=port, say=said.append)
+    beats = [m for m in said if "screenshots of 1 step(s) in headless Chromium" in m and "s so far" in m]
+    assert len(beats) >= 3, said
+    n = len(said)
+    _time.sleep(0.3)
+    assert len(said) == n            # the heartbeat stopped with the screenshots
+    assert port_free(port)           # and the server too

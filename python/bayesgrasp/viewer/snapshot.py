@@ -6,7 +6,9 @@ from __future__ import annotations
 
 import os
 import shutil
+import threading
 import time
+from contextlib import contextmanager
 from pathlib import Path
 from typing import Dict, List, Optional
 
@@ -36,6 +38,34 @@ def _variance(png: bytes) -> float:
     import matplotlib.image as mpimg
 
     return float(np.asarray(mpimg.imread(BytesIO(png), format="png"))[..., :3].var())
+
+
+#: seconds between the "still working" lines while the browser starts and draws
+HEARTBEAT_EVERY = 5.0
+
+
+@contextmanager
+def heartbeat(say, what: str, every: Optional[float] = None):
+    """While the block runs, ``say("  <what>: N s so far")`` every ``every`` seconds (default
+    :data:`HEARTBEAT_EVERY`): a browser starting or drawing on a loaded machine can take a minute
+    and says nothing itself. Nothing when ``say`` is None."""
+    if say is None:
+        yield
+        return
+    period = HEARTBEAT_EVERY if every is None else every
+    stop, start = threading.Event(), time.monotonic()
+
+    def beat():
+        while not stop.wait(period):
+            say(f"  {what}: {time.monotonic() - start:.0f} s so far")
+
+    t = threading.Thread(target=beat, daemon=True)
+    t.start()
+    try:
+        yield
+    finally:
+        stop.set()
+        t.join()
 
 
 def _driver(size):
@@ -101,22 +131,28 @@ def snapshot_steps(scene, paths: Dict[int, object], port: int = 8080, size=(960,
 
     server, view = serve(scene, port=port, say=say)
     try:
-        d = _driver(size)
-        try:
-            out = []
-            for i, (k, path) in enumerate(sorted(paths.items())):
-                view.slider.value = k
-                view.show(k)
-                if i == 0:
-                    d.get(f"http://127.0.0.1:{server.get_port()}")
-                    png = _drawn(d, 30.0, 1e-3, settle)
-                else:
-                    time.sleep(settle)
-                    d.execute_script(HIDE_NOTICES)
-                    png = d.get_screenshot_as_png()
-                out.append(_write(png, path))
-            return out
-        finally:
-            d.quit()
+        with heartbeat(say, f"3D view: screenshots of {len(paths)} step(s) in headless Chromium"):
+            return _shoot(server, view, paths, size, settle)
     finally:
         stop(server)
+
+
+def _shoot(server, view, paths: Dict[int, object], size, settle: float) -> List[Path]:
+    """The screenshots of :func:`snapshot_steps` from one browser session on ``server``."""
+    d = _driver(size)
+    try:
+        out = []
+        for i, (k, path) in enumerate(sorted(paths.items())):
+            view.slider.value = k
+            view.show(k)
+            if i == 0:
+                d.get(f"http://127.0.0.1:{server.get_port()}")
+                png = _drawn(d, 30.0, 1e-3, settle)
+            else:
+                time.sleep(settle)
+                d.execute_script(HIDE_NOTICES)
+                png = d.get_screenshot_as_png()
+            out.append(_write(png, path))
+        return out
+    finally:
+        d.quit()
