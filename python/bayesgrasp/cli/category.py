@@ -51,12 +51,14 @@ def run(args) -> int:
         raise CliError("--complete: not with camera data (it replaces the view by the object's whole surface)")
     exclude = args.exclude if args.exclude is not None else [m for m in [args.scene_object] if m]
     ctx = context(args, reads=())      # Eq. 4.1 on the registrations; every grasp is lift-tested
+    ctx.say(f"category: registering the {args.category} models to the view")
     ep = see(args.scene_object, pose, args.category, exclude=exclude, seed=ctx.seed, complete=args.complete,
              observation=None if view is None else camera_input.observation(view))
     if not any(r.success for r in ep.registrations):
         raise CliError("no training model registered to the cloud (is the object in view, is it of this category?)")
     grasps = task_grasps_arg(args)
     arm = robot_arm(args, ctx.hand_model)
+    ctx.say(f"category: planning the {args.task} grasp ({args.method}) and lift-testing it")
     r = plan_and_execute(ep, args.category, args.task, args.method, ctx, seed=ctx.seed, grasps=grasps,
                          reach=None if arm is None else _table_reach(arm))
     grasp = r.grasp(ctx.hand_model)
