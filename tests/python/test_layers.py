@@ -40,7 +40,7 @@ EXTENSIONS = {"_core"}   # compiled from cpp/bindings: no source in the package
 # Layer of each top-level module or sub-package, lowest first. "" is the package's own __init__.
 # Strictly downwards: members of one layer are peers and may not import each other.
 LAYERS = [
-    {"", "_core", "_args", "cache", "hand_urdf", "client"},  # peers: they import nothing of the package
+    {"", "_core", "_args", "cache", "hand_urdf", "client", "progress"},  # peers: they import nothing of the package
     # the numerical modules, ordered by their imports; peers in a row import none of each other
     {"hand", "gp", "belief", "optim", "quality", "lift_trace", "io", "decomposition"},
     {"sim", "vision"},               # sim -> hand; vision -> belief

@@ -155,13 +155,14 @@ def test_the_screenshots_say_they_are_still_working_while_the_browser_is_slow(tm
 
     from selenium.common.exceptions import TimeoutException
 
+    import bayesgrasp.progress as progress
     import bayesgrasp.viewer.snapshot as snap
 
     def slow_driver(size):
         _time.sleep(0.5)
         raise TimeoutException("renderer timed out")
 
-    monkeypatch.setattr(snap, "HEARTBEAT_EVERY", 0.1)
+    monkeypatch.setattr(progress, "HEARTBEAT_EVERY", 0.1)
     monkeypatch.setattr(snap, "_driver", slow_driver)
     said = []
     scene = scene_from_result({"scene_object": "mug/3", "object_pose": [0, 0, 0],

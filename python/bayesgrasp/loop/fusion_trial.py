@@ -21,6 +21,7 @@ from ..models import ModelSettings, relative_top_grasps
 from ..models.tasks import task_rule
 from ..planners.fusion import PART_TERMS, FusionPlanner, FusionSettings
 from ..planners.protocol import Reading
+from ..progress import heartbeat
 from ..world import World
 from .category import demonstrated, see
 from .context import RunContext
@@ -64,6 +65,7 @@ class FusionTrial:
         cat = category or (obj.split("/")[0] if "/" in str(obj) else "mug")
         self.obj, self.pose, self.ctx, self.seed = obj, np.asarray(pose, float), ctx, seed
         kw = {} if eye_offset is None else {"eye_offset": eye_offset}
+        ctx.say(f"fuse: registering the {cat} models to the view")
         self.episode = see(obj, pose, cat, exclude=tuple(exclude) or (obj,), seed=seed, observation=observation, **kw)
         if not any(r.success for r in self.episode.registrations):
             raise ValueError("no training model registered to the cloud: there is no vision belief to start from")
@@ -130,7 +132,11 @@ class FusionTrial:
         first lifted grasp on, round 0 included (the robot's rule: the object is up)."""
         rng, planner = self.start()
         belief = planner.belief
-        g0 = self.random_grasp(rng) if mode == "random" else planner.plan().action
+        if mode != "random":
+            self.ctx.say("fuse: round 0: planning on the vision belief (Eq. 4.6)")
+        with heartbeat(self.ctx.progress, "fuse: planning"):
+            g0 = self.random_grasp(rng) if mode == "random" else planner.plan().action
+        self.ctx.say(f"fuse: round 0: executing the {'random' if mode == 'random' else 'planned'} grasp and lift-testing it")
         records = [self._round(0, g0, belief)]
         if on_round:
             on_round(records[-1])
@@ -138,8 +144,10 @@ class FusionTrial:
             last = records[-1]
             if (t > 1 or stop_at_lift) and any(r.lifted for r in records):
                 break
+            self.ctx.say(f"fuse: round {t}: the belief after the joint angles (Eq. 4.5), the next grasp (Eq. 4.6)")
             up = planner.observe(last.execution.action, Reading(last.measurement, held=bool(last.lifted)))
-            plan = planner.plan()
+            with heartbeat(self.ctx.progress, f"fuse: round {t}"):
+                plan = planner.plan()
             records.append(self._round(t, plan.action, belief, plan, up.underflow))
             if on_round:
                 on_round(records[-1])

@@ -6,13 +6,13 @@ from __future__ import annotations
 
 import os
 import shutil
-import threading
 import time
-from contextlib import contextmanager
 from pathlib import Path
 from typing import Dict, List, Optional
 
 import numpy as np
+
+from .. import progress
 
 BROWSERS = ("chromium", "chromium-browser")
 DRIVERS = ("chromedriver",)
@@ -38,34 +38,6 @@ def _variance(png: bytes) -> float:
     import matplotlib.image as mpimg
 
     return float(np.asarray(mpimg.imread(BytesIO(png), format="png"))[..., :3].var())
-
-
-#: seconds between the "still working" lines while the browser starts and draws
-HEARTBEAT_EVERY = 5.0
-
-
-@contextmanager
-def heartbeat(say, what: str, every: Optional[float] = None):
-    """While the block runs, ``say("  <what>: N s so far")`` every ``every`` seconds (default
-    :data:`HEARTBEAT_EVERY`): a browser starting or drawing on a loaded machine can take a minute
-    and says nothing itself. Nothing when ``say`` is None."""
-    if say is None:
-        yield
-        return
-    period = HEARTBEAT_EVERY if every is None else every
-    stop, start = threading.Event(), time.monotonic()
-
-    def beat():
-        while not stop.wait(period):
-            say(f"  {what}: {time.monotonic() - start:.0f} s so far")
-
-    t = threading.Thread(target=beat, daemon=True)
-    t.start()
-    try:
-        yield
-    finally:
-        stop.set()
-        t.join()
 
 
 def _driver(size):
@@ -131,7 +103,7 @@ def snapshot_steps(scene, paths: Dict[int, object], port: int = 8080, size=(960,
 
     server, view = serve(scene, port=port, say=say)
     try:
-        with heartbeat(say, f"3D view: screenshots of {len(paths)} step(s) in headless Chromium"):
+        with progress.heartbeat(say, f"3D view: screenshots of {len(paths)} step(s) in headless Chromium"):
             return _shoot(server, view, paths, size, settle)
     finally:
         stop(server)
