@@ -16,11 +16,16 @@ import numpy as np
 from ..loop.episode import EpisodeSettings
 from ..loop.outside_loop import METHODS as POSE_METHODS          # the episodes' own lists
 from ..loop.outside_loop_category import CATEGORY_METHODS as _PLANNED_ONCE
+from ..planners import category as _category, fusion as _fusion, registry as _registry
 from . import camera_input
 from .args import (CliError, add_context_options, add_format_options, bounded_int, context, floats, output_format,
                    task_grasps_arg)
 
-CATEGORY_METHODS = _PLANNED_ONCE + ("fusion",)
+CATEGORY_METHODS = _PLANNED_ONCE + (_fusion.METHOD,)
+#: --method's help, each method's line as its planner family declares it.
+METHOD_HELP = (f"pose (default {EpisodeSettings.method}): {_registry.methods_help(POSE_METHODS)}; with --category "
+               f"(default laplace): {_registry.methods_help(_PLANNED_ONCE, _category.METHOD_HELP)}; "
+               f"{_registry.methods_help((_fusion.METHOD,), _fusion.METHOD_HELP)}")
 
 
 def add(sub) -> None:
@@ -35,9 +40,7 @@ def add(sub) -> None:
                         "with --category and no camera data the object whose simulated view is taken")
     n.add_argument("--estimate", default=None, metavar="X,Y,YAW",
                    help="the object's estimated pose on the table (m, m, rad); or give --cloud / --depth")
-    n.add_argument("--method", default=None, choices=list(POSE_METHODS + CATEGORY_METHODS),
-                   help="pose: stability (Eq. 3.1) or explore (Eq. 3.2, default); with --category: laplace (default), "
-                        "regularised, gaussian, baseline (Eq. 4.1, one grasp) or fusion (vision then touch, Eq. 4.6)")
+    n.add_argument("--method", default=None, choices=list(POSE_METHODS + CATEGORY_METHODS), help=METHOD_HELP)
     n.add_argument("--category", default=None, help="a category task or vision-then-touch episode: mug, bottle or knife")
     n.add_argument("--task", default=None, help="the task, with --category (mug: top, side, handle; ...)")
     n.add_argument("--object-pose", default="0,0,0", metavar="X,Y,YAW",
@@ -125,7 +128,7 @@ def _new_category(args, fmt: str) -> int:
     view = camera_input.observe(args)
     if view is None and not args.object:
         raise CliError("--cloud, --depth or --object: the view to plan from")
-    ctx = context(args, reads=("success", "models") if method == "fusion" else ())
+    ctx = context(args, reads=("success", "models") if method == _fusion.METHOD else ())
     if view is not None:
         obs = camera_input.observation(view)
     else:
@@ -133,7 +136,7 @@ def _new_category(args, fmt: str) -> int:
         obs = observe(obj, floats(args.object_pose, 3, "--object-pose"), seed=ctx.seed)
     exclude = args.exclude if args.exclude is not None else [m for m in [args.object] if m]
     common = dict(exclude=exclude, seed=ctx.seed, grasps=task_grasps_arg(args))
-    if method == "fusion":
+    if method == _fusion.METHOD:
         ep = FusionEpisode.new(args.dir, obs, args.category, args.task, ctx, attempts=args.attempts, **common)
     else:
         ep = CategoryTaskEpisode.new(args.dir, obs, args.category, args.task, ctx, method=method, **common)

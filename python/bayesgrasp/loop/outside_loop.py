@@ -31,13 +31,14 @@ from ..io.grasp_schema import hand_grasp_record
 from ..models import GraspModels, ModelSettings, relative_top_grasps
 from ..objects import ObjectModel, load_object, object_params
 from ..planners import PlannerSettings, Reading, make_planner
+from ..planners.registry import EPISODE_METHODS
 from ..world import World
 from .context import RunContext
 
 STATE_FILE = "episode.json"
 LOCK_FILE = ".lock"
 FORMAT = 1
-METHODS = ("stability", "explore")
+METHODS = EPISODE_METHODS   # the pose methods an episode offers, as the registry declares them
 JOINT_LIMIT_SLACK = 0.02   # rad a reading may lie beyond the hand file's limits (encoder noise)
 
 
