@@ -18,8 +18,8 @@ from ..loop.outside_loop import METHODS as POSE_METHODS          # the episodes'
 from ..loop.outside_loop_category import CATEGORY_METHODS as _PLANNED_ONCE
 from ..planners import category as _category, fusion as _fusion, registry as _registry
 from . import camera_input
-from .args import (CliError, add_context_options, add_format_options, bounded_int, context, floats, output_format,
-                   task_grasps_arg)
+from .args import (CliError, add_context_options, add_format_options, add_robot_options, bounded_int, context, floats,
+                   output_format, robot_arm, task_grasps_arg)
 
 CATEGORY_METHODS = _PLANNED_ONCE + (_fusion.METHOD,)
 #: --method's help, each method's line as its planner family declares it.
@@ -53,6 +53,7 @@ def add(sub) -> None:
     n.add_argument("--dir", required=True, help="the episode's directory (created; must not hold an episode)")
     add_format_options(n)
     add_context_options(n)
+    add_robot_options(n)
     camera_input.add(n)
     n.set_defaults(run=new)
 
@@ -99,6 +100,7 @@ def new(args) -> int:
 
         obj = load_object(args.object, units=args.units)
     ctx = context(args, reads=("success", "models", "planner"))   # the robot reads the joints and the lift
+    arm = robot_arm(args, ctx.hand_model)
     start, _ = _vision_start(args, obj, est, fmt != "text", ctx.seed)
     settings = started(ctx.planner_settings(), start)     # --set planner.FIELD=VALUE
     if start is not None:
@@ -106,7 +108,7 @@ def new(args) -> int:
     if est is None:
         raise CliError("--estimate: needed (or --cloud / --depth to register the object to)")
     ep = PoseEpisode.new(args.dir, obj, est, ctx, method=method, attempts=args.attempts, seed=ctx.seed,
-                         planner=settings, units=args.units)
+                         planner=settings, units=args.units, arm=arm)
     _print_next(ep, fmt)
     return 0
 
@@ -129,13 +131,14 @@ def _new_category(args, fmt: str) -> int:
     if view is None and not args.object:
         raise CliError("--cloud, --depth or --object: the view to plan from")
     ctx = context(args, reads=("success", "models") if method == _fusion.METHOD else ())
+    arm = robot_arm(args, ctx.hand_model)
     if view is not None:
         obs = camera_input.observation(view)
     else:
         obj = load_object(args.object, units=args.units) if args.units else args.object   # in its unit
         obs = observe(obj, floats(args.object_pose, 3, "--object-pose"), seed=ctx.seed)
     exclude = args.exclude if args.exclude is not None else [m for m in [args.object] if m]
-    common = dict(exclude=exclude, seed=ctx.seed, grasps=task_grasps_arg(args))
+    common = dict(exclude=exclude, seed=ctx.seed, grasps=task_grasps_arg(args), arm=arm)
     if method == _fusion.METHOD:
         ep = FusionEpisode.new(args.dir, obs, args.category, args.task, ctx, attempts=args.attempts, **common)
     else:
@@ -206,6 +209,10 @@ def _print_next(ep, fmt: str) -> None:
         print(f"attempt {nxt['attempt']} ({nxt['kind']}): palm at ({p[0]:.4f}, {p[1]:.4f}, {p[2]:.4f}) m, approach "
               f"({a[0]:.3f}, {a[1]:.3f}, {a[2]:.3f}), spread {g['spread']:.3f} rad; {_score(nxt)}")
     print("  joints " + ",".join(g["urdf"]["joint_names"] if "urdf" in g else g["joint_names"]))
+    if "arm" in g:          # with --robot: the arm's joints at the grasp, or why it cannot reach it
+        arm = g["arm"]
+        print("  arm joints " + ",".join(f"{v:.4f}" for v in arm["joint_positions"]) if arm["reachable"] else
+              f"  arm: cannot reach this grasp ({arm['reason']}); no reachable grasp was found")
     print("  then: bayesgrasp episode observe " + str(ep.directory) + " --joints A,B,... --lifted yes|no")
 
 
