@@ -66,6 +66,27 @@ def _category_method(body: Planning) -> str:
     return method
 
 
+def _arm(body: NewEpisode, hand):
+    """The built-in arm ``body.robot`` at ``robot_base`` with its ``flange`` and ``mount`` (default:
+    the hand's base on the flange), as ``--robot`` makes it; None without ``robot``."""
+    from ..arm import Arm, builtin_arms, default_mount, mount_pose
+
+    if body.robot is None:
+        for field in ("flange", "mount"):
+            if getattr(body, field) is not None:
+                _refuse(field, "only with robot")
+        return None
+    if body.robot not in builtin_arms():
+        _refuse("robot", f"not a built-in arm, got {body.robot!r} (built-in: {', '.join(builtin_arms())})")
+    try:
+        mount = default_mount(hand) if body.mount is None else mount_pose(body.mount)
+        return Arm.load(body.robot, flange=body.flange, mount=mount, base=body.robot_base)
+    except ValueError as e:
+        msg = str(e)
+        field = next((f for f in ("flange", "mount", "base") if msg.startswith(f)), "robot")
+        _refuse("robot_base" if field == "base" else field, msg.split(": ", 1)[-1])
+
+
 def start_episode(directory: Path, body: NewEpisode, cache_dir: Optional[str]):
     """The episode ``body`` asks for, written to ``directory`` with its first grasp planned."""
     if bool(body.category) != bool(body.task):
@@ -74,12 +95,12 @@ def start_episode(directory: Path, body: NewEpisode, cache_dir: Optional[str]):
         obj, method = _pose_inputs(body)
         ctx = _context(body, cache_dir)
         return PoseEpisode.new(directory, obj, body.estimate, ctx, method=method, attempts=body.attempts,
-                               seed=ctx.seed, planner=ctx.planner_settings())
+                               seed=ctx.seed, planner=ctx.planner_settings(), arm=_arm(body, ctx.hand_model))
     method = _category_method(body)
     ctx = _context(body, cache_dir, reads=("models",) if method == "fusion" else ())
     view = _view(body, ctx.seed)
     exclude = body.exclude if body.exclude is not None else [m for m in [body.object] if m]   # as the CLI
-    common = dict(exclude=exclude, seed=ctx.seed, grasps=None)
+    common = dict(exclude=exclude, seed=ctx.seed, grasps=None, arm=_arm(body, ctx.hand_model))
     if method == "fusion":
         return FusionEpisode.new(directory, view, body.category, body.task, ctx, attempts=body.attempts, **common)
     return CategoryTaskEpisode.new(directory, view, body.category, body.task, ctx, method=method, **common)
