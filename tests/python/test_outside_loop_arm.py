@@ -139,8 +139,8 @@ def test_a_category_task_episode_on_an_arm_plans_as_category_does(capsys, tmp_pa
 def test_a_fusion_episode_on_an_arm_prints_reachable_grasps_and_reopens_with_its_arm(capsys, tmp_path, cat_options):
     d = tmp_path / "ep"
     doc = cli_json(capsys, "episode", "new", "--category", "mug", "--task", "top", "--method", "fusion", "--object",
-                   SCENE, "--object-pose", SCENE_POSE, "--attempts", 3, "--dir", d, *cat_options, "--robot", "kuka_lbr4",
-                   "--robot-base", "-0.6,0.1,0,0", "--json")
+                   SCENE, "--object-pose", SCENE_POSE, "--attempts", 3, "--dir", d, *cat_options,
+                   "--robot", "kuka_lbr4", "--robot-base", "-0.6,0.1,0,0", "--json")
     assert_reaches(doc["next"]["grasp"])
     nxt = cli_json(capsys, "episode", "observe", d, "--joints", "0,1,1,1,1,1,1", "--lifted", "no", "--json")["next"]
     assert_reaches(nxt["grasp"])

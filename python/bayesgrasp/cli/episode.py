@@ -15,13 +15,12 @@ import numpy as np
 
 from ..loop.episode import EpisodeSettings
 from ..loop.outside_loop import METHODS as POSE_METHODS          # the episodes' own lists
-from ..loop.outside_loop_category import CATEGORY_METHODS as _PLANNED_ONCE
+from ..loop.outside_loop_category import CATEGORY_METHODS as _PLANNED_ONCE, EPISODE_CATEGORY_METHODS as CATEGORY_METHODS
 from ..planners import category as _category, fusion as _fusion, registry as _registry
 from . import camera_input
 from .args import (CliError, add_context_options, add_format_options, add_robot_options, bounded_int, context, floats,
                    output_format, robot_arm, task_grasps_arg)
 
-CATEGORY_METHODS = _PLANNED_ONCE + (_fusion.METHOD,)
 #: --method's help, each method's line as its planner family declares it.
 METHOD_HELP = (f"pose (default {EpisodeSettings.method}): {_registry.methods_help(POSE_METHODS)}; with --category "
                f"(default laplace): {_registry.methods_help(_PLANNED_ONCE, _category.METHOD_HELP)}; "

@@ -25,7 +25,7 @@ from ..cache import atomic_write
 from ..models.task_grasps import grasp_from_json, grasp_to_json
 from ..models.tasks import task_rule
 from ..planners.category import THESIS_METHODS
-from ..planners.fusion import FusionSettings
+from ..planners.fusion import METHOD as FUSION, FusionSettings
 from .category import Observation, demonstrated, plan_and_execute, see, training_models
 from .category_result import TaskGraspResult
 from .context import RunContext
@@ -36,6 +36,8 @@ from .reach import table_reach, top_reach, with_arm
 
 VIEW_FILE = "view.npz"
 CATEGORY_METHODS = THESIS_METHODS   # the planners that plan once from a view (fusion: its own episode)
+#: every method a category episode takes: the task grasp's (one grasp) and vision then touch
+EPISODE_CATEGORY_METHODS = CATEGORY_METHODS + (FUSION,)
 
 
 # ---- the stored view ----------------------------------------------------------------------------
@@ -130,7 +132,7 @@ class CategoryTaskEpisode(_CategoryBase):
         table, and the grasp carries its ``arm``."""
         directory = Path(directory)
         if method not in CATEGORY_METHODS:
-            raise EpisodeError(f"--method: with --category one of {', '.join(CATEGORY_METHODS)} or fusion; "
+            raise EpisodeError(f"--method: with --category one of {', '.join(EPISODE_CATEGORY_METHODS)}; "
                                f"got {method!r}")
         state = cls._new_state(directory, observation, category, task, ctx, 1, exclude, seed, grasps, arm)
         state["method"] = method
@@ -163,7 +165,8 @@ class CategoryTaskEpisode(_CategoryBase):
         grasp = r.planned_grasp(self.hand)
         if self.arm is not None:      # against the table (the object's mesh is not known)
             grasp = with_arm(self.arm, grasp)
-        self.state["next"] = {"attempt": 1, "kind": "task", "planned_pose": r.planned_pose, "grasp": grasp, "objective": p.objective, "weights": p.weights,
+        self.state["next"] = {"attempt": 1, "kind": "task", "planned_pose": r.planned_pose, "grasp": grasp,
+                              "objective": p.objective, "weights": p.weights,
                               "contributions": p.contributions, "dominant_model": p.dominant_model}
 
     def belief(self) -> dict:
@@ -210,7 +213,7 @@ class FusionEpisode(_CategoryBase):
         directory = Path(directory)
         state = cls._new_state(directory, observation, category, task, ctx, attempts, exclude, seed, grasps, arm)
         s = settings or FusionSettings()
-        state.update({"method": "fusion", "models_keys": None,
+        state.update({"method": FUSION, "models_keys": None,
                       "fusion": settings_json(s)})
         episode = cls(directory, state, ctx, observation)
         episode._start()

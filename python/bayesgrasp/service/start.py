@@ -11,7 +11,7 @@ import numpy as np
 from ..loop.category import Observation, observe
 from ..loop.context import context_from_plain
 from ..loop.outside_loop import METHODS as POSE_METHODS, PoseEpisode, check_builtin_hand, check_builtin_object
-from ..loop.outside_loop_category import CATEGORY_METHODS, CategoryTaskEpisode, FusionEpisode
+from ..loop.outside_loop_category import FUSION, EPISODE_CATEGORY_METHODS, CategoryTaskEpisode, FusionEpisode
 from .bodies import NewEpisode, Planning
 from .errors import ApiError
 
@@ -61,8 +61,8 @@ def _category_method(body: Planning) -> str:
     if body.estimate is not None:
         _refuse("estimate", "not with category (the view's registrations place the models)")
     method = body.method or "laplace"
-    if method not in CATEGORY_METHODS + ("fusion",):
-        _refuse("method", f"with category one of {', '.join(CATEGORY_METHODS + ('fusion',))}, got {method!r}")
+    if method not in EPISODE_CATEGORY_METHODS:
+        _refuse("method", f"with category one of {', '.join(EPISODE_CATEGORY_METHODS)}, got {method!r}")
     return method
 
 
@@ -97,11 +97,11 @@ def start_episode(directory: Path, body: NewEpisode, cache_dir: Optional[str]):
         return PoseEpisode.new(directory, obj, body.estimate, ctx, method=method, attempts=body.attempts,
                                seed=ctx.seed, planner=ctx.planner_settings(), arm=_arm(body, ctx.hand_model))
     method = _category_method(body)
-    ctx = _context(body, cache_dir, reads=("models",) if method == "fusion" else ())
+    ctx = _context(body, cache_dir, reads=("models",) if method == FUSION else ())
     view = _view(body, ctx.seed)
     exclude = body.exclude if body.exclude is not None else [m for m in [body.object] if m]   # as the CLI
     common = dict(exclude=exclude, seed=ctx.seed, grasps=None, arm=_arm(body, ctx.hand_model))
-    if method == "fusion":
+    if method == FUSION:
         return FusionEpisode.new(directory, view, body.category, body.task, ctx, attempts=body.attempts, **common)
     return CategoryTaskEpisode.new(directory, view, body.category, body.task, ctx, method=method, **common)
 
