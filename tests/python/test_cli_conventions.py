@@ -116,3 +116,22 @@ def test_method_choices_and_their_help_come_from_the_planners_declaration(comman
     assert list(option.choices) == methods
     for m in methods:
         assert f"{m}: {helps[m]}" in option.help
+
+
+def test_episode_methods_and_their_help_come_from_the_planners_declarations():
+    """`episode new --method` offers the registry's episode pose methods, the category planners'
+    thesis methods and fusion, each with the line its family declares; the outside loop accepts
+    exactly the registry's pose methods."""
+    from bayesgrasp.loop import outside_loop
+    from bayesgrasp.planners import category, fusion, registry
+
+    assert set(registry.EPISODE_METHODS) <= set(registry.PLANNERS)
+    assert outside_loop.METHODS == registry.EPISODE_METHODS
+    declared = {**{m: registry.METHOD_HELP[m] for m in registry.EPISODE_METHODS},
+                **{m: category.METHOD_HELP[m] for m in category.THESIS_METHODS}, **fusion.METHOD_HELP}
+    parser = next(p for n, p, _ in ALL if n == "bayesgrasp episode new")
+    option = next(a for a in parser._actions if "--method" in a.option_strings)
+    assert list(option.choices) == list(declared)
+    for m, line in declared.items():
+        assert f"{m}: {line}" in option.help
+    assert "part-aware" not in option.choices    # a category method the episode refuses is not offered

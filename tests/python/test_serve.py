@@ -137,6 +137,25 @@ def test_the_first_grasp_equals_the_episode_command_s_and_the_one_shot_plan_s(ca
     validate(by_api["next"]["grasp"])                          # the grasp schema's shape
 
 
+def test_an_episode_on_an_arm_through_the_api_equals_the_episode_command_s(capsys, tmp_path, server, client):
+    """robot, robot_base: the arm as `episode new --robot --robot-base` takes it; the first grasp (its
+    arm record included) is the command's; a bad arm option is refused and writes nothing."""
+    by_cli = cli_json(capsys, "episode", "new", "--object", OBJ, "--estimate", ",".join(map(repr, EST)), "--method",
+                      "stability", "--attempts", "2", "--seed", SEED, "--robot", "kuka_lbr4", "--robot-base",
+                      "-0.55,0.05,0,0.1", "--dir", tmp_path / "ep", "--json")
+    by_api = client.new_episode(**new_body("stability", 2, id="onarm", robot="kuka_lbr4",
+                                           robot_base=[-0.55, 0.05, 0.0, 0.1]))
+    assert by_api["next"] == by_cli["next"] and by_api["next"]["grasp"]["arm"]["reachable"] is True
+    for body, needle in [(new_body("stability", 2, id="arm1", robot="no_arm"), "not a built-in arm"),
+                         (new_body("stability", 2, id="arm2", flange="lbr4_link7"), "flange: only with robot"),
+                         (new_body("stability", 2, id="arm3", robot="kuka_lbr4", flange="nope"), "no link 'nope'"),
+                         (new_body("stability", 2, id="arm4", robot="kuka_lbr4", robot_base=[0, 0, 0]), "robot_base")]:
+        with pytest.raises(ServiceError) as e:
+            client.new_episode(**body)
+        assert e.value.status in (400, 422) and needle in e.value.message, e.value
+        assert not (server.episodes / body["id"]).exists()
+
+
 def test_the_api_is_described_by_openapi_behind_the_token(server):
     doc = httpx.get(server.url + "/openapi.json", headers=AUTH, timeout=30).json()
     assert {"/v1/episodes", "/v1/episodes/{eid}/observations", "/v1/episodes/{eid}", "/v1/plan",

@@ -9,9 +9,9 @@ Files by step: :mod:`.model` (the URDF, the chain, forward kinematics and the Ja
 :mod:`.mount` (the hand on the flange), :mod:`.ik` (damped least squares, batched),
 :mod:`.collision` (links against table and object), :mod:`.reach` (the check, its options and result).
 """
-from .model import ROBOTS_DIR, Arm, base_pose, builtin_arms, resolve_arm
+from .model import DEFAULT_BASE, ROBOTS_DIR, Arm, base_pose, builtin_arms, resolve_arm
 from .mount import default_mount, mount_pose, palm_depth
 from .reach import REASONS, ReachOptions, ReachResult, arm_record, check_reach
 
-__all__ = ["Arm", "ROBOTS_DIR", "REASONS", "ReachOptions", "ReachResult", "base_pose", "builtin_arms",
+__all__ = ["Arm", "DEFAULT_BASE", "ROBOTS_DIR", "REASONS", "ReachOptions", "ReachResult", "base_pose", "builtin_arms",
            "arm_record", "check_reach", "default_mount", "mount_pose", "palm_depth", "resolve_arm"]

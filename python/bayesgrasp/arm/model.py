@@ -25,6 +25,9 @@ import numpy as np
 __all__ = ["Arm", "ROBOTS_DIR", "builtin_arms", "base_pose", "resolve_arm"]
 
 ROBOTS_DIR = Path(__file__).resolve().parent.parent / "data" / "robots"
+#: X, Y, Z (m), YAW (rad) of the arm's root in the table frame when none is given: 0.6 m behind the
+#: table's origin, facing +x (the command line's --robot-base and the service's robot_base)
+DEFAULT_BASE = (-0.6, 0.0, 0.0, 0.0)
 
 
 def builtin_arms() -> List[str]:

@@ -10,6 +10,7 @@ from pathlib import Path
 from typing import List, Optional, Sequence, Tuple
 
 from .. import DEFAULT_HAND
+from ..arm import DEFAULT_BASE
 
 
 class CliError(Exception):
@@ -105,7 +106,7 @@ def add_robot_options(p: argparse.ArgumentParser) -> None:
     g.add_argument("--robot", default=None, metavar="ARM.urdf",
                    help="the arm's URDF (any serial arm), or a built-in arm's name (kuka_lbr4, the thesis's KUKA "
                         "LBR4+); default: none, the hand is free-floating")
-    g.add_argument("--robot-base", default="-0.6,0,0,0", metavar="X,Y,Z,YAW",
+    g.add_argument("--robot-base", default=",".join(f"{v:g}" for v in DEFAULT_BASE), metavar="X,Y,Z,YAW",
                    help="the arm's root in the table frame (m, m, m, rad)")
     g.add_argument("--flange", default=None, metavar="LINK",
                    help="the link the hand is mounted on (default: the chain's last link)")

@@ -58,9 +58,11 @@ def run(args) -> int:
         raise CliError("no training model registered to the cloud (is the object in view, is it of this category?)")
     grasps = task_grasps_arg(args)
     arm = robot_arm(args, ctx.hand_model)
+    from ..loop.reach import table_reach
+
     ctx.say(f"category: planning the {args.task} grasp ({args.method}) and lift-testing it")
     r = plan_and_execute(ep, args.category, args.task, args.method, ctx, seed=ctx.seed, grasps=grasps,
-                         reach=None if arm is None else _table_reach(arm))
+                         reach=None if arm is None else table_reach(arm))
     grasp = r.grasp(ctx.hand_model)
     if arm is not None and grasp is not None:
         grasp["arm"] = _arm_check(arm, grasp, args.scene_object, pose, ctx.hand)
@@ -87,14 +89,6 @@ def run(args) -> int:
 
     show_result(args, doc)
     return 0
-
-
-def _table_reach(arm):
-    """Eq. 4.1's reach: the arm against the table (the new object's shape is not known, only its
-    cloud, so its mesh is not checked while planning)."""
-    from ..arm import check_reach
-
-    return lambda poses: check_reach(arm, poses).reachable
 
 
 def _arm_check(arm, grasp: dict, scene_object, pose, hand) -> dict:

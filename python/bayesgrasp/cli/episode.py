@@ -15,12 +15,16 @@ import numpy as np
 
 from ..loop.episode import EpisodeSettings
 from ..loop.outside_loop import METHODS as POSE_METHODS          # the episodes' own lists
-from ..loop.outside_loop_category import CATEGORY_METHODS as _PLANNED_ONCE
+from ..loop.outside_loop_category import CATEGORY_METHODS as _PLANNED_ONCE, EPISODE_CATEGORY_METHODS as CATEGORY_METHODS
+from ..planners import category as _category, fusion as _fusion, registry as _registry
 from . import camera_input
-from .args import (CliError, add_context_options, add_format_options, bounded_int, context, floats, output_format,
-                   task_grasps_arg)
+from .args import (CliError, add_context_options, add_format_options, add_robot_options, bounded_int, context, floats,
+                   output_format, robot_arm, task_grasps_arg)
 
-CATEGORY_METHODS = _PLANNED_ONCE + ("fusion",)
+#: --method's help, each method's line as its planner family declares it.
+METHOD_HELP = (f"pose (default {EpisodeSettings.method}): {_registry.methods_help(POSE_METHODS)}; with --category "
+               f"(default laplace): {_registry.methods_help(_PLANNED_ONCE, _category.METHOD_HELP)}; "
+               f"{_registry.methods_help((_fusion.METHOD,), _fusion.METHOD_HELP)}")
 
 
 def add(sub) -> None:
@@ -35,9 +39,7 @@ def add(sub) -> None:
                         "with --category and no camera data the object whose simulated view is taken")
     n.add_argument("--estimate", default=None, metavar="X,Y,YAW",
                    help="the object's estimated pose on the table (m, m, rad); or give --cloud / --depth")
-    n.add_argument("--method", default=None, choices=list(POSE_METHODS + CATEGORY_METHODS),
-                   help="pose: stability (Eq. 3.1) or explore (Eq. 3.2, default); with --category: laplace (default), "
-                        "regularised, gaussian, baseline (Eq. 4.1, one grasp) or fusion (vision then touch, Eq. 4.6)")
+    n.add_argument("--method", default=None, choices=list(POSE_METHODS + CATEGORY_METHODS), help=METHOD_HELP)
     n.add_argument("--category", default=None, help="a category task or vision-then-touch episode: mug, bottle or knife")
     n.add_argument("--task", default=None, help="the task, with --category (mug: top, side, handle; ...)")
     n.add_argument("--object-pose", default="0,0,0", metavar="X,Y,YAW",
@@ -50,6 +52,7 @@ def add(sub) -> None:
     n.add_argument("--dir", required=True, help="the episode's directory (created; must not hold an episode)")
     add_format_options(n)
     add_context_options(n)
+    add_robot_options(n)
     camera_input.add(n)
     n.set_defaults(run=new)
 
@@ -96,6 +99,7 @@ def new(args) -> int:
 
         obj = load_object(args.object, units=args.units)
     ctx = context(args, reads=("success", "models", "planner"))   # the robot reads the joints and the lift
+    arm = robot_arm(args, ctx.hand_model)
     start, _ = _vision_start(args, obj, est, fmt != "text", ctx.seed)
     settings = started(ctx.planner_settings(), start)     # --set planner.FIELD=VALUE
     if start is not None:
@@ -103,7 +107,7 @@ def new(args) -> int:
     if est is None:
         raise CliError("--estimate: needed (or --cloud / --depth to register the object to)")
     ep = PoseEpisode.new(args.dir, obj, est, ctx, method=method, attempts=args.attempts, seed=ctx.seed,
-                         planner=settings, units=args.units)
+                         planner=settings, units=args.units, arm=arm)
     _print_next(ep, fmt)
     return 0
 
@@ -125,15 +129,16 @@ def _new_category(args, fmt: str) -> int:
     view = camera_input.observe(args)
     if view is None and not args.object:
         raise CliError("--cloud, --depth or --object: the view to plan from")
-    ctx = context(args, reads=("success", "models") if method == "fusion" else ())
+    ctx = context(args, reads=("success", "models") if method == _fusion.METHOD else ())
+    arm = robot_arm(args, ctx.hand_model)
     if view is not None:
         obs = camera_input.observation(view)
     else:
         obj = load_object(args.object, units=args.units) if args.units else args.object   # in its unit
         obs = observe(obj, floats(args.object_pose, 3, "--object-pose"), seed=ctx.seed)
     exclude = args.exclude if args.exclude is not None else [m for m in [args.object] if m]
-    common = dict(exclude=exclude, seed=ctx.seed, grasps=task_grasps_arg(args))
-    if method == "fusion":
+    common = dict(exclude=exclude, seed=ctx.seed, grasps=task_grasps_arg(args), arm=arm)
+    if method == _fusion.METHOD:
         ep = FusionEpisode.new(args.dir, obs, args.category, args.task, ctx, attempts=args.attempts, **common)
     else:
         ep = CategoryTaskEpisode.new(args.dir, obs, args.category, args.task, ctx, method=method, **common)
@@ -203,6 +208,10 @@ def _print_next(ep, fmt: str) -> None:
         print(f"attempt {nxt['attempt']} ({nxt['kind']}): palm at ({p[0]:.4f}, {p[1]:.4f}, {p[2]:.4f}) m, approach "
               f"({a[0]:.3f}, {a[1]:.3f}, {a[2]:.3f}), spread {g['spread']:.3f} rad; {_score(nxt)}")
     print("  joints " + ",".join(g["urdf"]["joint_names"] if "urdf" in g else g["joint_names"]))
+    if "arm" in g:          # with --robot: the arm's joints at the grasp, or why it cannot reach it
+        arm = g["arm"]
+        print("  arm joints " + ",".join(f"{v:.4f}" for v in arm["joint_positions"]) if arm["reachable"] else
+              f"  arm: cannot reach this grasp ({arm['reason']}); no reachable grasp was found")
     print("  then: bayesgrasp episode observe " + str(ep.directory) + " --joints A,B,... --lifted yes|no")
 
 

@@ -67,7 +67,9 @@ def run(args) -> int:
     fmt = output_format(args)
     arm = robot_arm(args, ctx.hand_model)
     if arm is not None:
-        trial.reach = _top_reach(arm, ctx.hand_model, trial.episode.observation.cloud)
+        from ..loop.reach import top_reach
+
+        trial.reach = top_reach(arm, ctx.hand_model, trial.episode.observation.cloud)
     r = trial.run(args.start, rounds=args.rounds, on_round=None if fmt != "text" else _print_round(trial.names),
                   stop_at_lift=True)
     grasps = [round_grasp(x, ctx.hand_model, trial.spread) for x in r.rounds]
@@ -98,20 +100,6 @@ def run(args) -> int:
 
     show_result(args, doc)
     return 0
-
-
-def _top_reach(arm, hand, cloud):
-    """Eq. 4.6's reach: top grasps (K, 3) as the palm down at (x, y, yaw) at the top of the seen cloud
-    (where a top grasp meets the object at the latest), checked against the table (the new
-    object's mesh is not known, only its cloud)."""
-    from ..arm import check_reach
-
-    top = float(np.max(np.asarray(cloud, float)[:, 2])) if len(cloud) else 0.0
-
-    def reach(X):
-        P = np.stack([hand.top_grasp_pose(x, y, yaw, top) for x, y, yaw in np.atleast_2d(X)])
-        return check_reach(arm, P).reachable
-    return reach
 
 
 def _arm_checks(arm, grasps: list, trial) -> None:

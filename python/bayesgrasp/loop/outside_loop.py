@@ -27,17 +27,21 @@ import numpy as np
 from .. import __version__
 from ..cache import atomic_write_text
 from ..hand import Hand, builtin_hands
+from ..arm import Arm
 from ..io.grasp_schema import hand_grasp_record
 from ..models import GraspModels, ModelSettings, relative_top_grasps
 from ..objects import ObjectModel, load_object, object_params
 from ..planners import PlannerSettings, Reading, make_planner
+from ..planners.registry import EPISODE_METHODS
 from ..world import World
+from ..planners.reach import ActionReach
 from .context import RunContext
+from .reach import arm_from_state, arm_state, with_arm
 
 STATE_FILE = "episode.json"
 LOCK_FILE = ".lock"
 FORMAT = 1
-METHODS = ("stability", "explore")
+METHODS = EPISODE_METHODS   # the pose methods an episode offers, as the registry declares them
 JOINT_LIMIT_SLACK = 0.02   # rad a reading may lie beyond the hand file's limits (encoder noise)
 
 
@@ -144,16 +148,29 @@ class DiskEpisode:
     def __init__(self, directory: Path, state: dict, ctx: RunContext):
         self.directory, self.state, self.ctx = Path(directory), state, ctx
         self.hand = ctx.hand_model
+        #: the arm the hand is on (``episode new --robot``), as stored at ``new``; None: free-floating
+        self.arm = None
+        if "arm" in state:
+            try:
+                self.arm = arm_from_state(state["arm"], str(self.directory))
+            except ValueError as e:
+                raise EpisodeError(str(e)) from None
 
     @staticmethod
-    def _base_state(kind: str, ctx: RunContext, attempts: int, seed: int) -> dict:
+    def _base_state(kind: str, ctx: RunContext, attempts: int, seed: int, arm: Optional[Arm] = None) -> dict:
+        """The state every kind starts from; with ``arm``, its ``arm`` (an episode without one has no key)."""
         if attempts < 1:
             raise EpisodeError(f"--attempts: must be at least 1, got {attempts}")
         if ctx.success != "lift":
             raise EpisodeError("--success: an episode's success is the robot's lift verdict (success 'lift')")
-        return {"format": FORMAT, "bayesgrasp": __version__, "kind": kind, "hand": ctx.hand, "cache": ctx.cache_dir,
-                "model_settings": None if ctx.model_settings is None else dataclasses.asdict(ctx.model_settings),
-                "attempts": int(attempts), "seed": int(seed), "steps": [], "next": None, "status": "open"}
+        if arm is not None and not isinstance(arm, Arm):
+            raise EpisodeError(f"--robot: expected a bayesgrasp.arm.Arm, got {type(arm).__name__}")
+        state = {"format": FORMAT, "bayesgrasp": __version__, "kind": kind, "hand": ctx.hand, "cache": ctx.cache_dir,
+                 "model_settings": None if ctx.model_settings is None else dataclasses.asdict(ctx.model_settings),
+                 "attempts": int(attempts), "seed": int(seed), "steps": [], "next": None, "status": "open"}
+        if arm is not None:
+            state["arm"] = arm_state(arm)
+        return state
 
     @classmethod
     def open(cls, directory, cache_dir: Optional[str] = None, progress=None) -> "DiskEpisode":
@@ -275,10 +292,14 @@ class PoseEpisode(DiskEpisode):
     @classmethod
     def new(cls, directory, obj: Union[str, ObjectModel], estimate: Sequence[float], ctx: RunContext,
             method: str = "explore", attempts: int = 4, seed: int = 0,
-            planner: Optional[PlannerSettings] = None, units: Optional[str] = None) -> "PoseEpisode":
+            planner: Optional[PlannerSettings] = None, units: Optional[str] = None,
+            arm: Optional[Arm] = None) -> "PoseEpisode":
         """``obj``: a built-in name, a mesh file or an ObjectModel (a file's is stored by its path);
-        ``units``: the mesh file's length unit, stored so that a later process reads it alike."""
-        episode = cls._unwritten(Path(directory), obj, estimate, ctx, method, attempts, seed, planner, units)
+        ``units``: the mesh file's length unit, stored so that a later process reads it alike;
+        ``arm``: the arm the hand is on (stored): the planner weighs only the grasps it reaches
+        (while it has met a reachable one; else, as the planner documents, the most stable) and each
+        grasp carries its ``arm``."""
+        episode = cls._unwritten(Path(directory), obj, estimate, ctx, method, attempts, seed, planner, units, arm)
         episode._create()
         return episode
 
@@ -286,19 +307,19 @@ class PoseEpisode(DiskEpisode):
     def first_grasp(cls, obj: Union[str, ObjectModel], estimate: Sequence[float], ctx: RunContext,
                     method: str = "explore", seed: int = 0, planner: Optional[PlannerSettings] = None) -> dict:
         """The grasp :meth:`new` would plan first (its ``next``), written nowhere: a one-shot question."""
-        episode = cls._unwritten(Path("<one-shot>"), obj, estimate, ctx, method, 1, seed, planner, None)
+        episode = cls._unwritten(Path("<one-shot>"), obj, estimate, ctx, method, 1, seed, planner, None, None)
         episode._plan_next()
         return episode.next
 
     @classmethod
     def _unwritten(cls, directory: Path, obj, estimate, ctx: RunContext, method: str, attempts: int, seed: int,
-                   planner: Optional[PlannerSettings], units: Optional[str]) -> "PoseEpisode":
+                   planner: Optional[PlannerSettings], units: Optional[str], arm: Optional[Arm]) -> "PoseEpisode":
         """The new episode with its planner, before its first plan and before anything is written."""
         if method not in METHODS:
             raise EpisodeError(f"--method: one of {', '.join(METHODS)}; got {method!r}")
         if (directory / STATE_FILE).exists():
             raise EpisodeError(f"{directory}: already holds an episode (remove it or pick another --dir)")
-        state = cls._base_state(cls.kind, ctx, attempts, seed)
+        state = cls._base_state(cls.kind, ctx, attempts, seed, arm)
         est = np.asarray(estimate, dtype=float).ravel()
         if est.shape != (3,) or not np.all(np.isfinite(est)):
             raise EpisodeError(f"--estimate: expected three finite numbers (x, y, yaw), got {estimate}")
@@ -323,8 +344,11 @@ class PoseEpisode(DiskEpisode):
     def _make_planner(self):
         s = self.state
         rng = np.random.default_rng(s["seed"])   # run_episode's: with an estimate given, one draw for the planner
-        return make_planner(s["method"], self.models, np.asarray(s["estimate"], dtype=float),
-                            PlannerSettings(**s["planner"]), seed=int(rng.integers(2**31)))
+        planner = make_planner(s["method"], self.models, np.asarray(s["estimate"], dtype=float),
+                               PlannerSettings(**s["planner"]), seed=int(rng.integers(2**31)))
+        if self.arm is not None:      # Eqs. 3.1, 3.2 over the grasps the arm reaches
+            planner.reach = ActionReach(self.arm, self.object, self.ctx.hand)
+        return planner
 
     def _replay(self):
         """The planner after the logged steps: every replayed plan must give the logged grasp."""
@@ -346,11 +370,18 @@ class PoseEpisode(DiskEpisode):
 
     def _plan_next(self) -> None:
         plan = self.planner.plan()
+        mean = self.planner.belief.mean()
+        grasp = predicted_top_grasp(self.hand, self.ctx.hand, self.object, mean, plan.action, self.models.spread)
+        if self.arm is not None:      # the arm checked against the table and the object at the belief's mean
+            try:
+                world = self.planner.reach.world(mean)
+                mesh = (world.vertices, world.faces)
+            except ValueError:        # the mean is off the table: the table only
+                mesh = None
+            grasp = with_arm(self.arm, grasp, mesh)
         self.state["next"] = {"attempt": len(self.state["steps"]) + 1, "kind": plan.kind,
                               "top_grasp": plan.action.tolist(), "predicted_stability": float(plan.predicted_stability),
-                              "expected_entropy": plan.expected_entropy,
-                              "grasp": predicted_top_grasp(self.hand, self.ctx.hand, self.object,
-                                                           self.planner.belief.mean(), plan.action, self.models.spread),
+                              "expected_entropy": plan.expected_entropy, "grasp": grasp,
                               "belief": self.planner.summary()}
 
 

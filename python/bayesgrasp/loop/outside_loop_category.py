@@ -25,16 +25,19 @@ from ..cache import atomic_write
 from ..models.task_grasps import grasp_from_json, grasp_to_json
 from ..models.tasks import task_rule
 from ..planners.category import THESIS_METHODS
-from ..planners.fusion import FusionSettings
+from ..planners.fusion import METHOD as FUSION, FusionSettings
 from .category import Observation, demonstrated, plan_and_execute, see, training_models
 from .category_result import TaskGraspResult
 from .context import RunContext
 from .outside_loop import (STATE_FILE, DiskEpisode, EpisodeError, PoseEpisode, open_state, particles_digest,
                            predicted_top_grasp, settings_json)
 from .fusion_trial import FusionTrial
+from .reach import table_reach, top_reach, with_arm
 
 VIEW_FILE = "view.npz"
 CATEGORY_METHODS = THESIS_METHODS   # the planners that plan once from a view (fusion: its own episode)
+#: every method a category episode takes: the task grasp's (one grasp) and vision then touch
+EPISODE_CATEGORY_METHODS = CATEGORY_METHODS + (FUSION,)
 
 
 # ---- the stored view ----------------------------------------------------------------------------
@@ -78,7 +81,7 @@ class _CategoryBase(DiskEpisode):
 
     @classmethod
     def _new_state(cls, directory: Path, observation: Observation, category: str, task: str, ctx: RunContext,
-                   attempts: int, exclude: Sequence[str], seed: int, grasps) -> dict:
+                   attempts: int, exclude: Sequence[str], seed: int, grasps, arm=None) -> dict:
         if (directory / STATE_FILE).exists():
             raise EpisodeError(f"{directory}: already holds an episode (remove it or pick another --dir)")
         _check_observation(observation)
@@ -87,7 +90,7 @@ class _CategoryBase(DiskEpisode):
             models = training_models(category, exclude)
         except ValueError as e:
             raise EpisodeError(str(e)) from None
-        state = cls._base_state(cls.kind, ctx, attempts, seed)
+        state = cls._base_state(cls.kind, ctx, attempts, seed, arm)
         grasps = demonstrated(models, rule, ctx) if grasps is None else grasps
         grasps = [g for g in grasps if g.task == task and g.model in models]
         if not grasps:
@@ -123,12 +126,15 @@ class CategoryTaskEpisode(_CategoryBase):
 
     @classmethod
     def new(cls, directory, observation: Observation, category: str, task: str, ctx: RunContext,
-            method: str = "laplace", exclude: Sequence[str] = (), seed: int = 0, grasps=None) -> "CategoryTaskEpisode":
+            method: str = "laplace", exclude: Sequence[str] = (), seed: int = 0, grasps=None,
+            arm=None) -> "CategoryTaskEpisode":
+        """``arm``: the arm the hand is on (stored): Eq. 4.1 over the grasps it reaches against the
+        table, and the grasp carries its ``arm``."""
         directory = Path(directory)
         if method not in CATEGORY_METHODS:
-            raise EpisodeError(f"--method: with --category one of {', '.join(CATEGORY_METHODS)} or fusion; "
+            raise EpisodeError(f"--method: with --category one of {', '.join(EPISODE_CATEGORY_METHODS)}; "
                                f"got {method!r}")
-        state = cls._new_state(directory, observation, category, task, ctx, 1, exclude, seed, grasps)
+        state = cls._new_state(directory, observation, category, task, ctx, 1, exclude, seed, grasps, arm)
         state["method"] = method
         episode = cls(directory, state, ctx, observation)
         episode._start()
@@ -137,7 +143,7 @@ class CategoryTaskEpisode(_CategoryBase):
     def _planned(self) -> TaskGraspResult:
         s = self.state
         return plan_and_execute(self._see(), s["category"], s["task"], s["method"], self.ctx, seed=s["seed"],
-                                grasps=self.grasps)
+                                grasps=self.grasps, reach=None if self.arm is None else table_reach(self.arm))
 
     def _replay(self) -> None:
         if self.state["steps"] or self.state["next"] is not None:
@@ -156,8 +162,11 @@ class CategoryTaskEpisode(_CategoryBase):
         if not r.plan.ok:
             raise EpisodeError(f"no task grasp: {r.outcome.reason or 'the plan failed'}")
         p = r.plan
-        self.state["next"] = {"attempt": 1, "kind": "task", "planned_pose": r.planned_pose,
-                              "grasp": r.planned_grasp(self.hand), "objective": p.objective, "weights": p.weights,
+        grasp = r.planned_grasp(self.hand)
+        if self.arm is not None:      # against the table (the object's mesh is not known)
+            grasp = with_arm(self.arm, grasp)
+        self.state["next"] = {"attempt": 1, "kind": "task", "planned_pose": r.planned_pose, "grasp": grasp,
+                              "objective": p.objective, "weights": p.weights,
                               "contributions": p.contributions, "dominant_model": p.dominant_model}
 
     def belief(self) -> dict:
@@ -184,6 +193,8 @@ class FusionEpisode(_CategoryBase):
                                      category=s["category"], observation=self.observation)
         except ValueError as e:
             raise EpisodeError(str(e)) from None
+        if self.arm is not None:      # Eq. 4.6 over the top grasps the arm reaches
+            self.trial.reach = top_reach(self.arm, self.hand, self.observation.cloud)
         keys = [m.info.get("key") for m in self.trial.models]
         if s.get("models_keys") is None:
             s["models_keys"] = keys
@@ -196,11 +207,13 @@ class FusionEpisode(_CategoryBase):
     @classmethod
     def new(cls, directory, observation: Observation, category: str, task: str, ctx: RunContext,
             attempts: int = 4, exclude: Sequence[str] = (), seed: int = 0, grasps=None,
-            settings: Optional[FusionSettings] = None) -> "FusionEpisode":
+            settings: Optional[FusionSettings] = None, arm=None) -> "FusionEpisode":
+        """``arm``: the arm the hand is on (stored): Eq. 4.6 over the top grasps it reaches against
+        the table, and each grasp carries its ``arm``."""
         directory = Path(directory)
-        state = cls._new_state(directory, observation, category, task, ctx, attempts, exclude, seed, grasps)
+        state = cls._new_state(directory, observation, category, task, ctx, attempts, exclude, seed, grasps, arm)
         s = settings or FusionSettings()
-        state.update({"method": "fusion", "models_keys": None,
+        state.update({"method": FUSION, "models_keys": None,
                       "fusion": settings_json(s)})
         episode = cls(directory, state, ctx, observation)
         episode._start()
@@ -232,6 +245,8 @@ class FusionEpisode(_CategoryBase):
         best = int(np.argmax(w))
         grasp = predicted_top_grasp(self.hand, self.ctx.hand, self.trial.names[best], self.planner.belief.poses[best],
                                     plan.action, self.trial.spread)
+        if self.arm is not None:      # against the table, as the planner's reach
+            grasp = with_arm(self.arm, grasp)
         self.state["next"] = {"attempt": len(self.state["steps"]) + 1, "round": len(self.state["steps"]),
                               "kind": "vision" if plan.round == 1 else "touch", "top_grasp": plan.action.tolist(),
                               "objective": plan.objective, "stability": plan.stability, "task": plan.task,

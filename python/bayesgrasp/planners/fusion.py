@@ -45,6 +45,10 @@ from .protocol import as_reading
 TASK_TERMS = ("laplace", "part-aware", "warped")
 PART_TERMS = ("part-aware", "warped")
 
+#: Vision then touch as a method name, with its line of help (the command line reads it).
+METHOD = "fusion"
+METHOD_HELP = {METHOD: "vision then touch: the weights and poses updated from each reading (Eq. 4.6)"}
+
 
 @dataclass(frozen=True)
 class FusionSettings(MixtureSettings):

@@ -20,6 +20,10 @@ METHOD_HELP = {"stability": "the most stable grasp (Eq. 3.1)",
                "ml_pose": "the most stable grasp at the most likely pose",
                "open_loop": "the most stable grasp at the estimate, no update"}
 
+#: The pose methods an episode with the robot outside offers (``bayesgrasp episode``, the outside
+#: loop): the thesis's two, Eq. 3.1 and Eq. 3.2; the others are the experiments' baselines.
+EPISODE_METHODS = ("stability", "explore")
+
 
 def methods_help(methods=None, help_of=None) -> str:
     """"name: what it does; ..." for ``methods`` (default: every pose method) from ``help_of``

@@ -6,6 +6,7 @@ from typing import Dict, List, Optional, Union
 
 from pydantic import BaseModel, ConfigDict, Field
 
+from ..arm import DEFAULT_BASE
 from ..loop.context import RunContext
 from ..loop.episode import EpisodeSettings
 
@@ -46,6 +47,14 @@ class NewEpisode(Planning):
 
     id: Optional[str] = Field(None, description="episode id (checked by the service's id pattern)")
     attempts: int = Field(EpisodeSettings.attempts, ge=1, le=1000)
+    robot: Optional[str] = Field(None, pattern=NAME, description="built-in arm the hand is on (as --robot); "
+                                                                 "default: none, the hand is free-floating")
+    robot_base: List[float] = Field(list(DEFAULT_BASE), min_length=4, max_length=4,
+                                    description="the arm's root in the table frame: x, y, z (m), yaw (rad)")
+    flange: Optional[str] = Field(None, pattern=NAME, description="the link the hand is mounted on (as --flange)")
+    mount: Optional[List[float]] = Field(None, min_length=6, max_length=6,
+                                         description="the palm in the flange's frame: x, y, z (m), roll, pitch, "
+                                                     "yaw (rad) (as --mount)")
 
 
 class Observation(_Body):

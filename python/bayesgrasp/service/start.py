@@ -11,7 +11,7 @@ import numpy as np
 from ..loop.category import Observation, observe
 from ..loop.context import context_from_plain
 from ..loop.outside_loop import METHODS as POSE_METHODS, PoseEpisode, check_builtin_hand, check_builtin_object
-from ..loop.outside_loop_category import CATEGORY_METHODS, CategoryTaskEpisode, FusionEpisode
+from ..loop.outside_loop_category import FUSION, EPISODE_CATEGORY_METHODS, CategoryTaskEpisode, FusionEpisode
 from .bodies import NewEpisode, Planning
 from .errors import ApiError
 
@@ -61,9 +61,30 @@ def _category_method(body: Planning) -> str:
     if body.estimate is not None:
         _refuse("estimate", "not with category (the view's registrations place the models)")
     method = body.method or "laplace"
-    if method not in CATEGORY_METHODS + ("fusion",):
-        _refuse("method", f"with category one of {', '.join(CATEGORY_METHODS + ('fusion',))}, got {method!r}")
+    if method not in EPISODE_CATEGORY_METHODS:
+        _refuse("method", f"with category one of {', '.join(EPISODE_CATEGORY_METHODS)}, got {method!r}")
     return method
+
+
+def _arm(body: NewEpisode, hand):
+    """The built-in arm ``body.robot`` at ``robot_base`` with its ``flange`` and ``mount`` (default:
+    the hand's base on the flange), as ``--robot`` makes it; None without ``robot``."""
+    from ..arm import Arm, builtin_arms, default_mount, mount_pose
+
+    if body.robot is None:
+        for field in ("flange", "mount"):
+            if getattr(body, field) is not None:
+                _refuse(field, "only with robot")
+        return None
+    if body.robot not in builtin_arms():
+        _refuse("robot", f"not a built-in arm, got {body.robot!r} (built-in: {', '.join(builtin_arms())})")
+    try:
+        mount = default_mount(hand) if body.mount is None else mount_pose(body.mount)
+        return Arm.load(body.robot, flange=body.flange, mount=mount, base=body.robot_base)
+    except ValueError as e:
+        msg = str(e)
+        field = next((f for f in ("flange", "mount", "base") if msg.startswith(f)), "robot")
+        _refuse("robot_base" if field == "base" else field, msg.split(": ", 1)[-1])
 
 
 def start_episode(directory: Path, body: NewEpisode, cache_dir: Optional[str]):
@@ -74,13 +95,13 @@ def start_episode(directory: Path, body: NewEpisode, cache_dir: Optional[str]):
         obj, method = _pose_inputs(body)
         ctx = _context(body, cache_dir)
         return PoseEpisode.new(directory, obj, body.estimate, ctx, method=method, attempts=body.attempts,
-                               seed=ctx.seed, planner=ctx.planner_settings())
+                               seed=ctx.seed, planner=ctx.planner_settings(), arm=_arm(body, ctx.hand_model))
     method = _category_method(body)
-    ctx = _context(body, cache_dir, reads=("models",) if method == "fusion" else ())
+    ctx = _context(body, cache_dir, reads=("models",) if method == FUSION else ())
     view = _view(body, ctx.seed)
     exclude = body.exclude if body.exclude is not None else [m for m in [body.object] if m]   # as the CLI
-    common = dict(exclude=exclude, seed=ctx.seed, grasps=None)
-    if method == "fusion":
+    common = dict(exclude=exclude, seed=ctx.seed, grasps=None, arm=_arm(body, ctx.hand_model))
+    if method == FUSION:
         return FusionEpisode.new(directory, view, body.category, body.task, ctx, attempts=body.attempts, **common)
     return CategoryTaskEpisode.new(directory, view, body.category, body.task, ctx, method=method, **common)
 
