@@ -177,3 +177,47 @@ def test_the_screenshots_say_they_are_still_working_while_the_browser_is_slow(tm
     _time.sleep(0.3)
     assert len(said) == n            # the heartbeat stopped with the screenshots
     assert port_free(port)           # and the server too
+
+
+def test_a_browser_that_times_out_once_is_retried_in_a_new_session(tmp_path, grasp_doc, monkeypatch):
+    """The renderer starved once (a loaded machine) costs a second session, not the pictures."""
+    from io import BytesIO
+
+    import matplotlib.pyplot as plt
+    from selenium.common.exceptions import TimeoutException
+
+    import bayesgrasp.viewer.snapshot as snap
+
+    buf = BytesIO()
+    plt.imsave(buf, np.random.default_rng(0).random((20, 30, 3)), format="png")
+    noisy = buf.getvalue()
+
+    class Driver:
+        def get(self, url):
+            self.url = url
+
+        def get_screenshot_as_png(self):
+            return noisy
+
+        def execute_script(self, script):
+            pass
+
+        def quit(self):
+            pass
+
+    sessions = []
+
+    def driver(size):
+        sessions.append(size)
+        if len(sessions) == 1:
+            raise TimeoutException("timeout: Timed out receiving message from renderer: 10.000")
+        return Driver()
+
+    monkeypatch.setattr(snap, "_driver", driver)
+    scene = scene_from_result({"scene_object": "mug/3", "object_pose": [0, 0, 0],
+                               "rounds": [{"round": 0, "grasp": grasp_doc["grasp"], "lifted": grasp_doc["lifted"],
+                                           "weights": {}, "poses": {}}]})
+    said = []
+    (p,) = snap.snapshot_steps(scene, {0: tmp_path / "a.png"}, port=free_port(), say=said.append, settle=0.0)
+    assert len(sessions) == 2 and p.read_bytes() == noisy
+    assert any("timed out" in m and "a new session" in m for m in said)

@@ -104,9 +104,27 @@ def snapshot_steps(scene, paths: Dict[int, object], port: int = 8080, size=(960,
     server, view = serve(scene, port=port, say=say)
     try:
         with progress.heartbeat(say, f"3D view: screenshots of {len(paths)} step(s) in headless Chromium"):
-            return _shoot(server, view, paths, size, settle)
+            return _shoot_retrying(server, view, paths, size, settle, say)
     finally:
         stop(server)
+
+
+#: browser sessions tried before giving up (a renderer starved on a loaded machine times out once)
+SESSIONS = 2
+
+
+def _shoot_retrying(server, view, paths, size, settle: float, say=None) -> List[Path]:
+    """:func:`_shoot`, with a new browser session after a timeout, up to :data:`SESSIONS`."""
+    from selenium.common.exceptions import TimeoutException
+
+    for attempt in range(1, SESSIONS + 1):
+        try:
+            return _shoot(server, view, paths, size, settle)
+        except TimeoutException as e:
+            if attempt == SESSIONS:
+                raise
+            if say is not None:
+                say(f"  3D view: the browser timed out ({str(e).strip().splitlines()[0]}); a new session")
 
 
 def _shoot(server, view, paths: Dict[int, object], size, settle: float) -> List[Path]:
