@@ -11,12 +11,14 @@ request id until answered. Afterwards every episode's steps are compared with wh
 answered: lost = answered but not in the episode, duplicated = in the episode more than once.
 
     OMP_NUM_THREADS=1 .venv/bin/python bench/serve_load.py --concurrency 1,8,32
+    OMP_NUM_THREADS=1 .venv/bin/python bench/serve_load.py --in-process-only --steps 8   # the step alone
 
 The cylinder with the default models (shipped with the package), stability method.
 """
 from __future__ import annotations
 
 import argparse
+import hashlib
 import json
 import os
 import signal
@@ -133,7 +135,7 @@ def in_process(root: Path, steps: int) -> dict:
     """The same step in this process, no HTTP: PoseEpisode.observe (the planner's update and plan,
     the state written), what the service's latency is made of."""
     from bayesgrasp.loop.context import RunContext
-    from bayesgrasp.loop.outside_loop import PoseEpisode
+    from bayesgrasp.loop.outside_loop import PoseEpisode, particles_digest
 
     ep = PoseEpisode.new(root / "in-process", BODY["object"], BODY["estimate"], RunContext(), method=BODY["method"],
                          attempts=1000, seed=BODY["seed"])
@@ -142,7 +144,11 @@ def in_process(root: Path, steps: int) -> dict:
         t0 = time.perf_counter()
         ep.observe(READINGS[k % len(READINGS)], False)
         times.append(time.perf_counter() - t0)
-    return {"observations": steps, "median_ms": 1e3 * statistics.median(times), "p99_ms": 1e3 * pct(times, 99)}
+    b = ep.planner.belief
+    return {"observations": steps, "median_ms": 1e3 * statistics.median(times), "p99_ms": 1e3 * pct(times, 99),
+            "step_ms": [round(1e3 * t, 1) for t in times],
+            "state_sha256": hashlib.sha256(json.dumps(ep.state, sort_keys=True).encode()).hexdigest(),
+            "belief_sha256": particles_digest(b.particles, b.weights)}   # a change that keeps results keeps these
 
 
 def faults(server: Server, n: int, total: int, kill_every: float, max_kills: int) -> dict:
@@ -213,8 +219,16 @@ def main() -> int:
     p.add_argument("--max-kills", type=int, default=10, help="kills at most (the fault run stays bounded)")
     p.add_argument("--no-faults", action="store_true")
     p.add_argument("--no-latency", action="store_true")
+    p.add_argument("--in-process-only", action="store_true",
+                   help="only the step in this process (PoseEpisode.observe, no server): --steps of them")
     a = p.parse_args()
     out = {"cpu_count": os.cpu_count()}
+    if a.in_process_only:
+        with tempfile.TemporaryDirectory(prefix="serve-load-") as tmp:
+            out["in_process"] = in_process(Path(tmp), a.steps)
+        say(f"in process (PoseEpisode.observe): median {out['in_process']['median_ms']:.1f} ms")
+        print(json.dumps(out, indent=1))
+        return 0
     with tempfile.TemporaryDirectory(prefix="serve-load-") as tmp:
         root = Path(tmp)
         server = Server(root, free_port())

@@ -88,5 +88,6 @@ class Client:
         return self._call("GET", f"/episodes/{episode_id}")
 
     def plan(self, **options) -> dict:
-        """``POST /v1/plan``: the first grasp for an object at an estimate, no episode kept."""
+        """``POST /v1/plan``: the first grasp for an object at an estimate (``{next}``), or with
+        category and task the task grasp as ``bayesgrasp category --json`` prints it; no episode kept."""
         return self._call("POST", "/plan", options)

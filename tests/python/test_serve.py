@@ -137,6 +137,24 @@ def test_the_first_grasp_equals_the_episode_command_s_and_the_one_shot_plan_s(ca
     validate(by_api["next"]["grasp"])                          # the grasp schema's shape
 
 
+def test_a_one_shot_category_plan_equals_the_category_command_s(capsys, server, client):
+    """POST /v1/plan with category and task answers what `bayesgrasp category --json` prints (the
+    README's example: its task grasps ship in the package's cache); a bad category, task or method
+    is refused with a JSON error and its code."""
+    by_cli = cli_json(capsys, "category", "--category", "mug", "--task", "handle", "--scene-object", "mug/3",
+                      "--object-pose", "0.02,-0.01,2.0", "--json")
+    by_api = client.plan(category="mug", task="handle", object="mug/3", object_pose=[0.02, -0.01, 2.0])
+    assert by_cli["grasp"] is not None and by_api["grasp"] == by_cli["grasp"]           # exact floats
+    assert by_api == by_cli
+    for body, needle in [(dict(category="teapot", task="handle", object="mug/3"), "category: no tasks for 'teapot'"),
+                         (dict(category="mug", task="spout", object="mug/3"), "task: 'mug' has no task 'spout'"),
+                         (dict(category="mug", task="handle", object="mug/3", method="fusion"), "an episode"),
+                         (dict(category="mug", object="mug/3"), "category, task: give both")]:
+        r = httpx.post(server.url + "/v1/plan", headers=AUTH, json=body, timeout=60)
+        assert r.status_code == 422 and r.json()["error"]["code"] == "invalid_body", r.text
+        assert needle in r.json()["error"]["message"], r.text
+
+
 def test_an_episode_on_an_arm_through_the_api_equals_the_episode_command_s(capsys, tmp_path, server, client):
     """robot, robot_base: the arm as `episode new --robot --robot-base` takes it; the first grasp (its
     arm record included) is the command's; a bad arm option is refused and writes nothing."""

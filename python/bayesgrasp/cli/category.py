@@ -58,14 +58,14 @@ def run(args) -> int:
         raise CliError("no training model registered to the cloud (is the object in view, is it of this category?)")
     grasps = task_grasps_arg(args)
     arm = robot_arm(args, ctx.hand_model)
-    from ..loop.reach import table_reach
+    from ..loop.reach import table_reach, with_arm_on
 
     ctx.say(f"category: planning the {args.task} grasp ({args.method}) and lift-testing it")
     r = plan_and_execute(ep, args.category, args.task, args.method, ctx, seed=ctx.seed, grasps=grasps,
                          reach=None if arm is None else table_reach(arm))
     grasp = r.grasp(ctx.hand_model)
     if arm is not None and grasp is not None:
-        grasp["arm"] = _arm_check(arm, grasp, args.scene_object, pose, ctx.hand)
+        grasp = with_arm_on(arm, grasp, args.scene_object, pose, ctx.hand)   # with the stand-in, if any
     scene = (args.cloud or args.depth) if view is not None else "simulated view"
     doc = category_document(r, grasp, ep, args.category, args.units, scene)
     fmt = output_format(args)
@@ -89,21 +89,6 @@ def run(args) -> int:
 
     show_result(args, doc)
     return 0
-
-
-def _arm_check(arm, grasp: dict, scene_object, pose, hand) -> dict:
-    """The grasp sent (table frame) checked with the arm: against the table and, when there is a
-    simulated stand-in, its mesh at --object-pose (the grasp schema's ``arm``)."""
-    from ..arm import ReachOptions, arm_record, check_reach
-    from ..world import World
-
-    mesh = None
-    if scene_object:
-        world = World.single(scene_object, pose=pose, hand=hand)
-        mesh = (world.vertices, world.faces)
-    r = check_reach(arm, np.asarray(grasp["pose"], dtype=float), mesh,
-                    ReachOptions(pregrasp_distance=grasp["pregrasp"]["distance"]))
-    return arm_record(arm, r, 0)
 
 
 def _print_part_check(pc: dict) -> None:

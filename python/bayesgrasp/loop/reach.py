@@ -69,3 +69,15 @@ def with_arm(arm: Arm, grasp: dict, mesh: Optional[tuple] = None) -> dict:
     r = check_reach(arm, np.asarray(grasp["pose"], dtype=float), mesh,
                     ReachOptions(pregrasp_distance=grasp["pregrasp"]["distance"]))
     return {**grasp, "arm": arm_record(arm, r, 0)}
+
+
+def with_arm_on(arm: Arm, grasp: dict, obj, pose, hand) -> dict:
+    """:func:`with_arm` against the simulated stand-in ``obj`` at ``pose`` (x, y, yaw on the table,
+    ``hand`` the world's), or the table alone when ``obj`` is None (a plan on camera data only)."""
+    from ..world import World
+
+    mesh = None
+    if obj:
+        world = World.single(obj, pose=pose, hand=hand)
+        mesh = (world.vertices, world.faces)
+    return with_arm(arm, grasp, mesh)

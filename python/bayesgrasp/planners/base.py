@@ -26,7 +26,7 @@ from __future__ import annotations
 import time
 import warnings
 from dataclasses import dataclass, replace
-from typing import List, Mapping, Optional, Sequence, Union
+from typing import List, Mapping, Optional, Sequence, Tuple, Union
 
 import numpy as np
 
@@ -186,6 +186,7 @@ class Planner:
         self.observations: List[Observation] = []
         self.history: List[PoseUpdate] = []
         self._plans = 0
+        self._entropy_memo: Optional[Tuple[bytes, float]] = None   # (belief state, its KDE entropy)
 
     # ---- the prior box --------------------------------------------------------------------------
     def _log_prior(self, poses: np.ndarray) -> np.ndarray:
@@ -375,6 +376,16 @@ class Planner:
             best = best[np.argsort(d)]
         return P[best[0]].copy()
 
+    def _kde_entropy(self, b: ParticleBelief, P: np.ndarray) -> float:
+        """The belief's KDE entropy, computed once per belief state: an episode step summarises the
+        same belief after its update and beside its next plan (the entropy is O(N^2), the rest O(N));
+        the state is the particles, weights, box and wrapping flags, compared byte for byte."""
+        state = b"".join(np.ascontiguousarray(a, dtype=float).tobytes()
+                         for a in (P, b.log_weights, b.low, b.high, np.asarray(b.wraps, dtype=float)))
+        if self._entropy_memo is None or self._entropy_memo[0] != state:
+            self._entropy_memo = (state, float(b.kde_entropy()))
+        return self._entropy_memo[1]
+
     def summary(self, true_pose: Optional[Sequence[float]] = None) -> dict:
         """The belief in numbers: mean, std per dim, ESS, KDE entropy, and errors to ``true_pose``."""
         b = self.belief
@@ -383,7 +394,7 @@ class Planner:
         d = P - mu
         d[:, 2] = wrap_angle(d[:, 2])
         out = {"mean": mu.tolist(), "std": np.sqrt(np.maximum(w @ (d * d), 0.0)).tolist(), "ess": float(b.ess()),
-               "kde_entropy": float(b.kde_entropy())}
+               "kde_entropy": self._kde_entropy(b, P)}
         if true_pose is not None:
             t = np.asarray(true_pose, dtype=float)
             out["position_error"] = float(np.hypot(mu[0] - t[0], mu[1] - t[1]))

@@ -11,6 +11,7 @@ from ..loop.context import RunContext
 from ..loop.episode import EpisodeSettings
 
 NAME = r"^[A-Za-z0-9][A-Za-z0-9_-]{0,63}$"      # built-in objects, hands, categories, tasks, methods
+OBJECT = NAME[:-1] + r"(/[0-9]{1,4})?$"           # a built-in object, or a category member (mug/3)
 Triple = List[float]
 
 
@@ -21,9 +22,10 @@ class _Body(BaseModel):
 class Planning(_Body):
     """What a plan is made from: the object (pose uncertainty: a built-in ``object`` at the
     ``estimate`` x, y, yaw) or a category task (``category``, ``task`` and the view: ``cloud`` +
-    ``viewpoint``, or the simulated view of built-in ``object`` at ``object_pose``)."""
+    ``viewpoint``, or the simulated view of built-in ``object`` at ``object_pose``); ``robot``: the
+    arm the hand is on (a category task's grasps are the ones it reaches)."""
 
-    object: Optional[str] = Field(None, pattern=NAME, description="built-in object name")
+    object: Optional[str] = Field(None, pattern=OBJECT, description="built-in object name (cylinder, mug/3)")
     estimate: Optional[Triple] = Field(None, min_length=3, max_length=3, description="x, y (m), yaw (rad)")
     method: Optional[str] = Field(None, pattern=NAME, description="stability | explore; with a category: laplace, "
                                                                     "regularised, gaussian, baseline or fusion")
@@ -39,14 +41,6 @@ class Planning(_Body):
         default_factory=dict, description="ModelSettings overrides (as --set models.FIELD=VALUE)")
     planner: Dict[str, Union[int, float, bool, str, None, List[float]]] = Field(
         default_factory=dict, description="PlannerSettings overrides (as --set planner.FIELD=VALUE)")
-
-
-class NewEpisode(Planning):
-    """``bayesgrasp episode new``'s options; ``id``: the client's name for the episode (a retry
-    with the same id and body returns the same episode), else one is made."""
-
-    id: Optional[str] = Field(None, description="episode id (checked by the service's id pattern)")
-    attempts: int = Field(EpisodeSettings.attempts, ge=1, le=1000)
     robot: Optional[str] = Field(None, pattern=NAME, description="built-in arm the hand is on (as --robot); "
                                                                  "default: none, the hand is free-floating")
     robot_base: List[float] = Field(list(DEFAULT_BASE), min_length=4, max_length=4,
@@ -55,6 +49,14 @@ class NewEpisode(Planning):
     mount: Optional[List[float]] = Field(None, min_length=6, max_length=6,
                                          description="the palm in the flange's frame: x, y, z (m), roll, pitch, "
                                                      "yaw (rad) (as --mount)")
+
+
+class NewEpisode(Planning):
+    """``bayesgrasp episode new``'s options; ``id``: the client's name for the episode (a retry
+    with the same id and body returns the same episode), else one is made."""
+
+    id: Optional[str] = Field(None, description="episode id (checked by the service's id pattern)")
+    attempts: int = Field(EpisodeSettings.attempts, ge=1, le=1000)
 
 
 class Observation(_Body):

@@ -16,7 +16,7 @@ from ..loop.outside_requests import RequestLog, body_digest, sync_directory
 from .bodies import NewEpisode, Observation, Planning
 from .errors import ApiError
 from .security import check_id
-from .start import first_grasp, start_episode
+from .start import category_answer, first_grasp, start_episode
 from .store import Warm
 
 router = APIRouter(prefix="/v1")
@@ -149,5 +149,11 @@ def show(eid: str, request: Request) -> dict:
 
 @router.post("/plan")
 def plan(body: Planning, request: Request) -> dict:
-    """One question, no episode: the first grasp a pose episode with these options would plan."""
-    return {"next": first_grasp(body, _store(request).cache_dir)}
+    """One question, no episode: the first grasp a pose episode with these options would plan
+    (``{next}``), or with ``category`` and ``task`` what ``bayesgrasp category --json`` prints
+    (its ``grasp`` the task grasp)."""
+    store = _store(request)
+    if body.category or body.task:
+        with store.creating:                 # the registrations and task grasps are loaded once, shared
+            return category_answer(body, store.cache_dir)
+    return {"next": first_grasp(body, store.cache_dir)}

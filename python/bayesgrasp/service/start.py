@@ -1,6 +1,7 @@
 """A new episode or a one-shot plan from a request body: the kind of episode its fields ask for,
 started through the loop as ``bayesgrasp episode new`` starts it (the same calls, so the same
-grasps), with the server's model cache."""
+grasps), or a category task's grasp as ``bayesgrasp category`` plans it, with the server's model
+cache."""
 from __future__ import annotations
 
 from pathlib import Path
@@ -66,7 +67,7 @@ def _category_method(body: Planning) -> str:
     return method
 
 
-def _arm(body: NewEpisode, hand):
+def _arm(body: Planning, hand):
     """The built-in arm ``body.robot`` at ``robot_base`` with its ``flange`` and ``mount`` (default:
     the hand's base on the flange), as ``--robot`` makes it; None without ``robot``."""
     from ..arm import Arm, builtin_arms, default_mount, mount_pose
@@ -109,9 +110,53 @@ def start_episode(directory: Path, body: NewEpisode, cache_dir: Optional[str]):
 def first_grasp(body: Planning, cache_dir: Optional[str]) -> dict:
     """The first grasp of the pose episode ``body`` describes (as :func:`start_episode` would plan
     it), written nowhere."""
-    if body.category or body.task:
-        _refuse("category", "one-shot plans are for pose questions here; start an episode for a category task")
     obj, method = _pose_inputs(body)
+    if body.robot is not None:
+        _refuse("robot", "a one-shot pose plan takes no arm; start an episode with robot")
     ctx = _context(body, cache_dir)
     return PoseEpisode.first_grasp(obj, body.estimate, ctx, method=method, seed=ctx.seed,
                                    planner=ctx.planner_settings())
+
+
+def category_answer(body: Planning, cache_dir: Optional[str]) -> dict:
+    """What ``bayesgrasp category --json`` prints for the category task ``body`` describes (the
+    view: ``cloud`` + ``viewpoint``, or the simulated view of ``object`` at ``object_pose``;
+    ``object``, when given, is the stand-in the grasp is executed on), written nowhere."""
+    from ..io.results import category_document
+    from ..loop.category import plan_and_execute, see
+    from ..loop.reach import table_reach, with_arm_on
+    from ..models.tasks import task_rule
+    from ..planners.category import METHODS
+
+    if not (body.category and body.task):
+        _refuse("category, task", "give both")
+    if body.estimate is not None:
+        _refuse("estimate", "not with category (the view's registrations place the models)")
+    method = body.method or "laplace"
+    if method not in METHODS:
+        _refuse("method", f"a one-shot category plan is one of {', '.join(METHODS)}, got {method!r}"
+                          + (" (vision then touch is an episode: POST /v1/episodes)" if method == FUSION else ""))
+    try:
+        task_rule(body.category, body.task)
+    except ValueError as e:
+        field, _, why = str(e).partition(": ")
+        _refuse(field, why)
+    obj = None if body.object is None else check_builtin_object(body.object)
+    ctx = _context(body, cache_dir, reads=())
+    arm = _arm(body, ctx.hand_model)
+    view = _view(body, ctx.seed)
+    exclude = body.exclude if body.exclude is not None else [m for m in [obj] if m]   # as the CLI
+    try:
+        ep = see(obj, tuple(body.object_pose), body.category, exclude=exclude, seed=ctx.seed, observation=view)
+    except ValueError as e:
+        field, _, why = str(e).partition(": ")
+        _refuse(field, why)
+    if not any(r.success for r in ep.registrations):
+        raise ApiError(422, "not_registered", "no training model registered to the cloud (is the object in view, "
+                                              "is it of this category?)")
+    r = plan_and_execute(ep, body.category, body.task, method, ctx, seed=ctx.seed,
+                         reach=None if arm is None else table_reach(arm))
+    grasp = r.grasp(ctx.hand_model)
+    if arm is not None and grasp is not None:
+        grasp = with_arm_on(arm, grasp, obj, ep.pose, ctx.hand)
+    return category_document(r, grasp, ep, body.category, None, "simulated view" if body.cloud is None else "cloud")
