@@ -23,11 +23,43 @@ from bayesgrasp.planners.reach import ActionReach
 from bayesgrasp.world import World
 
 
-def arm_verdict(arm, obj, pose, attempt, hand) -> str:
-    """"" when the arm reaches the executed grasp, else the reason."""
+def arm_verdict(arm, obj, pose, hand_pose, hand) -> str:
+    """"" when the arm reaches the executed palm pose ``hand_pose`` (4x4, table frame), else the
+    reason: its grasp, pre-grasp and approach, links against the table and ``obj`` at ``pose``."""
     world = World.single(obj, pose=list(pose), hand=hand)
-    r = check_reach(arm, np.asarray(attempt.execution.hand_pose), (world.vertices, world.faces), ReachOptions())
+    r = check_reach(arm, np.asarray(hand_pose, dtype=float), (world.vertices, world.faces), ReachOptions())
     return r.reason[0]
+
+
+def shipped_arm(base: str, hand_model) -> Arm:
+    """The shipped KUKA LBR4+ at ``base`` ("X,Y,Z,YAW", table frame), the hand on its default mount."""
+    return Arm.load("kuka_lbr4", base=[float(v) for v in base.split(",")], mount=default_mount(hand_model))
+
+
+def share_row(name: str, rows, label: str, oks=("success",)) -> str:
+    """One table row: of the runs' ``label`` plannings, those whose executed grasp the arm reaches,
+    then for each verdict in ``oks`` (``rows[i][label][ok]``) those it holds for and those it holds
+    for that the arm reaches, and the median seconds."""
+    n = len(rows)
+    cells = [f"{sum(r[label]['reason'] == '' for r in rows)} of {n}"]
+    for ok in oks:
+        cells += [f"{sum(bool(r[label][ok]) for r in rows)} of {n}",
+                  f"{sum(bool(r[label][ok]) and r[label]['reason'] == '' for r in rows)} of {n}"]
+    sec = float(np.median([r[label]["seconds"] for r in rows]))
+    return f"| {name} | {' | '.join(cells)} | {sec:.1f} |"
+
+
+def unreachable_reasons(rows, label: str = "free") -> dict:
+    """How many of the runs' ``label`` grasps are out of the arm's reach, by reason."""
+    reasons = {}
+    for r in rows:
+        if r[label]["reason"]:
+            reasons[r[label]["reason"]] = reasons.get(r[label]["reason"], 0) + 1
+    return reasons
+
+
+#: The two plannings of every run: (key, the table's name).
+PLANNINGS = (("free", "free-floating hand (thesis)"), ("arm", "over the arm's reachable grasps"))
 
 
 def main(argv=None) -> int:
@@ -36,8 +68,7 @@ def main(argv=None) -> int:
     p.add_argument("--robot-base", default="-0.6,0,0,0")
     a = p.parse_args(argv)
     ctx = RunContext()
-    arm = Arm.load("kuka_lbr4", base=[float(v) for v in a.robot_base.split(",")],
-                   mount=default_mount(ctx.hand_model))
+    arm = shipped_arm(a.robot_base, ctx.hand_model)
     rows = []
     for obj in FIVE:
         models = ctx.family_models(obj)
@@ -50,7 +81,8 @@ def main(argv=None) -> int:
                 r = run_episode(obj, pose, EpisodeSettings(method="stability", attempts=1), ctx, seed=seed,
                                 models=models, reach=reach)
                 att = r.attempts[0]
-                out[label] = {"reason": arm_verdict(arm, obj, pose, att, ctx.hand), "success": bool(att.success),
+                out[label] = {"reason": arm_verdict(arm, obj, pose, att.execution.hand_pose, ctx.hand),
+                              "success": bool(att.success),
                               "predicted": float(att.plan.predicted_stability), "seconds": time.perf_counter() - t}
             print(f"{obj} run {k}: free {out['free']}, arm {out['arm']}", file=sys.stderr, flush=True)
             rows.append(out)
@@ -59,17 +91,9 @@ def main(argv=None) -> int:
           f"{a.robot_base}")
     print("| planning | executed grasps the arm reaches | lifted | lifted and reachable | median s per plan+grasp |")
     print("|---|---|---|---|---|")
-    for label, name in (("free", "free-floating hand (thesis)"), ("arm", "over the arm's reachable grasps")):
-        reach = sum(r[label]["reason"] == "" for r in rows)
-        lifted = sum(r[label]["success"] for r in rows)
-        both = sum(r[label]["success"] and r[label]["reason"] == "" for r in rows)
-        sec = float(np.median([r[label]["seconds"] for r in rows]))
-        print(f"| {name} | {reach} of {n} | {lifted} of {n} | {both} of {n} | {sec:.1f} |")
-    reasons = {}
-    for r in rows:
-        if r["free"]["reason"]:
-            reasons[r["free"]["reason"]] = reasons.get(r["free"]["reason"], 0) + 1
-    print(f"\nwhy the free-floating grasps are out of reach: {reasons}")
+    for label, name in PLANNINGS:
+        print(share_row(name, rows, label))
+    print(f"\nwhy the free-floating grasps are out of reach: {unreachable_reasons(rows)}")
     return 0
 
 
