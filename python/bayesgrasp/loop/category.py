@@ -22,13 +22,16 @@ from ..models.task_grasps import TaskGraspSettings, task_grasps
 from ..models.tasks import TaskRule, task_rule
 from ..objects import CATEGORY_SIZES, category, load_object
 from ..objects.views import DEFAULT_EYE_OFFSET, capture_view
-from ..planners.category import CategoryPlan, CategoryPlanner, CategorySettings
+from ..planners.category import METHODS, CategoryPlan, CategoryPlanner, CategorySettings
 from ..vision import Registrar, RegistrationResult, model_samples
 from ..world import World
 from .category_result import TaskGraspOutcome, TaskGraspResult
 from .context import RunContext
 
 #: Categories that train on another category's models (the thesis's tools experiment).
+#: the category planner's methods (Eq. 4.1 and its part-aware variants), for the loop's users
+PLAN_METHODS = METHODS
+
 TRAINING_CATEGORY = {"knife": "hammer"}
 
 #: Failure classes (the thesis's own failure analysis names the first three).

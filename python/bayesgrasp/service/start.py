@@ -123,10 +123,9 @@ def category_answer(body: Planning, cache_dir: Optional[str]) -> dict:
     view: ``cloud`` + ``viewpoint``, or the simulated view of ``object`` at ``object_pose``;
     ``object``, when given, is the stand-in the grasp is executed on), written nowhere."""
     from ..io.results import category_document
-    from ..loop.category import plan_and_execute, see
+    from ..loop.category import PLAN_METHODS as METHODS
+    from ..loop.category import plan_and_execute, see, task_rule
     from ..loop.reach import table_reach, with_arm_on
-    from ..models.tasks import task_rule
-    from ..planners.category import METHODS
 
     if not (body.category and body.task):
         _refuse("category, task", "give both")
