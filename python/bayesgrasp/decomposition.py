@@ -24,8 +24,6 @@ from __future__ import annotations
 import hashlib
 import os
 import sys
-import threading
-import time
 import warnings
 from pathlib import Path
 from typing import Callable, List, Optional, Union
@@ -34,6 +32,7 @@ import numpy as np
 
 from bayesgrasp._args import c_seed
 from bayesgrasp.cache import atomic_write, cache_root, load_cached
+from bayesgrasp.progress import heartbeat
 
 #: Triangles above which the mesh is simplified before CoACD (the built-in objects, at most
 #: 3,640, stay below).
@@ -124,28 +123,9 @@ def _run_coacd(V: np.ndarray, F: np.ndarray, threshold: float, seed: int, search
     import coacd  # only needed here
 
     coacd.set_log_level("error")
-    out: dict = {}
-
-    def work() -> None:
-        try:
-            parts = coacd.run_coacd(coacd.Mesh(V, F.astype(np.int32)), threshold=float(threshold), seed=seed,
-                                    **search)
-            out["pieces"] = [np.ascontiguousarray(p[0], dtype=np.float64) for p in parts]
-        except Exception as e:  # noqa: BLE001 - any CoACD failure falls back to the hull
-            out["error"] = e
-
-    start = time.monotonic()
-    t = threading.Thread(target=work, daemon=True)
-    t.start()
-    while True:
-        t.join(PROGRESS_EVERY)
-        if not t.is_alive():
-            break
-        if say is not None:
-            say(f"  decomposing {what} for the lift test: {time.monotonic() - start:.0f} s so far")
-    if "error" in out:
-        raise out["error"]
-    return out["pieces"]
+    with heartbeat(say, f"decomposing {what} for the lift test", every=PROGRESS_EVERY):
+        parts = coacd.run_coacd(coacd.Mesh(V, F.astype(np.int32)), threshold=float(threshold), seed=seed, **search)
+    return [np.ascontiguousarray(p[0], dtype=np.float64) for p in parts]
 
 
 def _hull_volume(P: np.ndarray) -> float:

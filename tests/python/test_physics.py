@@ -349,3 +349,27 @@ def test_a_concave_objects_decomposition_waits_for_a_grasp_that_needs_it():
     assert rb.lifted.tolist() == re.lifted.tolist()
     np.testing.assert_array_equal(rb.displacement, re.displacement)
     assert r0.displacement == re.displacement[0] and lazy.num_pieces == eager.num_pieces
+
+
+def test_a_long_decomposition_says_it_is_still_working(monkeypatch):
+    """CoACD on a large mesh says nothing for minutes: a line comes every PROGRESS_EVERY seconds
+    while it runs, and its pieces come back as float64 arrays."""
+    import time
+
+    import coacd
+
+    from bayesgrasp import decomposition
+
+    def slow(mesh, **kw):
+        time.sleep(0.35)
+        return [(np.zeros((4, 3), np.float32), np.zeros((4, 3), np.int32))]
+
+    monkeypatch.setattr(coacd, "run_coacd", slow)
+    monkeypatch.setattr(decomposition, "PROGRESS_EVERY", 0.05)
+    said = []
+    V = np.array([[0, 0, 0], [1, 0, 0], [0, 1, 0], [0, 0, 1]], float)
+    F = np.array([[0, 1, 2], [0, 1, 3], [0, 2, 3], [1, 2, 3]])
+    pieces = decomposition._run_coacd(V, F, 0.05, 0, {}, said.append, "'box'")
+    assert [p.dtype for p in pieces] == [np.float64] and pieces[0].shape == (4, 3)
+    beats = [m for m in said if m.startswith("  decomposing 'box' for the lift test: ") and m.endswith(" s so far")]
+    assert len(beats) >= 3, said
